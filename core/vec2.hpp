@@ -1,0 +1,117 @@
+// bbm core: 2D vector and polygon primitives shared by every layer.
+//
+// Everything in bbm is plane strain with unit thickness, so a point, a force
+// and a displacement are all a pair of doubles. This header is the lowest layer
+// of the code: it includes nothing of bbm, and meshing/, fem/, contact/ and the
+// solver in core/ all build on it. Polygon integrals (area, centroid, polar
+// moment) are the exact closed forms for a simple polygon (Green's theorem),
+// since rigid-block mass properties are taken from them (SPEC §3).
+#pragma once
+
+#include <cmath>
+#include <span>
+
+namespace bbm {
+
+struct Vec2 {
+    double x = 0.0;
+    double y = 0.0;
+
+    constexpr Vec2& operator+=(Vec2 o) { x += o.x; y += o.y; return *this; }
+    constexpr Vec2& operator-=(Vec2 o) { x -= o.x; y -= o.y; return *this; }
+    constexpr Vec2& operator*=(double s) { x *= s; y *= s; return *this; }
+    friend constexpr Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
+    friend constexpr Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
+    friend constexpr Vec2 operator-(Vec2 a) { return {-a.x, -a.y}; }
+    friend constexpr Vec2 operator*(double s, Vec2 a) { return {s * a.x, s * a.y}; }
+    friend constexpr Vec2 operator*(Vec2 a, double s) { return {s * a.x, s * a.y}; }
+    friend constexpr Vec2 operator/(Vec2 a, double s) { return {a.x / s, a.y / s}; }
+    friend constexpr bool operator==(Vec2 a, Vec2 b) = default;
+};
+
+constexpr double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
+/// z-component of the 3D cross product: positive when b is counter-clockwise from a.
+constexpr double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+inline double norm(Vec2 a) { return std::hypot(a.x, a.y); }
+constexpr double norm2(Vec2 a) { return a.x * a.x + a.y * a.y; }
+/// Rotates a by +90 degrees (counter-clockwise).
+constexpr Vec2 perp(Vec2 a) { return {-a.y, a.x}; }
+
+/// Signed area; positive for a counter-clockwise polygon.
+inline double signed_area(std::span<const Vec2> p) {
+    double a2 = 0.0;
+    const std::size_t n = p.size();
+    for (std::size_t i = 0, j = n - 1; i < n; j = i++) a2 += cross(p[j], p[i]);
+    return 0.5 * a2;
+}
+
+/// Area centroid of a simple polygon of either orientation.
+inline Vec2 centroid(std::span<const Vec2> p) {
+    // Shift to the first vertex so that the sums stay well conditioned far from the origin.
+    const Vec2 o = p[0];
+    double a2 = 0.0;
+    Vec2 c{};
+    const std::size_t n = p.size();
+    for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+        const Vec2 pj = p[j] - o, pi = p[i] - o;
+        const double w = cross(pj, pi);
+        a2 += w;
+        c += w * (pj + pi);
+    }
+    return o + c / (3.0 * a2);
+}
+
+/// Polar second moment of area about the centroid, ∫(x² + y²) dA (unit density),
+/// for a counter-clockwise polygon; multiply by density for the rotational inertia.
+inline double polar_moment_about_centroid(std::span<const Vec2> p) {
+    const Vec2 c = centroid(p);
+    double j12 = 0.0;
+    const std::size_t n = p.size();
+    for (std::size_t i = 0, k = n - 1; i < n; k = i++) {
+        const Vec2 a = p[k] - c, b = p[i] - c;
+        j12 += cross(a, b) * (dot(a, a) + dot(a, b) + dot(b, b));
+    }
+    return j12 / 12.0;
+}
+
+struct Box2 {
+    Vec2 lo{+INFINITY, +INFINITY};
+    Vec2 hi{-INFINITY, -INFINITY};
+    void add(Vec2 p) {
+        lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y)};
+        hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y)};
+    }
+    bool empty() const { return lo.x > hi.x; }
+    double width() const { return hi.x - lo.x; }
+    double height() const { return hi.y - lo.y; }
+};
+
+inline Box2 bounding_box(std::span<const Vec2> p) {
+    Box2 b;
+    for (Vec2 q : p) b.add(q);
+    return b;
+}
+
+/// Even-odd point-in-polygon test; points on the boundary may go either way.
+inline bool point_in_polygon(Vec2 q, std::span<const Vec2> p) {
+    bool inside = false;
+    const std::size_t n = p.size();
+    for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+        if ((p[i].y > q.y) != (p[j].y > q.y)) {
+            const double xc = p[j].x + (q.y - p[j].y) * (p[i].x - p[j].x) / (p[i].y - p[j].y);
+            if (q.x < xc) inside = !inside;
+        }
+    }
+    return inside;
+}
+
+/// Distance from q to the segment [a, b].
+inline double distance_to_segment(Vec2 q, Vec2 a, Vec2 b) {
+    const Vec2 ab = b - a;
+    const double l2 = norm2(ab);
+    double t = l2 > 0.0 ? dot(q - a, ab) / l2 : 0.0;
+    t = std::fmin(1.0, std::fmax(0.0, t));
+    return norm(q - (a + t * ab));
+}
+
+} // namespace bbm

@@ -1,0 +1,92 @@
+// bbm meshing: the block assembly — blocks, and the joints between them.
+//
+// generate_blocks() is the whole geometry pipeline of paper §3.1:
+//   1. each region's domain = outline − holes − subtracted regions (CGAL Boolean
+//      operations, exact kernel), checked for self-intersection, holes outside the
+//      outline and overlap with other regions;
+//   2. the region is cut by its real discontinuities (explicit segments and joint
+//      sets) with a CGAL arrangement; every face of it is a "rock block";
+//   3. the inner pattern is generated inside each rock block, so no inner block
+//      crosses a real joint; real joints that end inside a rock block (finite
+//      traces) split the inner blocks they cross along their line, the part beyond
+//      the trace tip being an ordinary inner joint (a rock bridge that can break);
+//   4. short edges are collapsed (shared vertices move together, so the blocks
+//      still tile the region exactly);
+//   5. topology: every stretch of boundary shared by two blocks — a full shared
+//      edge or the part of an edge against a T-junction — becomes one JointRecord.
+//
+// The assembly is flat (structure of arrays, compressed vertex lists) because the
+// contact code walks it for ~10^5 blocks.
+#pragma once
+
+#include "core/vec2.hpp"
+#include "meshing/spec.hpp"
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace bbm::meshing {
+
+enum class JointTag : std::uint8_t {
+    inner,      ///< between inner blocks of a Voronoi / Delaunay / lattice pattern
+    radial,     ///< trigon: between triangles of the same Voronoi cell
+    peripheral, ///< trigon: between triangles of different Voronoi cells
+    real_joint, ///< on a real discontinuity (explicit segment or joint set)
+    interface,  ///< between blocks of different regions
+};
+const char* to_string(JointTag t);
+const char* to_string(PatternSpec::Kind k);
+
+struct JointRecord {
+    int block_a = -1, block_b = -1;
+    /// Edge of each block the joint lies on: edge i of a block runs from its vertex
+    /// i to vertex i+1. The joint is the part of both edges between p0 and p1.
+    int edge_a = -1, edge_b = -1;
+    Vec2 p0{}, p1{};
+    JointTag tag = JointTag::inner;
+    double length() const { return norm(p1 - p0); }
+};
+
+struct BlockAssembly {
+    // Block b has vertices points[first[b] .. first[b+1]), counter-clockwise.
+    std::vector<Vec2> points;
+    std::vector<std::uint32_t> first{0};
+    std::vector<int> region;              ///< index into region_names
+    std::vector<PatternSpec::Kind> pattern;
+    /// The Voronoi cell a trigon triangle came from, or the block itself.
+    std::vector<int> parent;
+    std::vector<double> area;
+    std::vector<JointRecord> joints;
+    std::vector<std::string> region_names;
+    /// Target size of each region's pattern (for the summary and checks).
+    std::vector<double> region_size;
+    /// Segments of real discontinuities after cutting (for output and checks).
+    std::vector<SegmentSpec> real_segments;
+
+    int block_count() const { return static_cast<int>(region.size()); }
+    std::span<const Vec2> block(int b) const {
+        return {points.data() + first[b], points.data() + first[b + 1]};
+    }
+    void add_block(std::span<const Vec2> poly, int region_id, PatternSpec::Kind kind, int parent_id);
+};
+
+struct GenerationStats {
+    double seconds_regions = 0, seconds_patterns = 0, seconds_topology = 0;
+    int collapsed_edges = 0;
+    /// Edges still shorter than their region's minimum (e.g. a short edge of the
+    /// outline itself); reported, never hidden.
+    int short_edges_left = 0;
+};
+
+/// The whole pipeline above. Throws GeometryError for an invalid description.
+BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats = nullptr);
+
+/// Polygon (counter-clockwise) of an outline, with arcs as polylines.
+std::vector<Vec2> outline_polygon(const OutlineSpec& o, double default_max_segment);
+
+/// Mean block size of the given blocks: diameter of the circle of their mean area.
+double mean_block_size(const BlockAssembly& a, int region = -1);
+
+} // namespace bbm::meshing

@@ -1,0 +1,110 @@
+// bbm meshing: the description of a block model's geometry, as the model file gives it.
+//
+// A model is a list of regions. Each region has an outline (rectangle, polygon,
+// circle, a path of straight and circular-arc pieces, or a tunnel opening with
+// vertical side walls and an arched roof), optional holes, optional other regions
+// subtracted from it ("outer minus bonded"), the real discontinuities that cut it
+// (explicit segments and statistical joint sets), and the pattern of inner blocks
+// that fills each piece left after cutting (paper §3.1: real joints first, inner
+// blocks second). Curved outlines become polylines whose segments are no longer
+// than `max_segment`. These structs are plain data: the input layer (apps/) fills
+// them, generate_blocks() in blocks.hpp turns them into blocks and joints.
+#pragma once
+
+#include "core/vec2.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace bbm::meshing {
+
+/// One outline. Only the fields of its kind are read.
+struct OutlineSpec {
+    enum class Kind { rectangle, polygon, circle, path, opening };
+    Kind kind = Kind::rectangle;
+
+    // rectangle
+    Vec2 min{}, max{};
+    // polygon: the vertices, either orientation, not repeated at the end
+    std::vector<Vec2> points;
+    // circle and opening
+    Vec2 center{};
+    double radius = 0.0;
+    // path: starts at `start`; each step goes to `to`, straight or along a circular
+    // arc about `center` (counter-clockwise unless `clockwise`); closes back to start.
+    struct Step {
+        Vec2 to{};
+        bool arc = false;
+        Vec2 center{};
+        bool clockwise = false;
+    };
+    Vec2 start{};
+    std::vector<Step> steps;
+    // opening: side walls at center.x ± width/2 from floor_y up to the springline
+    // center.y, then a circular roof of radius width/2 about `center` (a horseshoe
+    // with a flat floor). With `half`, only the part x >= center.x (for a model cut
+    // on its vertical symmetry plane).
+    double width = 0.0;
+    double floor_y = 0.0;
+    bool half = false;
+
+    /// Longest polyline segment for arcs and circles (m); 0 = the model's default.
+    double max_segment = 0.0;
+};
+
+struct PatternSpec {
+    enum class Kind { voronoi, trigon, delaunay, hexagonal, brick, single };
+    Kind kind = Kind::voronoi;
+    /// Mean block size d (m): the diameter of the circle with the mean block area
+    /// (voronoi, trigon: of the Voronoi cells before splitting; delaunay: of the
+    /// triangles). hexagonal: lattice spacing. brick: brick height.
+    double size = 0.0;
+    int lloyd_iterations = 0;
+    /// Edges shorter than this are collapsed (m); < 0 = default 0.1 × size.
+    double min_edge = -1.0;
+    std::uint64_t seed = 1;
+    /// brick: brick length over height; 1 gives squares.
+    double aspect = 2.0;
+    /// brick: running bond (rows offset by half a brick) or stack bond.
+    bool running_bond = true;
+    /// hexagonal, brick: lattice origin and rotation (degrees, counter-clockwise).
+    Vec2 origin{};
+    double angle = 0.0;
+};
+
+/// A statistical set of parallel joints (a simple discrete fracture network).
+struct JointSetSpec {
+    double angle = 0.0;         ///< trace direction, degrees counter-clockwise from +x
+    double spacing = 0.0;       ///< mean normal distance between traces (m)
+    double trace_length = 0.0;  ///< mean trace length (m); 0 = persistent (cuts through)
+    double gap = 0.0;           ///< mean rock bridge between collinear traces (m)
+    double angle_deviation = 0.0;   ///< uniform random deviation of each trace, ± degrees
+    double spacing_deviation = 0.0; ///< uniform random deviation of each offset, ± fraction of spacing
+    double length_deviation = 0.0;  ///< uniform random deviation of trace and gap, ± fraction
+    Vec2 origin{};              ///< a point one trace line passes through (before deviation)
+    std::uint64_t seed = 1;
+};
+
+struct SegmentSpec {
+    Vec2 a{}, b{};
+};
+
+struct RegionSpec {
+    std::string name;
+    OutlineSpec outline;
+    std::vector<OutlineSpec> holes;
+    /// Names of regions (earlier or later in the list) subtracted from this one.
+    std::vector<std::string> minus;
+    PatternSpec pattern;
+    std::vector<SegmentSpec> joints;
+    std::vector<JointSetSpec> joint_sets;
+};
+
+struct ModelGeometrySpec {
+    std::vector<RegionSpec> regions;
+    /// Default longest polyline segment for circles and arcs (m).
+    double max_segment = 0.1;
+};
+
+} // namespace bbm::meshing
