@@ -1,0 +1,721 @@
+// bbm apps: reading the model file (see model_input.hpp and docs/input.md).
+//
+// The reader walks the toml++ tree with a Path beside every node: its full dotted
+// key for messages ("region[1].pattern.size") and its key inside the region
+// ("pattern.size") under which its line is kept in ModelSource. Every table is
+// checked for unknown keys before its values are read, so a misspelt key is
+// reported as such (with a suggestion), not as the required key it failed to be.
+#include "apps/model_input.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <span>
+#include <sstream>
+
+namespace bbm::io {
+
+using meshing::JointSetSpec;
+using meshing::ModelGeometrySpec;
+using meshing::OutlineSpec;
+using meshing::PatternSpec;
+using meshing::RegionSpec;
+using meshing::SegmentSpec;
+
+namespace {
+
+using Keys = std::span<const std::string_view>;
+
+// --- text helpers ----------------------------------------------------------------
+
+/// Shortest text that reads back as the same double, so "-0.3" stays "-0.3".
+std::string fmt(double v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return {buf, r.ptr};
+}
+
+std::string fmt(Vec2 p) {
+    return "[" + fmt(p.x) + ", " + fmt(p.y) + "]";
+}
+
+std::string quoted(std::string_view s) {
+    return "'" + std::string(s) + "'";
+}
+
+std::string join(Keys words) {
+    std::string s;
+    for (std::string_view w : words)
+        s += (s.empty() ? "" : ", ") + std::string(w);
+    return s;
+}
+
+/// Optimal string alignment distance: Levenshtein plus adjacent transpositions,
+/// so that "szie" is one edit from "size".
+int edit_distance(std::string_view a, std::string_view b) {
+    std::vector<std::vector<int>> d(a.size() + 1, std::vector<int>(b.size() + 1));
+    for (std::size_t i = 0; i <= a.size(); ++i)
+        d[i][0] = static_cast<int>(i);
+    for (std::size_t j = 0; j <= b.size(); ++j)
+        d[0][j] = static_cast<int>(j);
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const int cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+        }
+    }
+    return d[a.size()][b.size()];
+}
+
+/// " (did you mean 'size'?)" for the closest option within two edits, else "".
+/// A word must be longer than the distance, or any short word would match.
+std::string did_you_mean(std::string_view word, Keys options) {
+    int best = 3;
+    std::string_view match;
+    for (std::string_view o : options) {
+        const int d = edit_distance(word, o);
+        if (d < best && d < static_cast<int>(word.size())) best = d, match = o;
+    }
+    return match.empty() ? "" : " (did you mean " + quoted(match) + "?)";
+}
+
+std::string describe(const toml::node& n) {
+    switch (n.type()) {
+    case toml::node_type::string:
+        return "string \"" + n.as_string()->get() + "\"";
+    case toml::node_type::integer:
+        return "integer " + std::to_string(n.as_integer()->get());
+    case toml::node_type::floating_point:
+        return "float " + fmt(n.as_floating_point()->get());
+    case toml::node_type::boolean:
+        return n.as_boolean()->get() ? "boolean true" : "boolean false";
+    case toml::node_type::array:
+        return "an array";
+    case toml::node_type::table:
+        return "a table";
+    default:
+        return "a date or time";
+    }
+}
+
+int line(const toml::node& n) {
+    return static_cast<int>(n.source().begin.line);
+}
+
+// --- where we are ----------------------------------------------------------------
+
+struct Path {
+    std::string full; ///< for messages: "region[1].pattern.size"
+    std::string rel;  ///< inside the region, for ModelSource: "pattern.size"
+
+    Path key(std::string_view k) const {
+        const std::string s(k);
+        return {full.empty() ? s : full + "." + s, rel.empty() ? s : rel + "." + s};
+    }
+    Path at(std::size_t i) const {
+        const std::string s = "[" + std::to_string(i) + "]";
+        return {full + s, rel + s};
+    }
+};
+
+struct Ctx {
+    std::string file;
+    ModelSource* source = nullptr;
+    int region = -1; ///< region being read, -1 outside regions
+    std::string region_name;
+
+    [[noreturn]] void fail(int at_line, const Path& p, const std::string& message) const {
+        throw InputError(file, at_line, p.full, message);
+    }
+    [[noreturn]] void fail(const toml::node& n, const Path& p, const std::string& message) const {
+        fail(line(n), p, message);
+    }
+    void note(const Path& p, const toml::node& n) const {
+        if (region >= 0 && !p.rel.empty()) source->key_line[region][p.rel] = line(n);
+    }
+    /// "region 'bonded': " inside a named region, for messages where the index alone
+    /// would make the user count tables.
+    std::string in_region() const {
+        return region_name.empty() ? "" : "region " + quoted(region_name) + ": ";
+    }
+};
+
+// --- value conversions: a node at path p to a C++ value, or an error at its line ----
+
+double to_number(const Ctx& c, const toml::node& n, const Path& p) {
+    double v;
+    if (const auto* i = n.as_integer())
+        v = static_cast<double>(i->get());
+    else if (const auto* f = n.as_floating_point())
+        v = f->get();
+    else
+        c.fail(n, p, "expected a number, got " + describe(n));
+    if (!std::isfinite(v)) c.fail(n, p, "expected a finite number, got " + fmt(v));
+    return v;
+}
+
+Vec2 to_vec2(const Ctx& c, const toml::node& n, const Path& p) {
+    const auto* a = n.as_array();
+    if (!a) c.fail(n, p, "expected a point [x, y], got " + describe(n));
+    if (a->size() != 2)
+        c.fail(n, p,
+               "expected a point [x, y] of 2 numbers, got an array of " +
+                   std::to_string(a->size()));
+    return {to_number(c, (*a)[0], p.at(0)), to_number(c, (*a)[1], p.at(1))};
+}
+
+const toml::table& to_table(const Ctx& c, const toml::node& n, const Path& p,
+                            std::string_view expected) {
+    const auto* t = n.as_table();
+    if (!t) c.fail(n, p, "expected " + std::string(expected) + ", got " + describe(n));
+    return *t;
+}
+
+const toml::array& to_array(const Ctx& c, const toml::node& n, const Path& p,
+                            std::string_view expected) {
+    const auto* a = n.as_array();
+    if (!a) c.fail(n, p, "expected " + std::string(expected) + ", got " + describe(n));
+    return *a;
+}
+
+std::string to_str(const Ctx& c, const toml::node& n, const Path& p) {
+    const auto* s = n.as_string();
+    if (!s) c.fail(n, p, "expected a string, got " + describe(n));
+    return s->get();
+}
+
+// --- keys of a table ---------------------------------------------------------------
+
+/// Rejects keys outside `allowed`. A key in `elsewhere` (valid for another kind of
+/// the same table) is reported as not applying to `kind`. The key reported is the
+/// first in the file, as toml++ iterates a table in key order.
+void check_keys(const Ctx& c, const toml::table& t, const Path& p, Keys allowed,
+                Keys elsewhere = {}, std::string_view kind = {}) {
+    const toml::key* bad = nullptr;
+    for (auto&& [k, v] : t) {
+        if (std::ranges::find(allowed, k.str()) != allowed.end()) continue;
+        if (!bad || k.source().begin.line < bad->source().begin.line) bad = &k;
+    }
+    if (!bad) return;
+    const std::string_view k = bad->str();
+    const int at = static_cast<int>(bad->source().begin.line);
+    if (std::ranges::find(elsewhere, k) != elsewhere.end())
+        c.fail(at, p.key(k),
+               "key " + quoted(k) + " does not apply to " + std::string(kind) +
+                   "; its keys are: " + join(allowed));
+    const std::string where = p.full.empty() ? "at top level" : "in " + p.full;
+    c.fail(at, p.key(k),
+           "unknown key " + quoted(k) + " " + where + did_you_mean(k, allowed) +
+               "; allowed keys: " + join(allowed));
+}
+
+/// The child `key` of t, its line noted; nullptr when absent.
+const toml::node* find(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
+    const toml::node* n = t.get(key);
+    if (n) c.note(p.key(key), *n);
+    return n;
+}
+
+const toml::node& need(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+                       std::string_view expected) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n)
+        c.fail(t, p.key(key),
+               c.in_region() + "missing required key " + quoted(key) + ": expected " +
+                   std::string(expected));
+    return *n;
+}
+
+/// Allowed values of a number, and its unit (with a leading space) for messages.
+struct Range {
+    double lo = -std::numeric_limits<double>::infinity();
+    double hi = std::numeric_limits<double>::infinity();
+    bool lo_open = false, hi_open = false;
+    std::string_view unit;
+
+    bool contains(double v) const {
+        return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+    }
+    std::string text() const {
+        if (std::isinf(hi))
+            return std::isinf(lo) ? "" : (lo_open ? "> " : ">= ") + fmt(lo) + std::string(unit);
+        return "in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) +
+               (hi_open ? ")" : "]") + std::string(unit);
+    }
+};
+Range unbounded(std::string_view unit) {
+    return {.unit = unit};
+}
+Range above(double lo, std::string_view unit) {
+    return {.lo = lo, .lo_open = true, .unit = unit};
+}
+Range at_least(double lo, std::string_view unit) {
+    return {.lo = lo, .unit = unit};
+}
+Range below(double lo, double hi, std::string_view unit) {
+    return {.lo = lo, .hi = hi, .hi_open = true, .unit = unit};
+}
+
+constexpr std::string_view metres = " m";
+constexpr std::string_view degrees = " degrees";
+
+double checked_number(const Ctx& c, const toml::node& n, const Path& p, const Range& r) {
+    const double v = to_number(c, n, p);
+    if (!r.contains(v)) c.fail(n, p, "must be " + r.text() + ", got " + fmt(v));
+    return v;
+}
+
+std::optional<double> number(const Ctx& c, const toml::table& t, const Path& p,
+                             std::string_view key, const Range& r) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return std::nullopt;
+    return checked_number(c, *n, p.key(key), r);
+}
+
+double required_number(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+                       const Range& r) {
+    const std::string expected = "a number" + (r.text().empty() ? "" : " " + r.text());
+    return checked_number(c, need(c, t, p, key, expected), p.key(key), r);
+}
+
+/// An integer >= lo; `hi` only guards the C++ type it is stored in.
+std::optional<std::int64_t> integer(const Ctx& c, const toml::table& t, const Path& p,
+                                    std::string_view key, std::int64_t lo, std::int64_t hi) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return std::nullopt;
+    const auto* i = n->as_integer();
+    if (!i)
+        c.fail(*n, p.key(key),
+               "expected an integer >= " + std::to_string(lo) + ", got " + describe(*n));
+    if (i->get() < lo)
+        c.fail(*n, p.key(key),
+               "must be an integer >= " + std::to_string(lo) + ", got " + std::to_string(i->get()));
+    if (i->get() > hi)
+        c.fail(*n, p.key(key),
+               "must be an integer <= " + std::to_string(hi) + ", got " + std::to_string(i->get()));
+    return i->get();
+}
+
+std::optional<std::uint64_t> seed(const Ctx& c, const toml::table& t, const Path& p) {
+    const auto s = integer(c, t, p, "seed", 0, std::numeric_limits<std::int64_t>::max());
+    if (!s) return std::nullopt;
+    return static_cast<std::uint64_t>(*s);
+}
+
+std::optional<bool> boolean(const Ctx& c, const toml::table& t, const Path& p,
+                            std::string_view key) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return std::nullopt;
+    const auto* b = n->as_boolean();
+    if (!b) c.fail(*n, p.key(key), "expected true or false, got " + describe(*n));
+    return b->get();
+}
+
+std::optional<Vec2> point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return std::nullopt;
+    return to_vec2(c, *n, p.key(key));
+}
+
+Vec2 required_point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
+    return to_vec2(c, need(c, t, p, key, "a point [x, y]"), p.key(key));
+}
+
+/// Index of the string value of `key` in `options`; `what` names the choice.
+std::size_t choice(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+                   Keys options, std::string_view what) {
+    const toml::node& n = need(c, t, p, key, "one of " + join(options));
+    const std::string s = to_str(c, n, p.key(key));
+    const auto it = std::ranges::find(options, s);
+    if (it == options.end())
+        c.fail(n, p.key(key),
+               "unknown " + std::string(what) + " " + quoted(s) + did_you_mean(s, options) +
+                   "; expected one of: " + join(options));
+    return static_cast<std::size_t>(it - options.begin());
+}
+
+/// Each element of an array-valued key, with its path and its line noted.
+template <class F> void for_each_element(const Ctx& c, const toml::array& a, const Path& p, F&& f) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        c.note(p.at(i), a[i]);
+        f(a[i], p.at(i));
+    }
+}
+
+// --- the model's tables ------------------------------------------------------------
+
+// In the order of OutlineSpec::Kind and PatternSpec::Kind.
+constexpr std::array<std::string_view, 5> outline_types{"rectangle", "polygon", "circle", "path",
+                                                        "opening"};
+constexpr std::array<std::string_view, 6> pattern_types{"voronoi",   "trigon", "delaunay",
+                                                        "hexagonal", "brick",  "single"};
+
+constexpr std::array<std::string_view, 3> rectangle_keys{"type", "min", "max"};
+constexpr std::array<std::string_view, 2> polygon_keys{"type", "points"};
+constexpr std::array<std::string_view, 4> circle_keys{"type", "center", "radius", "max_segment"};
+constexpr std::array<std::string_view, 4> path_keys{"type", "start", "steps", "max_segment"};
+constexpr std::array<std::string_view, 6> opening_keys{"type",  "center", "width",
+                                                       "floor", "half",   "max_segment"};
+constexpr std::array<std::string_view, 12> all_outline_keys{
+    "type",  "min",   "max",   "points", "center", "radius",
+    "start", "steps", "width", "floor",  "half",   "max_segment"};
+
+constexpr std::array<std::string_view, 5> random_pattern_keys{"type", "size", "lloyd", "min_edge",
+                                                              "seed"};
+constexpr std::array<std::string_view, 5> hexagonal_keys{"type", "size", "min_edge", "origin",
+                                                         "angle"};
+constexpr std::array<std::string_view, 7> brick_keys{"type",  "size",   "min_edge", "origin",
+                                                     "angle", "aspect", "bond"};
+constexpr std::array<std::string_view, 1> single_keys{"type"};
+constexpr std::array<std::string_view, 9> all_pattern_keys{
+    "type", "size", "lloyd", "min_edge", "seed", "origin", "angle", "aspect", "bond"};
+
+Keys outline_keys(OutlineSpec::Kind k) {
+    switch (k) {
+    case OutlineSpec::Kind::rectangle:
+        return rectangle_keys;
+    case OutlineSpec::Kind::polygon:
+        return polygon_keys;
+    case OutlineSpec::Kind::circle:
+        return circle_keys;
+    case OutlineSpec::Kind::path:
+        return path_keys;
+    case OutlineSpec::Kind::opening:
+        return opening_keys;
+    }
+    return {};
+}
+
+Keys pattern_keys(PatternSpec::Kind k) {
+    switch (k) {
+    case PatternSpec::Kind::voronoi:
+    case PatternSpec::Kind::trigon:
+    case PatternSpec::Kind::delaunay:
+        return random_pattern_keys;
+    case PatternSpec::Kind::hexagonal:
+        return hexagonal_keys;
+    case PatternSpec::Kind::brick:
+        return brick_keys;
+    case PatternSpec::Kind::single:
+        return single_keys;
+    }
+    return {};
+}
+
+/// A path step's arc must end on its circle: the radius is taken from the start.
+void check_arc(const Ctx& c, const toml::node& n, const Path& p, Vec2 from,
+               const OutlineSpec::Step& s) {
+    const double r0 = norm(from - s.center), r1 = norm(s.to - s.center);
+    if (r0 == 0.0) c.fail(n, p, "arc center " + fmt(s.center) + " coincides with the arc's start");
+    if (std::abs(r1 - r0) > 1e-6 * std::max(r0, r1))
+        c.fail(n, p,
+               "arc end " + fmt(s.to) + " is " + fmt(r1) + " m from center " + fmt(s.center) +
+                   " but its start " + fmt(from) + " is " + fmt(r0) +
+                   " m from it; the two must agree within 1e-6 relative");
+}
+
+OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "an outline table { type = ..., ... }");
+    check_keys(c, t, p, all_outline_keys);
+    OutlineSpec o;
+    o.kind = static_cast<OutlineSpec::Kind>(choice(c, t, p, "type", outline_types, "outline type"));
+    const std::string kind =
+        "a " + std::string(outline_types[static_cast<int>(o.kind)]) + " outline";
+    check_keys(c, t, p, outline_keys(o.kind), all_outline_keys, kind);
+
+    switch (o.kind) {
+    case OutlineSpec::Kind::rectangle: {
+        o.min = required_point(c, t, p, "min");
+        o.max = required_point(c, t, p, "max");
+        if (!(o.max.x > o.min.x && o.max.y > o.min.y))
+            c.fail(*t.get("max"), p.key("max"),
+                   "must exceed min = " + fmt(o.min) + " in both x and y, got " + fmt(o.max));
+        break;
+    }
+    case OutlineSpec::Kind::polygon: {
+        const Path pp = p.key("points");
+        const toml::array& pts =
+            to_array(c, need(c, t, p, "points", "an array of points [[x, y], ...]"), pp,
+                     "an array of points [[x, y], ...]");
+        if (pts.size() < 3)
+            c.fail(pts, pp, "a polygon needs at least 3 points, got " + std::to_string(pts.size()));
+        for_each_element(c, pts, pp, [&](const toml::node& n, const Path& ep) {
+            o.points.push_back(to_vec2(c, n, ep));
+        });
+        break;
+    }
+    case OutlineSpec::Kind::circle:
+        o.center = required_point(c, t, p, "center");
+        o.radius = required_number(c, t, p, "radius", above(0, metres));
+        break;
+    case OutlineSpec::Kind::path: {
+        o.start = required_point(c, t, p, "start");
+        const Path sp = p.key("steps");
+        const std::string expected = "an array of steps [{ to = [x, y] }, ...]";
+        const toml::array& steps = to_array(c, need(c, t, p, "steps", expected), sp, expected);
+        if (steps.empty()) c.fail(steps, sp, "a path needs at least one step, got none");
+        Vec2 from = o.start;
+        for_each_element(c, steps, sp, [&](const toml::node& n, const Path& ep) {
+            const toml::table& st =
+                to_table(c, n, ep, "a step { to = [x, y] } or { to = [x, y], center = [x, y] }");
+            static constexpr std::array<std::string_view, 3> step_keys{"to", "center", "clockwise"};
+            check_keys(c, st, ep, step_keys);
+            OutlineSpec::Step s;
+            s.to = required_point(c, st, ep, "to");
+            const auto center = point(c, st, ep, "center");
+            const auto clockwise = boolean(c, st, ep, "clockwise");
+            if (clockwise && !center)
+                c.fail(*st.get("clockwise"), ep.key("clockwise"),
+                       "applies only to an arc step (one with a center); this step is straight");
+            if (center) {
+                s.arc = true;
+                s.center = *center;
+                s.clockwise = clockwise.value_or(false);
+                check_arc(c, n, ep, from, s);
+            }
+            o.steps.push_back(s);
+            from = s.to;
+        });
+        break;
+    }
+    case OutlineSpec::Kind::opening: {
+        o.center = required_point(c, t, p, "center");
+        o.width = required_number(c, t, p, "width", above(0, metres));
+        o.floor_y = required_number(c, t, p, "floor", unbounded(metres));
+        if (!(o.floor_y < o.center.y))
+            c.fail(*t.get("floor"), p.key("floor"),
+                   "must be below the springline center.y = " + fmt(o.center.y) + " m, got " +
+                       fmt(o.floor_y));
+        o.half = boolean(c, t, p, "half").value_or(false);
+        break;
+    }
+    }
+    if (o.kind == OutlineSpec::Kind::circle || o.kind == OutlineSpec::Kind::path ||
+        o.kind == OutlineSpec::Kind::opening)
+        o.max_segment = number(c, t, p, "max_segment", above(0, metres)).value_or(0.0);
+    return o;
+}
+
+PatternSpec read_pattern(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a pattern table { type = ..., size = ... }");
+    check_keys(c, t, p, all_pattern_keys);
+    PatternSpec s;
+    s.kind = static_cast<PatternSpec::Kind>(choice(c, t, p, "type", pattern_types, "pattern type"));
+    const std::string kind =
+        "a " + std::string(pattern_types[static_cast<int>(s.kind)]) + " pattern";
+    check_keys(c, t, p, pattern_keys(s.kind), all_pattern_keys, kind);
+    if (s.kind == PatternSpec::Kind::single) return s;
+
+    s.size = required_number(c, t, p, "size", above(0, metres));
+    if (const auto e = number(c, t, p, "min_edge", at_least(0, metres))) {
+        if (!(*e < s.size))
+            c.fail(*t.get("min_edge"), p.key("min_edge"),
+                   "must be smaller than size = " + fmt(s.size) + " m, got " + fmt(*e));
+        s.min_edge = *e;
+    }
+    s.lloyd_iterations =
+        static_cast<int>(integer(c, t, p, "lloyd", 0, std::numeric_limits<int>::max()).value_or(0));
+    s.seed = seed(c, t, p).value_or(1);
+    s.origin = point(c, t, p, "origin").value_or(Vec2{});
+    s.angle = number(c, t, p, "angle", unbounded(degrees)).value_or(0.0);
+    s.aspect = number(c, t, p, "aspect", above(0, "")).value_or(2.0);
+    if (t.contains("bond")) {
+        static constexpr std::array<std::string_view, 2> bonds{"running", "stack"};
+        s.running_bond = choice(c, t, p, "bond", bonds, "brick bond") == 0;
+    }
+    return s;
+}
+
+SegmentSpec read_joint(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a joint { from = [x, y], to = [x, y] }");
+    static constexpr std::array<std::string_view, 2> keys{"from", "to"};
+    check_keys(c, t, p, keys);
+    return {required_point(c, t, p, "from"), required_point(c, t, p, "to")};
+}
+
+JointSetSpec read_joint_set(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a joint set table ([[region.joint_set]])");
+    static constexpr std::array<std::string_view, 9> keys{"angle",
+                                                          "spacing",
+                                                          "trace",
+                                                          "gap",
+                                                          "angle_deviation",
+                                                          "spacing_deviation",
+                                                          "length_deviation",
+                                                          "origin",
+                                                          "seed"};
+    check_keys(c, t, p, keys);
+    JointSetSpec s;
+    s.angle = required_number(c, t, p, "angle", unbounded(degrees));
+    s.spacing = required_number(c, t, p, "spacing", above(0, metres));
+    s.trace_length = number(c, t, p, "trace", at_least(0, metres)).value_or(0.0);
+    s.gap = number(c, t, p, "gap", at_least(0, metres)).value_or(0.0);
+    s.angle_deviation = number(c, t, p, "angle_deviation", below(0, 90, degrees)).value_or(0.0);
+    s.spacing_deviation = number(c, t, p, "spacing_deviation", below(0, 1, "")).value_or(0.0);
+    s.length_deviation = number(c, t, p, "length_deviation", below(0, 1, "")).value_or(0.0);
+    s.origin = point(c, t, p, "origin").value_or(Vec2{});
+    s.seed = seed(c, t, p).value_or(1);
+    return s;
+}
+
+/// The array-valued `key` of t, each element read by f; nothing when absent.
+template <class F>
+void read_list(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+               std::string_view expected, F&& f) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return;
+    const Path kp = p.key(key);
+    for_each_element(c, to_array(c, *n, kp, expected), kp, f);
+}
+
+RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a [[region]] table");
+    static constexpr std::array<std::string_view, 7> keys{"name",    "outline", "holes",    "minus",
+                                                          "pattern", "joints",  "joint_set"};
+    check_keys(c, t, p, keys);
+    RegionSpec r;
+    const Path np = p.key("name");
+    const toml::node& name = need(c, t, p, "name", "a non-empty string");
+    r.name = to_str(c, name, np);
+    if (r.name.empty()) c.fail(name, np, "must be a non-empty string, got \"\"");
+    c.region_name = r.name;
+
+    r.outline = read_outline(c, need(c, t, p, "outline", "an outline table"), p.key("outline"));
+    read_list(
+        c, t, p, "holes", "an array of outline tables",
+        [&](const toml::node& n, const Path& ep) { r.holes.push_back(read_outline(c, n, ep)); });
+    read_list(c, t, p, "minus", "an array of region names",
+              [&](const toml::node& n, const Path& ep) { r.minus.push_back(to_str(c, n, ep)); });
+    r.pattern = read_pattern(c, need(c, t, p, "pattern", "a pattern table"), p.key("pattern"));
+    read_list(
+        c, t, p, "joints", "an array of joints [{ from = [x, y], to = [x, y] }, ...]",
+        [&](const toml::node& n, const Path& ep) { r.joints.push_back(read_joint(c, n, ep)); });
+    read_list(c, t, p, "joint_set", "an array of joint set tables ([[region.joint_set]])",
+              [&](const toml::node& n, const Path& ep) {
+                  r.joint_sets.push_back(read_joint_set(c, n, ep));
+              });
+    return r;
+}
+
+/// Names are checked once all regions are read: `minus` may name a later region.
+void check_names(const Ctx& c, const ModelFile& mf) {
+    const auto& rs = mf.geometry.regions;
+    std::vector<std::string_view> names;
+    for (const RegionSpec& r : rs)
+        names.push_back(r.name);
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+        const Path p{"region[" + std::to_string(i) + "]", ""};
+        const auto& lines = mf.source.key_line[i];
+        for (std::size_t j = 0; j < i; ++j)
+            if (rs[j].name == rs[i].name)
+                c.fail(lines.at("name"), p.key("name"),
+                       "region name " + quoted(rs[i].name) + " is already used by region[" +
+                           std::to_string(j) + "] (line " +
+                           std::to_string(mf.source.region_line[j]) + ")");
+        for (std::size_t k = 0; k < rs[i].minus.size(); ++k) {
+            const std::string& m_name = rs[i].minus[k];
+            const Path mp = p.key("minus").at(k);
+            const int at = lines.at(mp.rel);
+            if (m_name == rs[i].name)
+                c.fail(at, mp, "region " + quoted(m_name) + " cannot subtract itself");
+            if (std::ranges::find(names, m_name) == names.end())
+                c.fail(at, mp,
+                       "region " + quoted(rs[i].name) + " subtracts " + quoted(m_name) +
+                           ", but there is no region of that name" + did_you_mean(m_name, names) +
+                           "; regions are: " + join(names));
+            for (std::size_t q = 0; q < k; ++q)
+                if (rs[i].minus[q] == m_name)
+                    c.fail(at, mp,
+                           quoted(m_name) + " is already listed as minus[" + std::to_string(q) +
+                               "]");
+        }
+    }
+}
+
+} // namespace
+
+int ModelSource::line_of(int region, const std::string& key) const {
+    if (region < 0 || region >= static_cast<int>(key_line.size())) return 0;
+    const auto& lines = key_line[static_cast<std::size_t>(region)];
+    std::string k = key;
+    while (!k.empty()) {
+        if (const auto it = lines.find(k); it != lines.end()) return it->second;
+        const auto cut = k.find_last_of(".[");
+        k.resize(cut == std::string::npos ? 0 : cut);
+    }
+    return region_line[static_cast<std::size_t>(region)];
+}
+
+ModelFile parse_model(std::string_view text, const std::string& name) {
+    toml::table doc;
+    try {
+        doc = toml::parse(text, std::string_view{name});
+    } catch (const toml::parse_error& e) {
+        throw InputError(name, static_cast<int>(e.source().begin.line), "",
+                         "TOML syntax error: " + std::string(e.description()));
+    }
+
+    ModelFile mf;
+    mf.source.file = name;
+    Ctx c;
+    c.file = name;
+    c.source = &mf.source;
+    const Path root{};
+    static constexpr std::array<std::string_view, 2> top_keys{"model", "region"};
+    check_keys(c, doc, root, top_keys);
+
+    if (const toml::node* n = find(c, doc, root, "model")) {
+        const Path p = root.key("model");
+        const toml::table& t = to_table(c, *n, p, "a [model] table");
+        static constexpr std::array<std::string_view, 2> keys{"title", "max_segment"};
+        check_keys(c, t, p, keys);
+        if (const toml::node* title = find(c, t, p, "title"))
+            mf.title = to_str(c, *title, p.key("title"));
+        mf.geometry.max_segment = number(c, t, p, "max_segment", above(0, metres)).value_or(0.1);
+    }
+
+    const toml::node* rn = find(c, doc, root, "region");
+    if (!rn)
+        c.fail(0, root.key("region"), "a model needs at least one [[region]] table, found none");
+    const toml::array& regions =
+        to_array(c, *rn, root.key("region"), "an array of [[region]] tables (double brackets)");
+    if (regions.empty())
+        c.fail(*rn, root.key("region"), "a model needs at least one region, found none");
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+        mf.source.region_line.push_back(line(regions[i]));
+        mf.source.key_line.emplace_back();
+        c.region = static_cast<int>(i);
+        c.region_name.clear();
+        mf.geometry.regions.push_back(
+            read_region(c, regions[i], {"region[" + std::to_string(i) + "]", ""}));
+    }
+    c.region = -1;
+    c.region_name.clear();
+    check_names(c, mf);
+    return mf;
+}
+
+ModelFile read_model(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "", "cannot open file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_model(text.str(), path);
+}
+
+InputError to_input_error(const ModelSource& source, const GeometryError& error) {
+    std::string key = "region[" + std::to_string(error.region()) + "]";
+    if (!error.key().empty()) key += "." + error.key();
+    return InputError(source.file, source.line_of(error.region(), error.key()), key, error.what());
+}
+
+} // namespace bbm::io

@@ -1,0 +1,57 @@
+// bbm apps: the model file — TOML text in, a checked geometry description out.
+//
+// read_model() turns a model file (format and every key: docs/input.md) into the
+// plain-data ModelGeometrySpec that meshing/ consumes. Everything a user can get
+// wrong without drawing a picture is caught here, at once, as an InputError that
+// names file, line and the full key ("tunnel.toml:14: region[1].pattern.size:
+// must be > 0 m, got -0.3"): syntax, unknown keys (with a "did you mean"), types,
+// missing keys, ranges, enum strings, region names. Geometry proper (self-crossing
+// outlines, holes outside, overlaps) is judged by meshing/, which knows nothing of
+// files and reports a GeometryError by region index and key; ModelSource keeps the
+// line of every key read so that to_input_error() can point the user back at the
+// right line anyway.
+//
+// toml++ is included by model_input.cpp only: it is heavy to compile, and no other
+// layer needs to see it.
+#pragma once
+
+#include "core/error.hpp"
+#include "meshing/spec.hpp"
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bbm::io {
+
+/// Where each region of a model came from, to report a GeometryError with a line.
+struct ModelSource {
+    std::string file;
+    /// Line of each [[region]] table.
+    std::vector<int> region_line;
+    /// Per region: key inside the region ("outline", "holes[0]", "minus[1]",
+    /// "pattern.size", "joint_set[0].spacing", ...) -> line.
+    std::vector<std::map<std::string, int>> key_line;
+
+    /// Best line for a key of a region: the key itself, else its nearest recorded
+    /// parent ("holes[0].radius" -> "holes[0]" -> "holes"), else the region's line;
+    /// 0 for a region index out of range.
+    int line_of(int region, const std::string& key) const;
+};
+
+struct ModelFile {
+    meshing::ModelGeometrySpec geometry;
+    ModelSource source;
+    std::string title;
+};
+
+/// Reads and checks a model file. Throws InputError.
+ModelFile read_model(const std::string& path);
+/// The same from text; `name` stands for the file name in messages (for tests).
+ModelFile parse_model(std::string_view text, const std::string& name);
+
+/// "file:line: region[i].key: message" for a defect found by meshing/.
+InputError to_input_error(const ModelSource& source, const GeometryError& error);
+
+} // namespace bbm::io

@@ -1,0 +1,333 @@
+// bbm io: VTK output of a block assembly (see vtk_output.hpp).
+#include "apps/vtk_output.hpp"
+
+// VTK 9.1's type macros end in a stray ';' that -Wpedantic reports in every file;
+// CMake passes VTK's directory with -isystem, this keeps a plain -I build quiet too.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#include <vtkCallbackCommand.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCellType.h>
+#include <vtkCommand.h>
+#include <vtkDoubleArray.h>
+#include <vtkErrorCode.h>
+#include <vtkExecutive.h>
+#include <vtkFieldData.h>
+#include <vtkIdTypeArray.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkStringArray.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+#pragma GCC diagnostic pop
+
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <stdexcept>
+#include <system_error>
+
+namespace bbm::io {
+
+namespace fs = std::filesystem;
+using meshing::BlockAssembly;
+using meshing::JointTag;
+using PatternKind = meshing::PatternSpec::Kind;
+
+namespace {
+
+// The enum values in order; the names written as field data are indexed by them.
+// Extend these lists when the enums grow.
+constexpr PatternKind all_pattern_kinds[] = {PatternKind::voronoi,   PatternKind::trigon,
+                                             PatternKind::delaunay,  PatternKind::hexagonal,
+                                             PatternKind::brick,     PatternKind::single};
+constexpr JointTag all_joint_tags[] = {JointTag::inner, JointTag::radial, JointTag::peripheral,
+                                       JointTag::real_joint, JointTag::interface};
+
+fs::path tmp_path(const fs::path& file) {
+    fs::path t = file;
+    t += ".tmp";
+    return t;
+}
+
+std::string in_quotes(const fs::path& file) { return "'" + file.string() + "'"; }
+
+/// Owns `file`.tmp until commit() renames it over `file`; removes it on any
+/// other way out, so a failed write leaves neither debris nor a damaged target.
+class TmpFile {
+public:
+    explicit TmpFile(const fs::path& file) : file_(file), tmp_(tmp_path(file)) {}
+    TmpFile(const TmpFile&) = delete;
+    TmpFile& operator=(const TmpFile&) = delete;
+    ~TmpFile() {
+        if (committed_) return;
+        std::error_code ec;
+        // Only a file we may have written; never a directory that happens to have the name.
+        if (fs::is_regular_file(tmp_, ec)) fs::remove(tmp_, ec);
+    }
+    const fs::path& path() const { return tmp_; }
+    void commit() {
+        std::error_code ec;
+        fs::rename(tmp_, file_, ec); // atomic replacement on POSIX
+        if (ec) {
+            throw std::runtime_error("cannot write " + in_quotes(file_) + ": rename from " +
+                                     in_quotes(tmp_) + " failed: " + ec.message());
+        }
+        committed_ = true;
+    }
+
+private:
+    fs::path file_, tmp_;
+    bool committed_ = false;
+};
+
+/// VTK reports errors through its output window, not the return value alone; an
+/// ErrorEvent observer catches the text so the exception can say what went wrong
+/// (and the message is not printed twice).
+void collect_vtk_error(vtkObject*, unsigned long, void* client, void* call) {
+    auto* out = static_cast<std::string*>(client);
+    std::string msg = call ? static_cast<const char*>(call) : "";
+    // The text is "ERROR: In <source file>, line N\n<class> (<address>): <message>".
+    if (const auto p = msg.find("): "); p != std::string::npos) msg.erase(0, p + 3);
+    while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' ')) msg.pop_back();
+    if (!out->empty()) *out += "; ";
+    *out += msg;
+}
+
+// Not vtkErrorCode::GetStringFromErrorCode: it lives in VTK::CommonMisc, a library
+// this module would link for one function. Codes below FirstVTKErrorCode are errno.
+std::string vtk_error_text(unsigned long code) {
+    if (code < vtkErrorCode::FirstVTKErrorCode)
+        return std::generic_category().message(static_cast<int>(code));
+    switch (code) {
+    case vtkErrorCode::CannotOpenFileError: return "cannot open the file";
+    case vtkErrorCode::OutOfDiskSpaceError: return "out of disk space";
+    default: return "VTK error code " + std::to_string(code);
+    }
+}
+
+void write_grid(vtkUnstructuredGrid* grid, const fs::path& file) {
+    TmpFile tmp(file);
+    std::string errors;
+    vtkNew<vtkCallbackCommand> on_error;
+    on_error->SetCallback(collect_vtk_error);
+    on_error->SetClientData(&errors);
+
+    vtkNew<vtkXMLUnstructuredGridWriter> writer;
+    writer->AddObserver(vtkCommand::ErrorEvent, on_error);
+    // The pipeline then adds only "algorithm returned failure", with a dump of its
+    // request, to stderr; the exception says it better.
+    vtkNew<vtkCallbackCommand> ignore;
+    writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, ignore);
+    writer->SetFileName(tmp.path().c_str());
+    writer->SetInputData(grid);
+    writer->SetDataModeToAppended();
+    writer->EncodeAppendedDataOff(); // raw binary, not base64
+    writer->SetCompressorTypeToZLib();
+    writer->SetHeaderTypeToUInt64(); // no 4 GiB limit on one array, whatever the model size
+    const int ok = writer->Write();
+    const unsigned long code = writer->GetErrorCode();
+    if (ok != 1 || code != vtkErrorCode::NoError || !errors.empty()) {
+        // The writer's own text already says what the code says, and more.
+        std::string why = errors;
+        if (why.empty() && code != vtkErrorCode::NoError) why = vtk_error_text(code);
+        if (why.empty()) why = "vtkXMLUnstructuredGridWriter failed";
+        throw std::runtime_error("cannot write " + in_quotes(file) + ": " + why);
+    }
+    tmp.commit();
+}
+
+vtkNew<vtkIntArray> int_array(const char* name, vtkIdType n) {
+    vtkNew<vtkIntArray> a;
+    a->SetName(name);
+    a->SetNumberOfTuples(n);
+    return a;
+}
+
+vtkNew<vtkDoubleArray> double_array(const char* name, vtkIdType n) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name);
+    a->SetNumberOfTuples(n);
+    return a;
+}
+
+template <class Range, class Name>
+vtkNew<vtkStringArray> string_array(const char* name, const Range& values, Name&& to_name) {
+    vtkNew<vtkStringArray> a;
+    a->SetName(name);
+    a->SetNumberOfValues(static_cast<vtkIdType>(std::size(values)));
+    vtkIdType i = 0;
+    for (const auto& v : values) a->SetValue(i++, to_name(v));
+    return a;
+}
+
+void require(bool cond, const fs::path& file, const std::string& what) {
+    if (!cond) throw std::invalid_argument("cannot write " + in_quotes(file) + ": " + what);
+}
+
+std::string xml_escape(std::string_view s) {
+    std::string out;
+    out.reserve(s.size());
+    for (const char c : s) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        case '\'': out += "&apos;"; break;
+        default: out += c;
+        }
+    }
+    return out;
+}
+
+/// Shortest text that reads back as the same double, so time steps never merge.
+std::string exact_number(double v) {
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return {buf, r.ptr};
+}
+
+} // namespace
+
+void write_blocks_vtu(const BlockAssembly& a, const fs::path& file) {
+    // Cheap always-on checks: a short array here would be read out of bounds.
+    const std::size_t n = a.region.size();
+    require(a.first.size() == n + 1, file, "first has " + std::to_string(a.first.size()) +
+                                               " entries for " + std::to_string(n) + " blocks");
+    require(a.first.back() == a.points.size(), file, "first.back() != points.size()");
+    require(a.pattern.size() == n && a.parent.size() == n && a.area.size() == n, file,
+            "pattern, parent and area must have one entry per block");
+
+    // Each block owns its vertices, so point i of the grid is a.points[i] and the
+    // cell offsets are `first` itself.
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(static_cast<vtkIdType>(a.points.size()));
+    for (std::size_t i = 0; i < a.points.size(); ++i)
+        points->SetPoint(static_cast<vtkIdType>(i), a.points[i].x, a.points[i].y, 0.0);
+
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->SetNumberOfValues(static_cast<vtkIdType>(a.first.size()));
+    for (std::size_t b = 0; b < a.first.size(); ++b)
+        offsets->SetValue(static_cast<vtkIdType>(b), static_cast<vtkIdType>(a.first[b]));
+    connectivity->SetNumberOfValues(static_cast<vtkIdType>(a.points.size()));
+    for (vtkIdType i = 0; i < connectivity->GetNumberOfValues(); ++i) connectivity->SetValue(i, i);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+
+    vtkNew<vtkUnstructuredGrid> grid;
+    grid->SetPoints(points);
+    grid->SetCells(VTK_POLYGON, cells);
+
+    const auto nb = static_cast<vtkIdType>(n);
+    auto block_id = int_array("block_id", nb);
+    auto region = int_array("region", nb);
+    auto area = double_array("area", nb);
+    auto pattern = int_array("pattern", nb);
+    auto parent = int_array("parent", nb);
+    for (vtkIdType b = 0; b < nb; ++b) {
+        block_id->SetValue(b, static_cast<int>(b));
+        region->SetValue(b, a.region[b]);
+        area->SetValue(b, a.area[b]);
+        pattern->SetValue(b, static_cast<int>(a.pattern[b]));
+        parent->SetValue(b, a.parent[b]);
+    }
+    vtkCellData* cd = grid->GetCellData();
+    cd->AddArray(block_id);
+    cd->AddArray(region);
+    cd->AddArray(area);
+    cd->AddArray(pattern);
+    cd->AddArray(parent);
+
+    vtkFieldData* fd = grid->GetFieldData();
+    fd->AddArray(string_array("pattern_names", all_pattern_kinds,
+                              [](PatternKind k) { return meshing::to_string(k); }));
+    fd->AddArray(string_array("region_names", a.region_names,
+                              [](const std::string& s) { return s; }));
+
+    write_grid(grid, file);
+}
+
+void write_joints_vtu(const BlockAssembly& a, const fs::path& file) {
+    const auto nj = static_cast<vtkIdType>(a.joints.size());
+
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(2 * nj);
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->SetNumberOfValues(nj + 1);
+    connectivity->SetNumberOfValues(2 * nj);
+    auto tag = int_array("tag", nj);
+    auto block_a = int_array("block_a", nj);
+    auto block_b = int_array("block_b", nj);
+    auto length = double_array("length", nj);
+    for (vtkIdType j = 0; j < nj; ++j) {
+        const meshing::JointRecord& r = a.joints[j];
+        points->SetPoint(2 * j, r.p0.x, r.p0.y, 0.0);
+        points->SetPoint(2 * j + 1, r.p1.x, r.p1.y, 0.0);
+        offsets->SetValue(j, 2 * j);
+        connectivity->SetValue(2 * j, 2 * j);
+        connectivity->SetValue(2 * j + 1, 2 * j + 1);
+        tag->SetValue(j, static_cast<int>(r.tag));
+        block_a->SetValue(j, r.block_a);
+        block_b->SetValue(j, r.block_b);
+        length->SetValue(j, r.length());
+    }
+    offsets->SetValue(nj, 2 * nj);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+
+    vtkNew<vtkUnstructuredGrid> grid;
+    grid->SetPoints(points);
+    grid->SetCells(VTK_LINE, cells);
+    vtkCellData* cd = grid->GetCellData();
+    cd->AddArray(tag);
+    cd->AddArray(block_a);
+    cd->AddArray(block_b);
+    cd->AddArray(length);
+    grid->GetFieldData()->AddArray(
+        string_array("tag_names", all_joint_tags, [](JointTag t) { return meshing::to_string(t); }));
+
+    write_grid(grid, file);
+}
+
+void write_pvd(const fs::path& file, const std::vector<std::pair<double, std::string>>& steps) {
+    std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"";
+    xml += std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian";
+    xml += "\">\n  <Collection>\n";
+    std::map<double, int> parts_at; // files already listed per time
+    for (const auto& [time, path] : steps) {
+        require(std::isfinite(time), file, "time of '" + path + "'" + " is not finite");
+        const int part = parts_at[time]++;
+        xml += "    <DataSet timestep=\"" + exact_number(time) + "\" group=\"\" part=\"" +
+               std::to_string(part) + "\" file=\"" + xml_escape(path) + "\"/>\n";
+    }
+    xml += "  </Collection>\n</VTKFile>\n";
+    write_text_atomically(file, xml);
+}
+
+void write_text_atomically(const fs::path& file, std::string_view text) {
+    TmpFile tmp(file);
+    std::FILE* f = std::fopen(tmp.path().c_str(), "wb");
+    if (!f) {
+        throw std::runtime_error("cannot write " + in_quotes(file) + ": " +
+                                 std::generic_category().message(errno));
+    }
+    const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    const int write_errno = errno;
+    // fclose flushes: a full disk may show up only here.
+    const bool closed = std::fclose(f) == 0;
+    if (!written || !closed) {
+        throw std::runtime_error("cannot write " + in_quotes(file) + ": " +
+                                 std::generic_category().message(written ? errno : write_errno));
+    }
+    tmp.commit();
+}
+
+} // namespace bbm::io

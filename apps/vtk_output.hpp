@@ -1,0 +1,48 @@
+// bbm io: VTK output of a block assembly, for ParaView.
+//
+// Two unstructured grids (.vtu) describe a model: the blocks, one polygon cell
+// each, and the joints, one line cell each (the bonds and contacts live on the
+// joints, so they are drawn apart and can be coloured by their own fields).
+// Enums and region indices are written as Int32 cell data; the names they stand
+// for go along as string field data (`pattern_names`, `region_names`,
+// `tag_names`, indexed by the value), so a ParaView user can decode them without
+// this code. Points are 3D in VTK: z = 0.
+//
+// The files are VTK XML with appended raw binary data, zlib-compressed, 64-bit
+// headers, double-precision points. A time series is a .pvd collection that
+// names one .vtu per step; VTK 9.1 has no writer for it, so write_pvd() writes
+// the few lines of XML itself.
+//
+// Every writer here is atomic: it writes `file` + ".tmp" in the same directory
+// and renames it over `file`, so a run killed mid-write never leaves a truncated
+// file and a failed write never destroys the previous good one. (It guards
+// against a killed process, not against power loss: nothing is fsync'ed.)
+// Failures throw std::runtime_error naming the file.
+#pragma once
+
+#include "meshing/blocks.hpp"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace bbm::io {
+
+/// One VTK_POLYGON per block, cell data block_id, region, area, pattern, parent.
+void write_blocks_vtu(const meshing::BlockAssembly& a, const std::filesystem::path& file);
+
+/// One VTK_LINE per JointRecord (p0 to p1), cell data tag, block_a, block_b, length.
+void write_joints_vtu(const meshing::BlockAssembly& a, const std::filesystem::path& file);
+
+/// A ParaView collection: each step is (time, path of a .vtu relative to the .pvd's
+/// directory). Files sharing a time become parts 0, 1, ... of that time step, so
+/// blocks and joints of one step can sit in one collection.
+void write_pvd(const std::filesystem::path& file,
+               const std::vector<std::pair<double, std::string>>& steps);
+
+/// Writes `text` to `file` atomically (summary.json, logs of a finished run).
+void write_text_atomically(const std::filesystem::path& file, std::string_view text);
+
+} // namespace bbm::io

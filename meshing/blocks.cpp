@@ -1,0 +1,359 @@
+// The geometry pipeline of blocks.hpp: regions, real joints, patterns, topology.
+#include "meshing/blocks.hpp"
+
+#include "core/error.hpp"
+#include "meshing/detail.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace bbm::meshing {
+
+const char* to_string(JointTag t) {
+    switch (t) {
+    case JointTag::inner: return "inner";
+    case JointTag::radial: return "radial";
+    case JointTag::peripheral: return "peripheral";
+    case JointTag::real_joint: return "real_joint";
+    case JointTag::interface: return "interface";
+    }
+    return "?";
+}
+
+const char* to_string(PatternSpec::Kind k) {
+    using K = PatternSpec::Kind;
+    switch (k) {
+    case K::voronoi: return "voronoi";
+    case K::trigon: return "trigon";
+    case K::delaunay: return "delaunay";
+    case K::hexagonal: return "hexagonal";
+    case K::brick: return "brick";
+    case K::single: return "single";
+    }
+    return "?";
+}
+
+void BlockAssembly::add_block(std::span<const Vec2> poly, int region_id, PatternSpec::Kind kind,
+                              int parent_id) {
+    const bool ccw = signed_area(poly) > 0;
+    for (std::size_t i = 0; i < poly.size(); ++i) points.push_back(ccw ? poly[i] : poly[poly.size() - 1 - i]);
+    first.push_back(std::uint32_t(points.size()));
+    region.push_back(region_id);
+    pattern.push_back(kind);
+    parent.push_back(parent_id);
+    area.push_back(std::abs(signed_area(poly)));
+}
+
+double mean_block_size(const BlockAssembly& a, int region) {
+    double total = 0.0;
+    int n = 0;
+    for (int b = 0; b < a.block_count(); ++b)
+        if (region < 0 || a.region[b] == region) total += a.area[b], ++n;
+    return n ? std::sqrt(4.0 * (total / n) / std::numbers::pi) : 0.0;
+}
+
+namespace {
+
+std::vector<Vec2> arc_points(Vec2 from, Vec2 to, Vec2 c, bool clockwise, double max_seg) {
+    const double r = norm(from - c);
+    const double a0 = std::atan2(from.y - c.y, from.x - c.x);
+    double sweep = std::atan2(to.y - c.y, to.x - c.x) - a0;
+    const double two_pi = 2.0 * std::numbers::pi;
+    if (clockwise) {
+        while (sweep >= 0) sweep -= two_pi;
+    } else {
+        while (sweep <= 0) sweep += two_pi;
+    }
+    const int n = std::max(2, int(std::ceil(std::abs(sweep) * r / max_seg)));
+    std::vector<Vec2> pts;
+    for (int k = 1; k < n; ++k) {
+        const double t = a0 + sweep * k / n;
+        pts.push_back({c.x + r * std::cos(t), c.y + r * std::sin(t)});
+    }
+    pts.push_back(to);
+    return pts;
+}
+
+} // namespace
+
+std::vector<Vec2> outline_polygon(const OutlineSpec& o, double default_max_segment) {
+    using K = OutlineSpec::Kind;
+    const double max_seg = o.max_segment > 0 ? o.max_segment : default_max_segment;
+    std::vector<Vec2> p;
+    switch (o.kind) {
+    case K::rectangle:
+        p = {o.min, {o.max.x, o.min.y}, o.max, {o.min.x, o.max.y}};
+        break;
+    case K::polygon:
+        p = o.points;
+        break;
+    case K::circle: {
+        const int n = std::max(8, int(std::ceil(2.0 * std::numbers::pi * o.radius / max_seg)));
+        for (int k = 0; k < n; ++k) {
+            const double t = 2.0 * std::numbers::pi * k / n;
+            p.push_back({o.center.x + o.radius * std::cos(t), o.center.y + o.radius * std::sin(t)});
+        }
+        break;
+    }
+    case K::path: {
+        p.push_back(o.start);
+        for (const auto& s : o.steps) {
+            if (s.arc) {
+                const auto arc = arc_points(p.back(), s.to, s.center, s.clockwise, max_seg);
+                p.insert(p.end(), arc.begin(), arc.end());
+            } else {
+                p.push_back(s.to);
+            }
+        }
+        if (p.size() > 1 && p.back() == p.front()) p.pop_back();
+        break;
+    }
+    case K::opening: {
+        const double r = 0.5 * o.width;
+        const Vec2 c = o.center;
+        if (o.half) {
+            p = {{c.x, o.floor_y}, {c.x + r, o.floor_y}, {c.x + r, c.y}};
+            const auto arc = arc_points({c.x + r, c.y}, {c.x, c.y + r}, c, false, max_seg);
+            p.insert(p.end(), arc.begin(), arc.end());
+        } else {
+            p = {{c.x - r, o.floor_y}, {c.x + r, o.floor_y}, {c.x + r, c.y}};
+            const auto arc = arc_points({c.x + r, c.y}, {c.x - r, c.y}, c, false, max_seg);
+            p.insert(p.end(), arc.begin(), arc.end());
+        }
+        break;
+    }
+    }
+    if (p.size() >= 3 && signed_area(p) < 0) std::reverse(p.begin(), p.end());
+    return p;
+}
+
+namespace {
+
+using cgal::Domain;
+
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(6);
+    s << v;
+    return s.str();
+}
+
+/// Traces of a statistical joint set over the box (they are cut to the region later).
+std::vector<SegmentSpec> joint_set_traces(const JointSetSpec& js, const Box2& box) {
+    detail::Random rng(js.seed);
+    const double deg = std::numbers::pi / 180.0;
+    const Vec2 t{std::cos(js.angle * deg), std::sin(js.angle * deg)}, n = perp(t);
+    double nmin = INFINITY, nmax = -INFINITY, tmin = INFINITY, tmax = -INFINITY;
+    for (Vec2 c : {box.lo, Vec2{box.hi.x, box.lo.y}, box.hi, Vec2{box.lo.x, box.hi.y}}) {
+        nmin = std::min(nmin, dot(c - js.origin, n)), nmax = std::max(nmax, dot(c - js.origin, n));
+        tmin = std::min(tmin, dot(c - js.origin, t)), tmax = std::max(tmax, dot(c - js.origin, t));
+    }
+    const double margin = 0.05 * (tmax - tmin) + js.spacing;
+    tmin -= margin, tmax += margin;
+    auto deviate = [&](double x, double frac) { return x * (1.0 + frac * rng.uniform(-1.0, 1.0)); };
+    std::vector<SegmentSpec> out;
+    auto emit = [&](Vec2 a, Vec2 b) {
+        if (js.angle_deviation > 0) {
+            const double d = js.angle_deviation * deg * rng.uniform(-1.0, 1.0);
+            const Vec2 m = 0.5 * (a + b), h = 0.5 * (b - a);
+            const Vec2 hr{h.x * std::cos(d) - h.y * std::sin(d), h.x * std::sin(d) + h.y * std::cos(d)};
+            a = m - hr, b = m + hr;
+        }
+        out.push_back({a, b});
+    };
+    for (long k = long(std::floor(nmin / js.spacing)) - 1; k <= long(std::ceil(nmax / js.spacing)) + 1; ++k) {
+        const double offset = (double(k) + js.spacing_deviation * rng.uniform(-0.5, 0.5)) * js.spacing;
+        const Vec2 base = js.origin + offset * n;
+        if (js.trace_length <= 0) {
+            emit(base + tmin * t, base + tmax * t);
+            continue;
+        }
+        double s = tmin - rng.uniform() * (js.trace_length + js.gap);
+        while (s < tmax) {
+            const double len = deviate(js.trace_length, js.length_deviation);
+            emit(base + s * t, base + (s + len) * t);
+            s += len + std::max(0.0, deviate(js.gap, js.length_deviation));
+        }
+    }
+    return out;
+}
+
+bool segment_enters(std::span<const Vec2> poly, Vec2 a, Vec2 b) {
+    if (point_in_polygon(0.5 * (a + b), poly) || point_in_polygon(a, poly) || point_in_polygon(b, poly))
+        return true;
+    const Vec2 d = b - a;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+        const double s1 = cross(d, p - a), s2 = cross(d, q - a);
+        const double s3 = cross(q - p, a - p), s4 = cross(q - p, b - p);
+        if (((s1 > 0 && s2 < 0) || (s1 < 0 && s2 > 0)) && ((s3 > 0 && s4 < 0) || (s3 < 0 && s4 > 0)))
+            return true;
+    }
+    return false;
+}
+
+/// Inserts `tip` as a vertex where it lies strictly inside an edge.
+void insert_vertex_on_edge(std::vector<Vec2>& poly, Vec2 tip, double tol) {
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+        if (tip == p || tip == q) return;
+        if (distance_to_segment(tip, p, q) <= tol && norm(tip - p) > tol && norm(tip - q) > tol) {
+            poly.insert(poly.begin() + long(i) + 1, tip);
+            return;
+        }
+    }
+}
+
+struct RegionBlocks {
+    std::vector<std::vector<Vec2>> polygons;
+    std::vector<int> parent;
+};
+
+/// Real joints that end inside a rock block split the inner blocks they cross,
+/// along their line; the part beyond the tip becomes an ordinary inner joint.
+void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& dangling, double tol) {
+    for (const auto& s : dangling) {
+        Box2 sb;
+        sb.add(s.a);
+        sb.add(s.b);
+        const std::size_t n = rb.polygons.size();
+        for (std::size_t k = 0; k < n; ++k) {
+            const Box2 b = bounding_box(rb.polygons[k]);
+            if (b.hi.x < sb.lo.x || b.lo.x > sb.hi.x || b.hi.y < sb.lo.y || b.lo.y > sb.hi.y) continue;
+            if (!segment_enters(rb.polygons[k], s.a, s.b)) continue;
+            auto pieces = cgal::split_by_line(rb.polygons[k], s.a, s.b);
+            if (pieces.size() < 2) continue;
+            for (auto& piece : pieces) {
+                insert_vertex_on_edge(piece, s.a, tol);
+                insert_vertex_on_edge(piece, s.b, tol);
+            }
+            rb.polygons[k] = std::move(pieces[0]);
+            for (std::size_t i = 1; i < pieces.size(); ++i) {
+                rb.polygons.push_back(std::move(pieces[i]));
+                rb.parent.push_back(rb.parent[k]);
+            }
+        }
+    }
+}
+
+} // namespace
+
+BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats) {
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    const int nr = int(spec.regions.size());
+    std::vector<Domain> base(nr), domain(nr);
+
+    // 1. Region domains, with the checks a user needs to hear about.
+    for (int r = 0; r < nr; ++r) {
+        const RegionSpec& reg = spec.regions[r];
+        const auto outer = outline_polygon(reg.outline, spec.max_segment);
+        if (outer.size() < 3 || std::abs(signed_area(outer)) <= 0)
+            throw GeometryError(r, "outline", "outline of region '" + reg.name + "' has no area");
+        if (!cgal::is_simple(outer))
+            throw GeometryError(r, "outline", "outline of region '" + reg.name + "' intersects itself");
+        std::vector<std::vector<Vec2>> holes;
+        const Domain outer_domain = cgal::make_domain(outer, {});
+        for (int h = 0; h < int(reg.holes.size()); ++h) {
+            const std::string key = "holes[" + std::to_string(h) + "]";
+            auto hole = outline_polygon(reg.holes[h], spec.max_segment);
+            if (hole.size() < 3 || !cgal::is_simple(hole))
+                throw GeometryError(r, key, "hole " + std::to_string(h) + " of region '" + reg.name +
+                                                "' is not a simple polygon");
+            const double outside = cgal::area(cgal::difference(cgal::make_domain(hole, {}), outer_domain));
+            if (outside > 1e-9 * std::abs(signed_area(hole)))
+                throw GeometryError(r, key, "hole " + std::to_string(h) + " of region '" + reg.name +
+                                                "' lies outside its outline by " + fmt(outside) + " m²");
+            holes.push_back(std::move(hole));
+        }
+        base[r] = cgal::make_domain(outer, holes);
+    }
+    for (int r = 0; r < nr; ++r) {
+        const RegionSpec& reg = spec.regions[r];
+        domain[r] = base[r];
+        for (const auto& name : reg.minus) {
+            const auto it = std::find_if(spec.regions.begin(), spec.regions.end(),
+                                         [&](const RegionSpec& o) { return o.name == name; });
+            if (it == spec.regions.end() || it - spec.regions.begin() == r)
+                throw GeometryError(r, "minus", "region '" + reg.name + "' subtracts '" + name +
+                                                    "', which is not another region");
+            domain[r] = cgal::difference(domain[r], base[it - spec.regions.begin()]);
+        }
+        if (cgal::area(domain[r]) <= 1e-12 * cgal::area(base[r]))
+            throw GeometryError(r, "minus", "nothing is left of region '" + reg.name + "' after subtraction");
+    }
+    for (int r = 0; r < nr; ++r)
+        for (int q = 0; q < r; ++q) {
+            const double overlap = cgal::area(cgal::intersection(domain[r], domain[q]));
+            if (overlap > 1e-9 * std::min(cgal::area(domain[r]), cgal::area(domain[q])))
+                throw GeometryError(r, "outline",
+                                    "region '" + spec.regions[r].name + "' overlaps region '" +
+                                        spec.regions[q].name + "' by " + fmt(overlap) +
+                                        " m² (subtract one from the other with `minus`)");
+        }
+    const auto t1 = clock::now();
+
+    // 2–4. Real joints, then the inner pattern in each rock block.
+    BlockAssembly a;
+    GenerationStats st;
+    Box2 all;
+    for (const auto& d : domain)
+        for (const auto& p : d)
+            for (Vec2 q : p.outer) all.add(q);
+    const double tol = 1e-9 * std::max(all.width(), all.height());
+    for (int r = 0; r < nr; ++r) {
+        const RegionSpec& reg = spec.regions[r];
+        a.region_names.push_back(reg.name);
+        a.region_size.push_back(reg.pattern.size);
+        Box2 box;
+        for (const auto& p : domain[r])
+            for (Vec2 q : p.outer) box.add(q);
+        std::vector<SegmentSpec> segments = reg.joints;
+        for (const auto& js : reg.joint_sets) {
+            const auto traces = joint_set_traces(js, box);
+            segments.insert(segments.end(), traces.begin(), traces.end());
+        }
+        const auto cut = cgal::cut_by_segments(domain[r], segments);
+        a.real_segments.insert(a.real_segments.end(), cut.separating.begin(), cut.separating.end());
+        a.real_segments.insert(a.real_segments.end(), cut.dangling.begin(), cut.dangling.end());
+
+        detail::Random rng(reg.pattern.seed);
+        RegionBlocks rb;
+        for (const auto& face : cut.faces) {
+            auto fill = detail::fill_face(face, reg.pattern, rng);
+            st.collapsed_edges += fill.collapsed_edges;
+            const int offset = rb.parent.empty() ? 0 : *std::max_element(rb.parent.begin(), rb.parent.end()) + 1;
+            for (std::size_t k = 0; k < fill.polygons.size(); ++k) {
+                rb.polygons.push_back(std::move(fill.polygons[k]));
+                rb.parent.push_back(offset + fill.parent[k]);
+            }
+        }
+        split_by_dangling(rb, cut.dangling, tol);
+        const int parent_base = a.block_count();
+        for (std::size_t k = 0; k < rb.polygons.size(); ++k)
+            a.add_block(rb.polygons[k], r, reg.pattern.kind, parent_base + rb.parent[k]);
+        if (reg.pattern.kind != PatternSpec::Kind::single) {
+            const double min_edge = reg.pattern.min_edge >= 0 ? reg.pattern.min_edge : 0.1 * reg.pattern.size;
+            for (int b = parent_base; b < a.block_count(); ++b) {
+                const auto poly = a.block(b);
+                for (std::size_t i = 0; i < poly.size(); ++i)
+                    if (norm(poly[(i + 1) % poly.size()] - poly[i]) < min_edge * (1.0 - 1e-12)) ++st.short_edges_left;
+            }
+        }
+    }
+    const auto t2 = clock::now();
+
+    // 5. Topology.
+    detail::build_joints(a);
+    const auto t3 = clock::now();
+    st.seconds_regions = std::chrono::duration<double>(t1 - t0).count();
+    st.seconds_patterns = std::chrono::duration<double>(t2 - t1).count();
+    st.seconds_topology = std::chrono::duration<double>(t3 - t2).count();
+    if (stats) *stats = st;
+    return a;
+}
+
+} // namespace bbm::meshing

@@ -1,0 +1,74 @@
+// bbm meshing, internal: pieces of the generation pipeline shared between its
+// translation units. Not part of the public interface (blocks.hpp is).
+#pragma once
+
+#include "meshing/blocks.hpp"
+#include "meshing/cgal_ops.hpp"
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace bbm::meshing::detail {
+
+/// Reproducible uniform numbers: mt19937_64 is fully specified by the standard,
+/// the conversion to [0, 1) is ours (std's distributions are not portable).
+class Random {
+public:
+    explicit Random(std::uint64_t seed) : engine_(seed) {}
+    double uniform() { return double(engine_() >> 11) * 0x1.0p-53; }
+    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+
+private:
+    std::mt19937_64 engine_;
+};
+
+/// Segments in a uniform grid, for "which segments are near this box" queries.
+class SegmentGrid {
+public:
+    SegmentGrid(std::vector<std::pair<Vec2, Vec2>> segments, double cell_hint);
+    /// Calls f(index) for each segment whose box overlaps `b` (possibly repeatedly).
+    template <class F> void for_each_near(const Box2& b, F&& f) const {
+        if (segments_.empty() || b.hi.x < box_.lo.x || b.lo.x > box_.hi.x || b.hi.y < box_.lo.y ||
+            b.lo.y > box_.hi.y)
+            return;
+        for (int j = cy(b.lo.y); j <= cy(b.hi.y); ++j)
+            for (int i = cx(b.lo.x); i <= cx(b.hi.x); ++i)
+                for (std::uint32_t k = start_[j * nx_ + i]; k < start_[j * nx_ + i + 1]; ++k)
+                    f(items_[k]);
+    }
+    /// Distance from q to the nearest segment within `radius`, or +inf.
+    double distance_within(Vec2 q, double radius) const;
+    const std::vector<std::pair<Vec2, Vec2>>& segments() const { return segments_; }
+
+private:
+    int cx(double x) const;
+    int cy(double y) const;
+    std::vector<std::pair<Vec2, Vec2>> segments_;
+    Box2 box_;
+    double cell_ = 1.0;
+    int nx_ = 1, ny_ = 1;
+    std::vector<std::uint32_t> start_;
+    std::vector<int> items_;
+};
+
+bool domain_contains(const cgal::Domain& d, Vec2 q);
+
+/// Blocks filling one rock block (a face of the real-joint arrangement).
+struct FaceFill {
+    std::vector<std::vector<Vec2>> polygons;
+    std::vector<int> parent;  ///< local parent id (the Voronoi cell of a trigon triangle)
+    int collapsed_edges = 0;
+};
+FaceFill fill_face(const cgal::PolygonWithHoles& face, const PatternSpec& pattern, Random& rng);
+
+/// Collapses edges shorter than min_edge; shared vertices move together so the
+/// polygons still tile the same area. Outline vertices of `face` never move, and
+/// vertices on the outline move only along it. Returns the number collapsed.
+int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::PolygonWithHoles& face,
+                         double min_edge);
+
+/// Joint records from shared edge stretches (see blocks.hpp, step 5).
+void build_joints(BlockAssembly& a);
+
+} // namespace bbm::meshing::detail

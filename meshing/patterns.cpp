@@ -1,0 +1,306 @@
+// Inner-block patterns (paper §3.1): each fills one rock block exactly.
+#include "core/error.hpp"
+#include "meshing/detail.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace bbm::meshing::detail {
+namespace {
+
+using cgal::Domain;
+using cgal::PolygonWithHoles;
+
+double face_area(const PolygonWithHoles& f) { return cgal::area(Domain{f}); }
+
+Box2 face_box(const PolygonWithHoles& f) { return bounding_box(f.outer); }
+
+std::vector<std::pair<Vec2, Vec2>> face_edges(const PolygonWithHoles& f) {
+    std::vector<std::pair<Vec2, Vec2>> e;
+    auto add = [&](const std::vector<Vec2>& r) {
+        for (std::size_t i = 0; i < r.size(); ++i) e.push_back({r[i], r[(i + 1) % r.size()]});
+    };
+    add(f.outer);
+    for (const auto& h : f.holes) add(h);
+    return e;
+}
+
+/// Appends the pieces of `poly ∩ face` as simple polygons.
+void clip_into(const cgal::Clipper& clipper, std::span<const Vec2> poly, int parent, FaceFill& out) {
+    for (const auto& piece : clipper.clip(poly)) {
+        if (piece.holes.empty()) {
+            out.polygons.push_back(piece.outer);
+            out.parent.push_back(parent);
+        } else {
+            for (auto& p : cgal::split_holes(piece)) {
+                out.polygons.push_back(std::move(p));
+                out.parent.push_back(parent);
+            }
+        }
+    }
+}
+
+std::vector<Vec2> random_seeds(const PolygonWithHoles& face, int n, Random& rng) {
+    const Box2 b = face_box(face);
+    const Domain d{face};
+    std::vector<Vec2> seeds;
+    seeds.reserve(n);
+    while (int(seeds.size()) < n) {
+        const Vec2 q{rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y)};
+        if (domain_contains(d, q)) seeds.push_back(q);
+    }
+    return seeds;
+}
+
+/// Voronoi cells of the seeds clipped to the face; `parent` is the seed index.
+FaceFill clipped_voronoi(const PolygonWithHoles& face, const cgal::Clipper& clipper,
+                         std::span<const Vec2> seeds) {
+    const auto vor = cgal::voronoi(seeds, face_box(face));
+    FaceFill out;
+    std::vector<Vec2> poly;
+    for (int i = 0; i < int(vor.cells.size()); ++i) {
+        if (vor.cells[i].size() < 3) continue;
+        poly.clear();
+        for (int v : vor.cells[i]) poly.push_back(vor.vertices[v]);
+        clip_into(clipper, poly, i, out);
+    }
+    return out;
+}
+
+/// Lloyd relaxation: each seed moves to the centroid of its clipped cell.
+void lloyd(const PolygonWithHoles& face, const cgal::Clipper& clipper, std::vector<Vec2>& seeds,
+           int iterations) {
+    for (int it = 0; it < iterations; ++it) {
+        const FaceFill cells = clipped_voronoi(face, clipper, seeds);
+        std::vector<double> area(seeds.size(), 0.0);
+        std::vector<Vec2> moment(seeds.size());
+        for (std::size_t k = 0; k < cells.polygons.size(); ++k) {
+            const double a = signed_area(cells.polygons[k]);
+            area[cells.parent[k]] += a;
+            moment[cells.parent[k]] += a * centroid(cells.polygons[k]);
+        }
+        for (std::size_t i = 0; i < seeds.size(); ++i)
+            if (area[i] > 0) seeds[i] = moment[i] / area[i];
+    }
+}
+
+double min_edge_of(const PatternSpec& p) { return p.min_edge >= 0 ? p.min_edge : 0.1 * p.size; }
+
+int cell_count(double area, double size) {
+    return std::max(1, int(std::lround(area / (std::numbers::pi * size * size / 4.0))));
+}
+
+FaceFill fill_voronoi(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+    const cgal::Clipper clipper(Domain{face});
+    auto seeds = random_seeds(face, cell_count(face_area(face), p.size), rng);
+    lloyd(face, clipper, seeds, p.lloyd_iterations);
+    FaceFill out = clipped_voronoi(face, clipper, seeds);
+    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
+    return out;
+}
+
+/// A point from which every edge of the polygon is seen (its kernel), preferring
+/// the centroid; false if the polygon is not star-shaped.
+bool star_center(const std::vector<Vec2>& poly, Vec2& center) {
+    auto sees_all = [&](Vec2 c) {
+        const double a = std::abs(signed_area(poly));
+        for (std::size_t i = 0; i < poly.size(); ++i)
+            if (cross(poly[i] - c, poly[(i + 1) % poly.size()] - c) <= 1e-9 * a) return false;
+        return true;
+    };
+    center = centroid(poly);
+    if (sees_all(center)) return true;
+    // Kernel = intersection of the inner half-planes of all edges (convex clipping).
+    std::vector<Vec2> k;
+    const Box2 b = bounding_box(poly);
+    k = {b.lo, {b.hi.x, b.lo.y}, b.hi, {b.lo.x, b.hi.y}};
+    for (std::size_t i = 0; i < poly.size() && k.size() >= 3; ++i) {
+        const Vec2 a = poly[i], d = poly[(i + 1) % poly.size()] - a;
+        std::vector<Vec2> next;
+        for (std::size_t j = 0; j < k.size(); ++j) {
+            const Vec2 p = k[j], q = k[(j + 1) % k.size()];
+            const double sp = cross(d, p - a), sq = cross(d, q - a);
+            if (sp >= 0) next.push_back(p);
+            if ((sp >= 0) != (sq >= 0)) next.push_back(p + (sp / (sp - sq)) * (q - p));
+        }
+        k = std::move(next);
+    }
+    if (k.size() < 3 || signed_area(k) <= 0) return false;
+    center = centroid(k);
+    return sees_all(center);
+}
+
+FaceFill fill_trigon(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+    FaceFill cells = fill_voronoi(face, p, rng);
+    FaceFill out;
+    out.collapsed_edges = cells.collapsed_edges;
+    for (int c = 0; c < int(cells.polygons.size()); ++c) {
+        const auto& poly = cells.polygons[c];
+        Vec2 center;
+        if (!star_center(poly, center)) {
+            // Not star-shaped (a cell clipped by a strongly concave outline): kept whole.
+            out.polygons.push_back(poly);
+            out.parent.push_back(c);
+            continue;
+        }
+        for (std::size_t i = 0; i < poly.size(); ++i) {
+            out.polygons.push_back({center, poly[i], poly[(i + 1) % poly.size()]});
+            out.parent.push_back(c);
+        }
+    }
+    return out;
+}
+
+FaceFill fill_delaunay(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+    // Triangles of mean area π d²/4; boundary sampled at the edge of an equilateral
+    // triangle of that area, interior seeds kept apart (hard core) so that no
+    // triangle edge is much shorter than the minimum.
+    const double tri_area = std::numbers::pi * p.size * p.size / 4.0;
+    const double spacing = std::sqrt(4.0 * tri_area / std::sqrt(3.0));
+    PolygonWithHoles sampled;
+    auto sample = [&](const std::vector<Vec2>& r) {
+        std::vector<Vec2> out;
+        for (std::size_t i = 0; i < r.size(); ++i) {
+            const Vec2 a = r[i], b = r[(i + 1) % r.size()];
+            const int n = std::max(1, int(std::lround(norm(b - a) / spacing)));
+            for (int k = 0; k < n; ++k) out.push_back(k == 0 ? a : a + (double(k) / n) * (b - a));
+        }
+        return out;
+    };
+    sampled.outer = sample(face.outer);
+    std::size_t boundary_points = sampled.outer.size();
+    for (const auto& h : face.holes) {
+        sampled.holes.push_back(sample(h));
+        boundary_points += sampled.holes.back().size();
+    }
+    const double area = face_area(face);
+    const int triangles = std::max(1, int(std::lround(area / tri_area)));
+    const int interior = std::max(0, (triangles - int(boundary_points) + 2) / 2);
+    const double hard_core = std::max(min_edge_of(p), 0.5 * spacing);
+
+    const cgal::Clipper clipper(Domain{face});
+    auto seeds = random_seeds(face, interior, rng);
+    lloyd(face, clipper, seeds, p.lloyd_iterations);
+    // Keep seeds away from the boundary and from each other.
+    const SegmentGrid boundary(face_edges(sampled), hard_core);
+    const Box2 b = face_box(face);
+    const double cell = hard_core;
+    const int nx = std::max(1, int(b.width() / cell) + 1), ny = std::max(1, int(b.height() / cell) + 1);
+    std::vector<std::vector<Vec2>> grid(std::size_t(nx) * ny);
+    auto gx = [&](double x) { return std::clamp(int((x - b.lo.x) / cell), 0, nx - 1); };
+    auto gy = [&](double y) { return std::clamp(int((y - b.lo.y) / cell), 0, ny - 1); };
+    std::vector<Vec2> kept;
+    for (Vec2 s : seeds) {
+        if (boundary.distance_within(s, hard_core) < hard_core) continue;
+        bool close = false;
+        for (int j = gy(s.y) - 1; j <= gy(s.y) + 1 && !close; ++j)
+            for (int i = gx(s.x) - 1; i <= gx(s.x) + 1 && !close; ++i) {
+                if (i < 0 || j < 0 || i >= nx || j >= ny) continue;
+                for (Vec2 q : grid[j * nx + i]) close = close || norm(q - s) < hard_core;
+            }
+        if (close) continue;
+        grid[gy(s.y) * nx + gx(s.x)].push_back(s);
+        kept.push_back(s);
+    }
+    FaceFill out;
+    for (const auto& t : cgal::constrained_delaunay(Domain{sampled}, kept)) {
+        std::vector<Vec2> tri(t.begin(), t.end());
+        if (signed_area(tri) < 0) std::reverse(tri.begin(), tri.end());
+        out.polygons.push_back(std::move(tri));
+        out.parent.push_back(int(out.parent.size()));
+    }
+    return out;
+}
+
+/// Lattice frame: origin and rotated axes.
+struct Lattice {
+    Vec2 origin, u, v;
+    explicit Lattice(const PatternSpec& p) {
+        const double t = p.angle * std::numbers::pi / 180.0;
+        origin = p.origin;
+        u = {std::cos(t), std::sin(t)};
+        v = perp(u);
+    }
+    Vec2 at(double a, double b) const { return origin + a * u + b * v; }
+    /// Lattice coordinates range covering the box.
+    void range(const Box2& box, double& amin, double& amax, double& bmin, double& bmax) const {
+        amin = bmin = INFINITY;
+        amax = bmax = -INFINITY;
+        for (Vec2 c : {box.lo, Vec2{box.hi.x, box.lo.y}, box.hi, Vec2{box.lo.x, box.hi.y}}) {
+            const double a = dot(c - origin, u), b = dot(c - origin, v);
+            amin = std::min(amin, a), amax = std::max(amax, a);
+            bmin = std::min(bmin, b), bmax = std::max(bmax, b);
+        }
+    }
+};
+
+FaceFill fill_hexagonal(const PolygonWithHoles& face, const PatternSpec& p) {
+    // Seeds on a triangular lattice of spacing s: their Voronoi cells are regular
+    // hexagons of side s/√3.
+    const Lattice lat(p);
+    const double s = p.size, row = s * std::sqrt(3.0) / 2.0;
+    double amin, amax, bmin, bmax;
+    lat.range(face_box(face), amin, amax, bmin, bmax);
+    std::vector<Vec2> seeds;
+    for (long j = long(std::floor(bmin / row)) - 1; j <= long(std::ceil(bmax / row)) + 1; ++j)
+        for (long i = long(std::floor(amin / s)) - 2; i <= long(std::ceil(amax / s)) + 1; ++i)
+            seeds.push_back(lat.at((double(i) + 0.5 * double(j & 1)) * s, double(j) * row));
+    const cgal::Clipper clipper(Domain{face});
+    FaceFill out = clipped_voronoi(face, clipper, seeds);
+    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
+    return out;
+}
+
+FaceFill fill_brick(const PolygonWithHoles& face, const PatternSpec& p) {
+    // Corners are computed from integer half-brick indices, so neighbouring bricks
+    // share bit-identical corners.
+    const Lattice lat(p);
+    const double h = p.size, half = 0.5 * p.aspect * p.size;
+    double amin, amax, bmin, bmax;
+    lat.range(face_box(face), amin, amax, bmin, bmax);
+    const cgal::Clipper clipper(Domain{face});
+    FaceFill out;
+    for (long j = long(std::floor(bmin / h)) - 1; j <= long(std::ceil(bmax / h)); ++j) {
+        const long shift = p.running_bond ? (j & 1) : 0;
+        for (long m = long(std::floor(amin / half)) - 3; m <= long(std::ceil(amax / half)) + 1; ++m) {
+            if (((m - shift) & 1) != 0) continue;
+            const std::vector<Vec2> brick{lat.at(double(m) * half, double(j) * h),
+                                          lat.at(double(m + 2) * half, double(j) * h),
+                                          lat.at(double(m + 2) * half, double(j + 1) * h),
+                                          lat.at(double(m) * half, double(j + 1) * h)};
+            clip_into(clipper, brick, int(out.polygons.size()), out);
+        }
+    }
+    for (std::size_t k = 0; k < out.parent.size(); ++k) out.parent[k] = int(k);
+    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
+    return out;
+}
+
+FaceFill fill_single(const PolygonWithHoles& face) {
+    FaceFill out;
+    if (face.holes.empty()) {
+        out.polygons.push_back(face.outer);
+    } else {
+        out.polygons = cgal::split_holes(face);
+    }
+    for (std::size_t k = 0; k < out.polygons.size(); ++k) out.parent.push_back(int(k));
+    return out;
+}
+
+} // namespace
+
+FaceFill fill_face(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+    using K = PatternSpec::Kind;
+    switch (p.kind) {
+    case K::voronoi: return fill_voronoi(face, p, rng);
+    case K::trigon: return fill_trigon(face, p, rng);
+    case K::delaunay: return fill_delaunay(face, p, rng);
+    case K::hexagonal: return fill_hexagonal(face, p);
+    case K::brick: return fill_brick(face, p);
+    case K::single: return fill_single(face);
+    }
+    return {};
+}
+
+} // namespace bbm::meshing::detail

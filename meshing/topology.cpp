@@ -1,0 +1,292 @@
+// Vertex welding, short-edge collapse and joint records (blocks.hpp, steps 4–5).
+#include "core/error.hpp"
+#include "meshing/detail.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace bbm::meshing::detail {
+
+// ---------------------------------------------------------------------------
+SegmentGrid::SegmentGrid(std::vector<std::pair<Vec2, Vec2>> segments, double cell_hint)
+    : segments_(std::move(segments)) {
+    for (const auto& [p, q] : segments_) box_.add(p), box_.add(q);
+    if (segments_.empty()) return;
+    const double span = std::max(box_.width(), box_.height());
+    cell_ = std::max(cell_hint, span / 2048.0);
+    if (!(cell_ > 0)) cell_ = 1.0;
+    nx_ = std::max(1, int(box_.width() / cell_) + 1);
+    ny_ = std::max(1, int(box_.height() / cell_) + 1);
+    start_.assign(std::size_t(nx_) * ny_ + 1, 0);
+    auto visit = [&](auto&& f) {
+        for (int s = 0; s < int(segments_.size()); ++s) {
+            const auto& [p, q] = segments_[s];
+            for (int j = cy(std::min(p.y, q.y)); j <= cy(std::max(p.y, q.y)); ++j)
+                for (int i = cx(std::min(p.x, q.x)); i <= cx(std::max(p.x, q.x)); ++i) f(j * nx_ + i, s);
+        }
+    };
+    visit([&](int c, int) { ++start_[c + 1]; });
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    items_.resize(start_.back());
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    visit([&](int c, int s) { items_[fill[c]++] = s; });
+}
+
+int SegmentGrid::cx(double x) const { return std::clamp(int((x - box_.lo.x) / cell_), 0, nx_ - 1); }
+int SegmentGrid::cy(double y) const { return std::clamp(int((y - box_.lo.y) / cell_), 0, ny_ - 1); }
+
+double SegmentGrid::distance_within(Vec2 q, double radius) const {
+    Box2 b;
+    b.add(q - Vec2{radius, radius});
+    b.add(q + Vec2{radius, radius});
+    double best = INFINITY;
+    for_each_near(b, [&](int s) {
+        best = std::min(best, distance_to_segment(q, segments_[s].first, segments_[s].second));
+    });
+    return best;
+}
+
+bool domain_contains(const cgal::Domain& d, Vec2 q) {
+    for (const auto& p : d) {
+        if (!point_in_polygon(q, p.outer)) continue;
+        bool in_hole = false;
+        for (const auto& h : p.holes) in_hole = in_hole || point_in_polygon(q, h);
+        if (!in_hole) return true;
+    }
+    return false;
+}
+
+// ---------------------------------------------------------------------------
+namespace {
+
+struct PointHash {
+    std::size_t operator()(Vec2 p) const {
+        std::uint64_t a, b;
+        std::memcpy(&a, &p.x, 8);
+        std::memcpy(&b, &p.y, 8);
+        return std::hash<std::uint64_t>{}(a * 0x9E3779B97F4A7C15ull ^ b);
+    }
+};
+
+std::uint64_t edge_key(int u, int v) {
+    return (std::uint64_t(std::uint32_t(std::min(u, v))) << 32) | std::uint32_t(std::max(u, v));
+}
+
+} // namespace
+
+int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::PolygonWithHoles& face,
+                         double min_edge) {
+    if (min_edge <= 0 || polygons.empty()) return 0;
+    // Weld: bit-identical coordinates are one vertex (the Voronoi and clipping
+    // steps guarantee shared vertices are bit-identical).
+    std::unordered_map<Vec2, int, PointHash> index;
+    std::vector<Vec2> pos;
+    std::vector<std::vector<int>> polys(polygons.size());
+    for (std::size_t k = 0; k < polygons.size(); ++k)
+        for (Vec2 p : polygons[k]) {
+            auto [it, fresh] = index.try_emplace(p, int(pos.size()));
+            if (fresh) pos.push_back(p);
+            polys[k].push_back(it->second);
+        }
+    // Classes: 0 free, 1 on the face outline, 2 an outline vertex (fixed).
+    std::vector<int> cls(pos.size(), 0);
+    std::unordered_map<std::uint64_t, int> uses;
+    for (const auto& p : polys)
+        for (std::size_t i = 0; i < p.size(); ++i) ++uses[edge_key(p[i], p[(i + 1) % p.size()])];
+    for (const auto& [key, n] : uses)
+        if (n == 1) cls[key >> 32] = cls[key & 0xffffffffu] = 1;
+    auto mark_fixed = [&](const std::vector<Vec2>& ring) {
+        for (Vec2 q : ring)
+            if (auto it = index.find(q); it != index.end()) cls[it->second] = 2;
+    };
+    mark_fixed(face.outer);
+    for (const auto& h : face.holes) mark_fixed(h);
+
+    std::vector<std::vector<int>> incident(pos.size());
+    for (int k = 0; k < int(polys.size()); ++k)
+        for (int v : polys[k]) incident[v].push_back(k);
+
+    struct Candidate { double length; int u, v; };
+    std::vector<Candidate> cand;
+    for (const auto& [key, n] : uses) {
+        const int u = int(key >> 32), v = int(key & 0xffffffffu);
+        const double l = norm(pos[u] - pos[v]);
+        if (l < min_edge) cand.push_back({l, u, v});
+    }
+    std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
+        return a.length < b.length || (a.length == b.length && (a.u < b.u || (a.u == b.u && a.v < b.v)));
+    });
+
+    std::vector<int> alias(pos.size());
+    std::iota(alias.begin(), alias.end(), 0);
+    auto root = [&](int v) {
+        while (alias[v] != v) v = alias[v] = alias[alias[v]];
+        return v;
+    };
+    auto merged_polygon = [&](const std::vector<int>& p, int from, int to) {
+        std::vector<int> r;
+        for (int v : p) {
+            const int w = (v == from) ? to : v;
+            if (r.empty() || r.back() != w) r.push_back(w);
+        }
+        while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+        return r;
+    };
+    auto area_of = [&](const std::vector<int>& p, int moved, Vec2 at) {
+        double a2 = 0.0;
+        for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++) {
+            const Vec2 a = p[j] == moved ? at : pos[p[j]], b = p[i] == moved ? at : pos[p[i]];
+            a2 += cross(a, b);
+        }
+        return 0.5 * a2;
+    };
+
+    int collapsed = 0;
+    for (const Candidate& c : cand) {
+        int u = root(c.u), v = root(c.v);
+        if (u == v || norm(pos[u] - pos[v]) >= min_edge) continue;
+        if (cls[u] < cls[v]) std::swap(u, v); // u keeps its place unless both are free
+        const bool on_outline = uses[edge_key(u, v)] == 1;
+        if (cls[u] == 2 && cls[v] == 2) continue;
+        if (cls[v] >= 1 && !on_outline) continue; // an outline vertex slides only along the outline
+        const Vec2 target = (cls[u] == 0 && cls[v] == 0) || (cls[u] == 1 && cls[v] == 1)
+                                ? 0.5 * (pos[u] + pos[v])
+                                : pos[u];
+        // Every polygon touching u or v must stay a polygon with positive area.
+        bool ok = true;
+        std::vector<int> touched = incident[u];
+        touched.insert(touched.end(), incident[v].begin(), incident[v].end());
+        std::sort(touched.begin(), touched.end());
+        touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+        for (int k : touched) {
+            const auto m = merged_polygon(polys[k], v, u);
+            if (m.size() < 3) { ok = false; break; }
+            const double before = area_of(polys[k], -1, {});
+            const double after = area_of(m, u, target);
+            if (!(after > 0.25 * before)) { ok = false; break; }
+        }
+        if (!ok) continue;
+        auto count_edges = [&](int delta) {
+            for (int k : touched)
+                for (std::size_t i = 0; i < polys[k].size(); ++i)
+                    uses[edge_key(polys[k][i], polys[k][(i + 1) % polys[k].size()])] += delta;
+        };
+        count_edges(-1);
+        for (int k : touched) polys[k] = merged_polygon(polys[k], v, u);
+        count_edges(+1);
+        pos[u] = target;
+        alias[v] = u;
+        incident[u] = touched;
+        ++collapsed;
+    }
+    for (std::size_t k = 0; k < polygons.size(); ++k) {
+        polygons[k].clear();
+        for (int v : polys[k]) polygons[k].push_back(pos[v]);
+    }
+    return collapsed;
+}
+
+// ---------------------------------------------------------------------------
+void build_joints(BlockAssembly& a) {
+    a.joints.clear();
+    const int nb = a.block_count();
+    if (nb < 2) return;
+    struct Edge { Vec2 p, q; int block, index; };
+    std::vector<Edge> edges;
+    edges.reserve(a.points.size());
+    Box2 all;
+    double total = 0.0;
+    for (int b = 0; b < nb; ++b) {
+        const auto poly = a.block(b);
+        for (int i = 0; i < int(poly.size()); ++i) {
+            const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+            edges.push_back({p, q, b, i});
+            all.add(p);
+            total += norm(q - p);
+        }
+    }
+    const double tol = 1e-9 * std::max(all.width(), all.height());
+    std::vector<std::pair<Vec2, Vec2>> segs;
+    segs.reserve(edges.size());
+    for (const auto& e : edges) segs.push_back({e.p, e.q});
+    const double cell = 2.0 * total / double(edges.size());
+    const SegmentGrid grid(std::move(segs), cell);
+
+    std::vector<std::pair<Vec2, Vec2>> real;
+    for (const auto& s : a.real_segments) real.push_back({s.a, s.b});
+    const SegmentGrid real_grid(std::move(real), cell);
+    auto on_real_joint = [&](Vec2 p0, Vec2 p1) {
+        const Vec2 m = 0.5 * (p0 + p1);
+        bool hit = false;
+        Box2 b;
+        b.add(m);
+        real_grid.for_each_near(b, [&](int s) {
+            const auto& [ra, rb] = real_grid.segments()[s];
+            hit = hit || (distance_to_segment(m, ra, rb) <= tol &&
+                          std::abs(cross(rb - ra, p1 - p0)) <= tol * norm(rb - ra));
+        });
+        return hit;
+    };
+
+    for (int e1 = 0; e1 < int(edges.size()); ++e1) {
+        const Edge& E = edges[e1];
+        const Vec2 d = E.q - E.p;
+        const double len = norm(d);
+        if (len <= tol) continue;
+        const Vec2 t = d / len;
+        Box2 b;
+        b.add(E.p);
+        b.add(E.q);
+        int last = -1;
+        grid.for_each_near(b, [&](int e2) {
+            // A pair is visited from its lower-numbered edge only; the grid can
+            // report the same neighbour from several cells, hence `last`.
+            if (e2 <= e1 || e2 == last) return;
+            const Edge& F = edges[e2];
+            if (F.block == E.block) return;
+            const Vec2 f = F.q - F.p;
+            if (dot(f, d) >= 0) return; // shared boundaries of two CCW polygons run opposite ways
+            if (std::abs(cross(t, F.p - E.p)) > tol || std::abs(cross(t, F.q - E.p)) > tol) return;
+            const double sp = dot(F.p - E.p, t), sq = dot(F.q - E.p, t);
+            // F runs against E, so F.q is the start of the overlap along E.
+            const double lo = std::max(0.0, sq), hi = std::min(len, sp);
+            if (hi - lo <= tol) return;
+            last = e2;
+            JointRecord j;
+            j.block_a = E.block;
+            j.edge_a = E.index;
+            j.block_b = F.block;
+            j.edge_b = F.index;
+            j.p0 = (sq > 0.0) ? F.q : E.p; // actual vertices, never re-rounded projections
+            j.p1 = (sp < len) ? F.p : E.q;
+            if (a.region[E.block] != a.region[F.block]) {
+                j.tag = JointTag::interface;
+            } else if (on_real_joint(j.p0, j.p1)) {
+                j.tag = JointTag::real_joint;
+            } else if (a.pattern[E.block] == PatternSpec::Kind::trigon) {
+                j.tag = a.parent[E.block] == a.parent[F.block] ? JointTag::radial : JointTag::peripheral;
+            } else {
+                j.tag = JointTag::inner;
+            }
+            a.joints.push_back(j);
+        });
+    }
+    // A pair of edges might be reported twice if the grid gave it from two cells
+    // between other candidates: remove exact duplicates.
+    std::sort(a.joints.begin(), a.joints.end(), [](const JointRecord& x, const JointRecord& y) {
+        return std::tie(x.block_a, x.edge_a, x.block_b, x.edge_b) <
+               std::tie(y.block_a, y.edge_a, y.block_b, y.edge_b);
+    });
+    a.joints.erase(std::unique(a.joints.begin(), a.joints.end(),
+                               [](const JointRecord& x, const JointRecord& y) {
+                                   return x.block_a == y.block_a && x.edge_a == y.edge_a &&
+                                          x.block_b == y.block_b && x.edge_b == y.edge_b;
+                               }),
+                   a.joints.end());
+}
+
+} // namespace bbm::meshing::detail

@@ -1,0 +1,25 @@
+# A model with an error must fail with exit status 2, name file, line and key,
+# and leave earlier output untouched.
+file(REMOVE_RECURSE ${DIR})
+file(MAKE_DIRECTORY ${DIR}/out)
+file(WRITE ${DIR}/out/summary.json "earlier good output\n")
+file(WRITE ${DIR}/bad.toml "[[region]]\nname = \"a\"\noutline = { type = \"rectangle\", min = [0.0, 0.0], max = [1.0, 1.0] }\npattern = { type = \"voronoi\", size = -0.3 }\n")
+execute_process(COMMAND ${BBM} mesh ${DIR}/bad.toml --out ${DIR}/out
+                RESULT_VARIABLE status ERROR_VARIABLE err OUTPUT_VARIABLE out)
+if(NOT status EQUAL 2)
+  message(FATAL_ERROR "expected exit status 2, got ${status}: ${err}")
+endif()
+if(NOT err MATCHES "bad.toml:4: region\\[0\\]\\.pattern\\.size")
+  message(FATAL_ERROR "message does not name file:line: key: ${err}")
+endif()
+file(READ ${DIR}/out/summary.json kept)
+if(NOT kept STREQUAL "earlier good output\n")
+  message(FATAL_ERROR "earlier output was changed")
+endif()
+# A geometric defect (self-intersecting outline) is reported at its line too.
+file(WRITE ${DIR}/bowtie.toml "[[region]]\nname = \"a\"\noutline = { type = \"polygon\", points = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]] }\npattern = { type = \"single\" }\n")
+execute_process(COMMAND ${BBM} mesh ${DIR}/bowtie.toml --out ${DIR}/out
+                RESULT_VARIABLE status ERROR_VARIABLE err)
+if(NOT status EQUAL 2 OR NOT err MATCHES "bowtie.toml:3: region\\[0\\]\\.outline: .*intersects itself")
+  message(FATAL_ERROR "self-intersection not reported as expected (${status}): ${err}")
+endif()
