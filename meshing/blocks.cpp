@@ -225,6 +225,16 @@ void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& danglin
             if (b.hi.x < sb.lo.x || b.lo.x > sb.hi.x || b.hi.y < sb.lo.y || b.lo.y > sb.hi.y) continue;
             if (!segment_enters(rb.polygons[k], s.a, s.b)) continue;
             auto pieces = cgal::split_by_line(rb.polygons[k], s.a, s.b);
+            // A line through (or within rounding of) a vertex leaves a sliver piece
+            // whose rounded vertices coincide: drop repeated vertices and slivers.
+            std::erase_if(pieces, [&](std::vector<Vec2>& piece) {
+                std::vector<Vec2> clean;
+                for (Vec2 q : piece)
+                    if (clean.empty() || norm(q - clean.back()) > tol) clean.push_back(q);
+                while (clean.size() > 1 && norm(clean.front() - clean.back()) <= tol) clean.pop_back();
+                piece = std::move(clean);
+                return piece.size() < 3 || signed_area(piece) <= tol * tol;
+            });
             if (pieces.size() < 2) continue;
             for (auto& piece : pieces) {
                 insert_vertex_on_edge(piece, s.a, tol);
