@@ -261,10 +261,10 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
     for (int r = 0; r < nr; ++r) {
         const RegionSpec& reg = spec.regions[r];
         const auto outer = outline_polygon(reg.outline, spec.max_segment);
+        if (outer.size() >= 3 && !cgal::is_simple(outer))
+            throw GeometryError(r, "outline", "outline of region '" + reg.name + "' intersects itself");
         if (outer.size() < 3 || std::abs(signed_area(outer)) <= 0)
             throw GeometryError(r, "outline", "outline of region '" + reg.name + "' has no area");
-        if (!cgal::is_simple(outer))
-            throw GeometryError(r, "outline", "outline of region '" + reg.name + "' intersects itself");
         std::vector<std::vector<Vec2>> holes;
         const Domain outer_domain = cgal::make_domain(outer, {});
         for (int h = 0; h < int(reg.holes.size()); ++h) {
