@@ -3,6 +3,7 @@
 // Exit status: 0 success, 2 bad input (the message names file, line and key),
 // 1 any other failure. Earlier output in DIR is only replaced by complete files.
 #include "apps/model_input.hpp"
+#include "apps/picture.hpp"
 #include "apps/vtk_output.hpp"
 #include "core/error.hpp"
 #include "meshing/blocks.hpp"
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <vector>
 
 namespace {
 
@@ -68,7 +70,8 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
                          {"total", seconds}}}};
 }
 
-int run_mesh(const std::string& model_path, const fs::path& out, bool quiet) {
+int run_mesh(const std::string& model_path, const fs::path& out, const io::PictureOptions& picture,
+             bool quiet) {
     const auto t0 = std::chrono::steady_clock::now();
     const io::ModelFile model = io::read_model(model_path);
     meshing::GenerationStats stats;
@@ -81,6 +84,7 @@ int run_mesh(const std::string& model_path, const fs::path& out, bool quiet) {
     fs::create_directories(out);
     io::write_blocks_vtu(blocks, out / "blocks.vtu");
     io::write_joints_vtu(blocks, out / "joints.vtu");
+    io::draw_blocks(blocks, out / "blocks.png", picture);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const auto summary = mesh_summary(blocks, stats, seconds);
     io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
@@ -92,7 +96,7 @@ int run_mesh(const std::string& model_path, const fs::path& out, bool quiet) {
             std::printf("  region %-12s %-9s %7d blocks  %10.4f m²  mean size %.4g m\n",
                         r["name"].get<std::string>().c_str(), r["pattern"].get<std::string>().c_str(),
                         r["blocks"].get<int>(), r["area"].get<double>(), r["mean_block_size"].get<double>());
-        std::printf("  wrote %s/{blocks.vtu, joints.vtu, summary.json}\n", out.string().c_str());
+        std::printf("  wrote %s/{blocks.vtu, joints.vtu, blocks.png, summary.json}\n", out.string().c_str());
     }
     return 0;
 }
@@ -112,12 +116,16 @@ int main(int argc, char** argv) {
     auto* mesh = app.add_subcommand(
         "mesh", "Generate the blocks of a model file and write DIR/blocks.vtu (polygons: block id, "
                 "region, area, pattern), DIR/joints.vtu (lines: joint tag, the two blocks) and "
-                "DIR/summary.json (counts, areas, mean block size).");
+                "DIR/blocks.png (a picture of blocks and joints) and DIR/summary.json (counts, areas, "
+                "mean block size).");
     mesh->add_option("model", model_path, "Model file (TOML; keys in docs/input.md)")
         ->required()
         ->check(CLI::ExistingFile);
     mesh->add_option("-o,--out", out_dir, "Output directory (created if missing)")->capture_default_str();
     mesh->add_flag("-q,--quiet", quiet, "Print nothing but errors");
+    std::vector<double> window;
+    mesh->add_option("--window", window, "Part of the model drawn in blocks.png: XMIN YMIN XMAX YMAX (m)")
+        ->expected(4);
 
     try {
         app.parse(argc, argv);
@@ -126,7 +134,16 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : 2;
     }
     try {
-        if (*mesh) return run_mesh(model_path, out_dir, quiet);
+        if (*mesh) {
+            io::PictureOptions picture;
+            if (window.size() == 4) {
+                if (!(window[2] > window[0] && window[3] > window[1]))
+                    throw InputError("--window", 0, "", "needs XMIN < XMAX and YMIN < YMAX");
+                picture.window.add({window[0], window[1]});
+                picture.window.add({window[2], window[3]});
+            }
+            return run_mesh(model_path, out_dir, picture, quiet);
+        }
     } catch (const InputError& e) {
         std::fprintf(stderr, "bbm: error: %s\n", e.what());
         return 2;
