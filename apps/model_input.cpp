@@ -14,6 +14,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -40,6 +41,13 @@ std::string fmt(double v) {
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, v);
     return {buf, r.ptr};
+}
+
+/// A computed value, to 6 significant digits: 2.1 - 0.6 shows as 1.5.
+std::string fmt6(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
 }
 
 std::string fmt(Vec2 p) {
@@ -131,7 +139,8 @@ struct Ctx {
     std::string file;
     ModelSource* source = nullptr;
     int region = -1; ///< region being read, -1 outside regions
-    std::string region_name;
+    /// The named table being read, for messages: "region 'bonded'", "boundary 'top'".
+    std::string owner;
 
     [[noreturn]] void fail(int at_line, const Path& p, const std::string& message) const {
         throw InputError(file, at_line, p.full, message);
@@ -140,13 +149,15 @@ struct Ctx {
         fail(line(n), p, message);
     }
     void note(const Path& p, const toml::node& n) const {
-        if (region >= 0 && !p.rel.empty()) source->key_line[region][p.rel] = line(n);
+        if (region >= 0) {
+            if (!p.rel.empty()) source->key_line[region][p.rel] = line(n);
+        } else if (!p.full.empty()) {
+            source->analysis_line[p.full] = line(n);
+        }
     }
-    /// "region 'bonded': " inside a named region, for messages where the index alone
+    /// "region 'bonded': " inside a named table, for messages where the index alone
     /// would make the user count tables.
-    std::string in_region() const {
-        return region_name.empty() ? "" : "region " + quoted(region_name) + ": ";
-    }
+    std::string in_owner() const { return owner.empty() ? "" : owner + ": "; }
 };
 
 // --- value conversions: a node at path p to a C++ value, or an error at its line ----
@@ -230,7 +241,7 @@ const toml::node& need(const Ctx& c, const toml::table& t, const Path& p, std::s
     const toml::node* n = find(c, t, p, key);
     if (!n)
         c.fail(t, p.key(key),
-               c.in_region() + "missing required key " + quoted(key) + ": expected " +
+               c.in_owner() + "missing required key " + quoted(key) + ": expected " +
                    std::string(expected));
     return *n;
 }
@@ -288,21 +299,30 @@ double required_number(const Ctx& c, const toml::table& t, const Path& p, std::s
 }
 
 /// An integer >= lo; `hi` only guards the C++ type it is stored in.
+std::int64_t to_integer(const Ctx& c, const toml::node& n, const Path& p, std::int64_t lo,
+                        std::int64_t hi) {
+    const auto* i = n.as_integer();
+    if (!i) c.fail(n, p, "expected an integer >= " + std::to_string(lo) + ", got " + describe(n));
+    if (i->get() < lo)
+        c.fail(n, p,
+               "must be an integer >= " + std::to_string(lo) + ", got " + std::to_string(i->get()));
+    if (i->get() > hi)
+        c.fail(n, p,
+               "must be an integer <= " + std::to_string(hi) + ", got " + std::to_string(i->get()));
+    return i->get();
+}
+
 std::optional<std::int64_t> integer(const Ctx& c, const toml::table& t, const Path& p,
                                     std::string_view key, std::int64_t lo, std::int64_t hi) {
     const toml::node* n = find(c, t, p, key);
     if (!n) return std::nullopt;
-    const auto* i = n->as_integer();
-    if (!i)
-        c.fail(*n, p.key(key),
-               "expected an integer >= " + std::to_string(lo) + ", got " + describe(*n));
-    if (i->get() < lo)
-        c.fail(*n, p.key(key),
-               "must be an integer >= " + std::to_string(lo) + ", got " + std::to_string(i->get()));
-    if (i->get() > hi)
-        c.fail(*n, p.key(key),
-               "must be an integer <= " + std::to_string(hi) + ", got " + std::to_string(i->get()));
-    return i->get();
+    return to_integer(c, *n, p.key(key), lo, hi);
+}
+
+std::int64_t required_integer(const Ctx& c, const toml::table& t, const Path& p,
+                              std::string_view key, std::int64_t lo, std::int64_t hi) {
+    const toml::node& n = need(c, t, p, key, "an integer >= " + std::to_string(lo));
+    return to_integer(c, n, p.key(key), lo, hi);
 }
 
 std::optional<std::uint64_t> seed(const Ctx& c, const toml::table& t, const Path& p) {
@@ -330,17 +350,22 @@ Vec2 required_point(const Ctx& c, const toml::table& t, const Path& p, std::stri
     return to_vec2(c, need(c, t, p, key, "a point [x, y]"), p.key(key));
 }
 
-/// Index of the string value of `key` in `options`; `what` names the choice.
-std::size_t choice(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
-                   Keys options, std::string_view what) {
-    const toml::node& n = need(c, t, p, key, "one of " + join(options));
-    const std::string s = to_str(c, n, p.key(key));
+/// Index of the string at node n in `options`; `what` names the choice.
+std::size_t to_choice(const Ctx& c, const toml::node& n, const Path& p, Keys options,
+                      std::string_view what) {
+    const std::string s = to_str(c, n, p);
     const auto it = std::ranges::find(options, s);
     if (it == options.end())
-        c.fail(n, p.key(key),
+        c.fail(n, p,
                "unknown " + std::string(what) + " " + quoted(s) + did_you_mean(s, options) +
                    "; expected one of: " + join(options));
     return static_cast<std::size_t>(it - options.begin());
+}
+
+/// Index of the string value of the required `key` in `options`.
+std::size_t choice(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+                   Keys options, std::string_view what) {
+    return to_choice(c, need(c, t, p, key, "one of " + join(options)), p.key(key), options, what);
 }
 
 /// Each element of an array-valued key, with its path and its line noted.
@@ -577,17 +602,22 @@ void read_list(const Ctx& c, const toml::table& t, const Path& p, std::string_vi
     for_each_element(c, to_array(c, *n, kp, expected), kp, f);
 }
 
-RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p) {
+/// A region; the name in its `material` key (checked once materials are read) goes
+/// to `material`.
+RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
+                       std::optional<std::string>& material) {
     const toml::table& t = to_table(c, node, p, "a [[region]] table");
-    static constexpr std::array<std::string_view, 7> keys{"name",    "outline", "holes",    "minus",
-                                                          "pattern", "joints",  "joint_set"};
+    static constexpr std::array<std::string_view, 8> keys{
+        "name", "outline", "holes", "minus", "pattern", "joints", "joint_set", "material"};
     check_keys(c, t, p, keys);
     RegionSpec r;
     const Path np = p.key("name");
     const toml::node& name = need(c, t, p, "name", "a non-empty string");
     r.name = to_str(c, name, np);
     if (r.name.empty()) c.fail(name, np, "must be a non-empty string, got \"\"");
-    c.region_name = r.name;
+    c.owner = "region " + quoted(r.name);
+    if (const toml::node* m = find(c, t, p, "material"))
+        material = to_str(c, *m, p.key("material"));
 
     r.outline = read_outline(c, need(c, t, p, "outline", "an outline table"), p.key("outline"));
     read_list(
@@ -641,6 +671,497 @@ void check_names(const Ctx& c, const ModelFile& mf) {
     }
 }
 
+// --- the analysis tables -----------------------------------------------------------
+
+std::string article(std::string_view word) {
+    return std::string(std::string_view("aeiou").find(word.front()) == std::string_view::npos
+                           ? "a "
+                           : "an ") +
+           std::string(word);
+}
+
+/// The names of one kind of table, for uniqueness and for references to them.
+struct Names {
+    std::string_view what;   ///< "joint property"
+    std::string_view plural; ///< "joint properties"
+    std::string_view table;  ///< "joint_property": the key of its tables
+    std::vector<std::string> names;
+    std::vector<int> lines; ///< line of each table
+
+    std::vector<std::string_view> views() const { return {names.begin(), names.end()}; }
+    bool has(std::string_view s) const { return std::ranges::find(names, s) != names.end(); }
+};
+
+/// A new name for `names`: not used before. `at` is the line of its key.
+void add_name(const Ctx& c, Names& names, const std::string& name, int at, const Path& np,
+              int table_line) {
+    for (std::size_t j = 0; j < names.names.size(); ++j)
+        if (names.names[j] == name)
+            c.fail(at, np,
+                   std::string(names.what) + " name " + quoted(name) + " is already used by " +
+                       std::string(names.table) + "[" + std::to_string(j) + "] (line " +
+                       std::to_string(names.lines[j]) + ")");
+    names.names.push_back(name);
+    names.lines.push_back(table_line);
+}
+
+/// The required, non-empty, unique `name` of a table; it becomes the owner in messages.
+std::string read_name(Ctx& c, const toml::table& t, const Path& p, Names& names) {
+    const Path np = p.key("name");
+    const toml::node& n = need(c, t, p, "name", "a non-empty string");
+    std::string s = to_str(c, n, np);
+    if (s.empty()) c.fail(n, np, "must be a non-empty string, got \"\"");
+    add_name(c, names, s, line(n), np, line(t));
+    c.owner = std::string(names.what) + " " + quoted(s);
+    return s;
+}
+
+/// `name` must be one of `known`.
+void check_ref(const Ctx& c, int at, const Path& p, std::string_view name, const Names& known) {
+    if (known.has(name)) return;
+    const std::string head = "unknown " + std::string(known.what) + " " + quoted(name);
+    const auto v = known.views();
+    if (v.empty())
+        c.fail(at, p, head + ": the file has no [[" + std::string(known.table) + "]] tables");
+    c.fail(at, p,
+           head + did_you_mean(name, v) + "; " + std::string(known.plural) + " are: " + join(v));
+}
+
+/// The array of strings `key` (required or not): not empty, no repeats, each
+/// checked by f(string, node, path). `if_absent` says what leaving it out means.
+template <class F>
+std::vector<std::string> string_list(const Ctx& c, const toml::table& t, const Path& p,
+                                     std::string_view key, std::string_view what,
+                                     std::string_view if_absent, F&& f) {
+    std::vector<std::string> list;
+    const std::string expected = "an array of " + std::string(what) + " names";
+    const toml::node* n = if_absent.empty()
+                              ? &need(c, t, p, key, "a non-empty " + expected.substr(3))
+                              : find(c, t, p, key);
+    if (!n) return list;
+    const Path kp = p.key(key);
+    const toml::array& a = to_array(c, *n, kp, expected);
+    if (a.empty())
+        c.fail(*n, kp,
+               "must list at least one " + std::string(what) + ", got an empty array" +
+                   (if_absent.empty()
+                        ? ""
+                        : "; leave " + quoted(key) + " out " + std::string(if_absent)));
+    for_each_element(c, a, kp, [&](const toml::node& e, const Path& ep) {
+        std::string s = to_str(c, e, ep);
+        f(s, e, ep);
+        if (const auto it = std::ranges::find(list, s); it != list.end())
+            c.fail(e, ep,
+                   quoted(s) + " is already listed as " + std::string(key) + "[" +
+                       std::to_string(it - list.begin()) + "]");
+        list.push_back(std::move(s));
+    });
+    return list;
+}
+
+std::vector<std::string> name_list(const Ctx& c, const toml::table& t, const Path& p,
+                                   std::string_view key, const Names& known,
+                                   std::string_view if_absent) {
+    return string_list(c, t, p, key, known.what, if_absent,
+                       [&](const std::string& s, const toml::node& e, const Path& ep) {
+                           check_ref(c, line(e), ep, s, known);
+                       });
+}
+
+constexpr std::string_view pascals = " Pa";
+constexpr std::string_view pascals_per_metre = " Pa/m";
+
+// In the order of the enums of core/model_spec.hpp and meshing::JointTag.
+constexpr std::array<std::string_view, 2> solver_modes{"quasi_static", "dynamic"};
+constexpr std::array<std::string_view, 3> laws{"elastic", "coulomb", "softening"};
+constexpr std::array<std::string_view, 5> joint_tags{"inner", "radial", "peripheral", "real_joint",
+                                                     "interface"};
+constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
+constexpr std::array<std::string_view, 14> quantities{"unbalanced_ratio",  "displacement_x",
+                                                      "displacement_y",    "velocity_x",
+                                                      "velocity_y",        "rotation",
+                                                      "boundary_force_x",  "boundary_force_y",
+                                                      "cracks_tensile",    "cracks_shear",
+                                                      "kinetic_energy",    "strain_energy",
+                                                      "dissipated_energy", "work"};
+constexpr std::array<std::string_view, 4> stage_types{"initialize", "solve", "excavate", "cycle"};
+
+SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
+                       const Names& properties) {
+    const toml::table& t = to_table(c, node, p, "a [solver] table");
+    static constexpr std::array<std::string_view, 9> keys{"mode",
+                                                          "damping",
+                                                          "safety",
+                                                          "timestep",
+                                                          "gravity",
+                                                          "detection_tolerance",
+                                                          "new_contact_property",
+                                                          "output_every",
+                                                          "history_every"};
+    check_keys(c, t, p, keys);
+    SolverSpec s;
+    if (t.contains("mode"))
+        s.mode =
+            static_cast<SolverSpec::Mode>(choice(c, t, p, "mode", solver_modes, "solver mode"));
+    s.damping = number(c, t, p, "damping", below(0, 1, "")).value_or(s.damping);
+    s.safety = number(c, t, p, "safety", Range{.lo = 0, .hi = 1, .lo_open = true, .unit = ""})
+                   .value_or(s.safety);
+    s.timestep = number(c, t, p, "timestep", at_least(0, " s")).value_or(s.timestep);
+    s.gravity = point(c, t, p, "gravity").value_or(s.gravity);
+    s.detection_tolerance =
+        number(c, t, p, "detection_tolerance", at_least(0, metres)).value_or(0.0);
+    if (const toml::node* n = find(c, t, p, "new_contact_property")) {
+        const Path np = p.key("new_contact_property");
+        s.new_contact_property = to_str(c, *n, np);
+        if (!s.new_contact_property.empty())
+            check_ref(c, line(*n), np, s.new_contact_property, properties);
+    }
+    constexpr std::int64_t int_max = std::numeric_limits<int>::max();
+    s.output_every = static_cast<int>(integer(c, t, p, "output_every", 0, int_max).value_or(0));
+    s.history_every =
+        static_cast<int>(integer(c, t, p, "history_every", 1, int_max).value_or(s.history_every));
+    return s;
+}
+
+MaterialSpec read_material(Ctx& c, const toml::table& t, const Path& p, Names& names) {
+    static constexpr std::array<std::string_view, 2> keys{"name", "density"};
+    check_keys(c, t, p, keys);
+    MaterialSpec m;
+    m.name = read_name(c, t, p, names);
+    m.density = number(c, t, p, "density", above(0, " kg/m³")).value_or(m.density);
+    return m;
+}
+
+/// A softening curve: points (alpha, beta) after the peak (1, 1), SPEC §4.
+std::vector<std::pair<double, double>> read_curve(const Ctx& c, const toml::table& t, const Path& p,
+                                                  std::string_view key) {
+    std::vector<std::pair<double, double>> pts;
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return pts;
+    const Path kp = p.key(key);
+    const toml::array& a = to_array(c, *n, kp, "an array of points [[alpha, beta], ...]");
+    for_each_element(c, a, kp, [&](const toml::node& e, const Path& ep) {
+        const auto* pa = e.as_array();
+        if (!pa) c.fail(e, ep, "expected a point [alpha, beta], got " + describe(e));
+        if (pa->size() != 2)
+            c.fail(e, ep,
+                   "expected a point [alpha, beta] of 2 numbers, got an array of " +
+                       std::to_string(pa->size()));
+        const double alpha = to_number(c, (*pa)[0], ep.at(0));
+        const double beta =
+            checked_number(c, (*pa)[1], ep.at(1), Range{.lo = 0, .hi = 1, .unit = ""});
+        if (pts.empty()) {
+            if (!(alpha > 1))
+                c.fail((*pa)[0], ep.at(0),
+                       "the first alpha must be > 1 (alpha = 1 is the peak), got " + fmt(alpha));
+        } else {
+            const auto [a0, b0] = pts.back();
+            const std::string prev = std::string(key) + "[" + std::to_string(pts.size() - 1) + "]";
+            if (b0 == 0)
+                c.fail(e, ep,
+                       "the curve already ends at " + prev +
+                           " (beta = 0: the bond is broken); "
+                           "remove the points after it");
+            if (!(alpha > a0))
+                c.fail((*pa)[0], ep.at(0),
+                       "the curve snaps back: alpha must increase from point to point, got " +
+                           fmt(alpha) + " after " + fmt(a0) + " at " + prev);
+            if (!(alpha - beta > a0 - b0))
+                c.fail(e, ep,
+                       "the curve snaps back: alpha - beta (the plastic displacement) must "
+                       "increase from point to point, got " +
+                           fmt(alpha) + " - " + fmt(beta) + " = " + fmt6(alpha - beta) + " after " +
+                           fmt(a0) + " - " + fmt(b0) + " = " + fmt6(a0 - b0) + " at " + prev);
+        }
+        pts.emplace_back(alpha, beta);
+    });
+    if (!pts.empty() && pts.back().second != 0) {
+        const toml::node& beta = (*a.back().as_array())[1];
+        c.fail(beta, kp.at(pts.size() - 1).at(1),
+               "the last point must have beta = 0 (the curve must end at zero strength), got " +
+                   fmt(pts.back().second));
+    }
+    return pts;
+}
+
+/// Peak strength of a softening law: > 0, the curves are normalised by it.
+double peak(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+            std::string_view curve) {
+    const std::string why = "the peak the " + std::string(curve) + " curve is normalised by";
+    const toml::node& n = need(c, t, p, key, "a number > 0 Pa, " + why);
+    const double v = to_number(c, n, p.key(key));
+    if (!(v > 0))
+        c.fail(n, p.key(key),
+               "a softening law needs " + std::string(key) + " > 0 Pa, " + why + "; got " + fmt(v));
+    return v;
+}
+
+JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
+    static constexpr std::array<std::string_view, 10> all_keys{"name",
+                                                               "law",
+                                                               "kn",
+                                                               "ks",
+                                                               "friction",
+                                                               "residual_friction",
+                                                               "cohesion",
+                                                               "tensile",
+                                                               "tension_softening",
+                                                               "shear_softening"};
+    check_keys(c, t, p, all_keys);
+    JointPropertySpec j;
+    using Law = JointPropertySpec::Law;
+    j.name = read_name(c, t, p, names);
+    j.law = static_cast<Law>(choice(c, t, p, "law", laws, "joint law"));
+    const Keys keys = j.law == Law::elastic   ? Keys(all_keys).first(4)
+                      : j.law == Law::coulomb ? Keys(all_keys).first(8)
+                                              : Keys(all_keys);
+    check_keys(c, t, p, keys, all_keys,
+               article(laws[static_cast<std::size_t>(j.law)]) + " joint property");
+    j.kn = required_number(c, t, p, "kn", above(0, pascals_per_metre));
+    j.ks = required_number(c, t, p, "ks", above(0, pascals_per_metre));
+    if (j.law == Law::elastic) return j;
+    j.friction = number(c, t, p, "friction", below(0, 90, degrees)).value_or(j.friction);
+    j.residual_friction = number(c, t, p, "residual_friction", below(0, 90, degrees)).value_or(-1);
+    if (j.law == Law::coulomb) {
+        j.cohesion = number(c, t, p, "cohesion", at_least(0, pascals)).value_or(0.0);
+        j.tensile = number(c, t, p, "tensile", at_least(0, pascals)).value_or(0.0);
+        return j;
+    }
+    j.cohesion = peak(c, t, p, "cohesion", "shear softening");
+    j.tensile = peak(c, t, p, "tensile", "tension softening");
+    j.tension_softening = read_curve(c, t, p, "tension_softening");
+    j.shear_softening = read_curve(c, t, p, "shear_softening");
+    return j;
+}
+
+JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Path& p,
+                                          const Names& properties, const Names& regions) {
+    static constexpr std::array<std::string_view, 3> keys{"property", "tags", "regions"};
+    check_keys(c, t, p, keys);
+    JointAssignmentSpec a;
+    const Path pp = p.key("property");
+    const toml::node& n = need(c, t, p, "property", "the name of a [[joint_property]]");
+    a.property = to_str(c, n, pp);
+    check_ref(c, line(n), pp, a.property, properties);
+    for (const std::string& tag :
+         string_list(c, t, p, "tags", "joint tag", "for every tag",
+                     [&](const std::string&, const toml::node&e, const Path&ep) {
+                         to_choice(c, e, ep, joint_tags, "joint tag");
+                     }))
+        a.tags.push_back(static_cast<meshing::JointTag>(std::ranges::find(joint_tags, tag) -
+                                                        joint_tags.begin()));
+    a.regions = name_list(c, t, p, "regions", regions, "for joints of any region");
+    return a;
+}
+
+constexpr std::array<std::string_view, 7> stress_keys{"sxx",     "syy",     "sxy",    "y_ref",
+                                                      "dsxx_dy", "dsyy_dy", "dsxy_dy"};
+
+StressFieldSpec read_stress(const Ctx& c, const toml::table& t, const Path& p) {
+    StressFieldSpec s;
+    s.sxx = number(c, t, p, "sxx", unbounded(pascals)).value_or(0.0);
+    s.syy = number(c, t, p, "syy", unbounded(pascals)).value_or(0.0);
+    s.sxy = number(c, t, p, "sxy", unbounded(pascals)).value_or(0.0);
+    s.y_ref = number(c, t, p, "y_ref", unbounded(metres)).value_or(0.0);
+    s.dsxx_dy = number(c, t, p, "dsxx_dy", unbounded(pascals_per_metre)).value_or(0.0);
+    s.dsyy_dy = number(c, t, p, "dsyy_dy", unbounded(pascals_per_metre)).value_or(0.0);
+    s.dsxy_dy = number(c, t, p, "dsxy_dy", unbounded(pascals_per_metre)).value_or(0.0);
+    return s;
+}
+
+Box2 read_box(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a box { min = [x, y], max = [x, y] }");
+    static constexpr std::array<std::string_view, 2> keys{"min", "max"};
+    check_keys(c, t, p, keys);
+    Box2 b;
+    b.lo = required_point(c, t, p, "min");
+    b.hi = required_point(c, t, p, "max");
+    if (!(b.hi.x > b.lo.x && b.hi.y > b.lo.y))
+        c.fail(*t.get("max"), p.key("max"),
+               "must exceed min = " + fmt(b.lo) + " in both x and y, got " + fmt(b.hi));
+    return b;
+}
+
+BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& names,
+                           const Names& regions) {
+    static constexpr std::array<std::string_view, 7> velocity_keys{"name", "type", "regions", "box",
+                                                                   "vx",   "vy",   "omega"};
+    static constexpr std::array<std::string_view, 11> stress_boundary_keys{
+        "name", "type",  "regions", "box",     "sxx",    "syy",
+        "sxy",  "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
+    static constexpr std::array<std::string_view, 14> all_keys{
+        "name", "type", "regions", "box",   "vx",      "vy",      "omega",
+        "sxx",  "syy",  "sxy",     "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
+    check_keys(c, t, p, all_keys);
+    BoundarySpec b;
+    using Kind = BoundarySpec::Kind;
+    b.name = read_name(c, t, p, names);
+    b.kind = static_cast<Kind>(choice(c, t, p, "type", boundary_types, "boundary type"));
+    check_keys(c, t, p, b.kind == Kind::velocity ? Keys(velocity_keys) : Keys(stress_boundary_keys),
+               all_keys, article(boundary_types[static_cast<std::size_t>(b.kind)]) + " boundary");
+    b.select.regions = name_list(c, t, p, "regions", regions, "to select by box only (or all)");
+    if (const toml::node* n = find(c, t, p, "box")) b.select.box = read_box(c, *n, p.key("box"));
+    if (b.kind == Kind::stress) {
+        b.stress = read_stress(c, t, p);
+        return b;
+    }
+    b.vx = number(c, t, p, "vx", unbounded(" m/s"));
+    b.vy = number(c, t, p, "vy", unbounded(" m/s"));
+    b.omega = number(c, t, p, "omega", unbounded(" rad/s"));
+    if (!b.vx && !b.vy && !b.omega)
+        c.fail(t, p,
+               c.in_owner() + "a velocity boundary needs at least one of vx, vy, omega "
+                              "(the components it prescribes; 0 fixes one)");
+    return b;
+}
+
+HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& names,
+                         const Names& boundaries) {
+    static constexpr std::array<std::string_view, 4> all_keys{"name", "quantity", "point",
+                                                              "boundary"};
+    static constexpr std::array<std::string_view, 3> point_keys{"name", "quantity", "point"};
+    static constexpr std::array<std::string_view, 3> boundary_keys{"name", "quantity", "boundary"};
+    check_keys(c, t, p, all_keys);
+    HistorySpec h;
+    using Q = HistorySpec::Quantity;
+    h.name = read_name(c, t, p, names);
+    h.quantity = static_cast<Q>(choice(c, t, p, "quantity", quantities, "history quantity"));
+    const std::string_view q = quantities[static_cast<std::size_t>(h.quantity)];
+    const bool at_point = h.quantity >= Q::displacement_x && h.quantity <= Q::rotation;
+    const bool at_boundary = h.quantity == Q::boundary_force_x || h.quantity == Q::boundary_force_y;
+    check_keys(c, t, p,
+               at_point      ? Keys(point_keys)
+               : at_boundary ? Keys(boundary_keys)
+                             : Keys(all_keys).first(2),
+               all_keys, article(q) + " history");
+    if (at_point) {
+        const toml::node& n = need(c, t, p, "point",
+                                   "a point [x, y]: the " + std::string(q) +
+                                       " of the block containing (or nearest to) it is recorded");
+        h.point = to_vec2(c, n, p.key("point"));
+    }
+    if (at_boundary) {
+        const Path bp = p.key("boundary");
+        const toml::node& n = need(c, t, p, "boundary", "the name of a [[boundary]]");
+        h.boundary = to_str(c, n, bp);
+        check_ref(c, line(n), bp, h.boundary, boundaries);
+    }
+    return h;
+}
+
+StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
+                     const Names& regions) {
+    static constexpr std::array<std::string_view, 14> all_keys{
+        "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy",
+        "dsyy_dy", "dsxy_dy", "ratio", "max_steps", "regions", "relax_steps", "steps"};
+    static constexpr std::array<std::string_view, 9> initialize_keys{
+        "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
+    static constexpr std::array<std::string_view, 4> solve_keys{"name", "type", "ratio",
+                                                                "max_steps"};
+    static constexpr std::array<std::string_view, 4> excavate_keys{"name", "type", "regions",
+                                                                   "relax_steps"};
+    static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
+    check_keys(c, t, p, all_keys);
+    StageSpec s;
+    using Kind = StageSpec::Kind;
+    const Path np = p.key("name");
+    int name_line = line(t);
+    if (const toml::node* n = find(c, t, p, "name")) {
+        s.name = to_str(c, *n, np);
+        if (s.name.empty()) c.fail(*n, np, "must be a non-empty string, got \"\"");
+        name_line = line(*n);
+    } else {
+        s.name = "stage " + std::to_string(index + 1);
+    }
+    add_name(c, names, s.name, name_line, np, line(t));
+    c.owner = "stage " + quoted(s.name);
+    s.kind = static_cast<Kind>(choice(c, t, p, "type", stage_types, "stage type"));
+    const Keys keys = s.kind == Kind::initialize ? Keys(initialize_keys)
+                      : s.kind == Kind::solve    ? Keys(solve_keys)
+                      : s.kind == Kind::excavate ? Keys(excavate_keys)
+                                                 : Keys(cycle_keys);
+    check_keys(c, t, p, keys, all_keys,
+               article(stage_types[static_cast<std::size_t>(s.kind)]) + " stage");
+    constexpr std::int64_t long_max = std::numeric_limits<long>::max();
+    switch (s.kind) {
+    case Kind::initialize:
+        s.stress = read_stress(c, t, p);
+        break;
+    case Kind::solve:
+        s.ratio = number(c, t, p, "ratio",
+                         Range{.lo = 0, .hi = 1, .lo_open = true, .hi_open = true, .unit = ""})
+                      .value_or(s.ratio);
+        s.max_steps = integer(c, t, p, "max_steps", 1, long_max).value_or(s.max_steps);
+        break;
+    case Kind::excavate:
+        s.regions = name_list(c, t, p, "regions", regions, "");
+        s.relax_steps = integer(c, t, p, "relax_steps", 0, long_max).value_or(0);
+        break;
+    case Kind::cycle:
+        s.steps = required_integer(c, t, p, "steps", 1, long_max);
+        break;
+    }
+    return s;
+}
+
+/// Each table of the top-level array `key` ([[key]] sections), read by f(table, path).
+template <class F> void read_tables(Ctx& c, const toml::table& doc, std::string_view key, F&& f) {
+    const Path kp = Path{}.key(key);
+    const toml::node* n = find(c, doc, Path{}, key);
+    if (!n) return;
+    const std::string what = "[[" + std::string(key) + "]]";
+    const toml::array& a = to_array(c, *n, kp, "an array of " + what + " tables (double brackets)");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        c.note(kp.at(i), a[i]);
+        c.owner.clear();
+        f(to_table(c, a[i], kp.at(i), "a " + what + " table"), kp.at(i), i);
+    }
+    c.owner.clear();
+}
+
+/// The analysis tables, after the regions (whose names they refer to) are read.
+/// `region_material` is the `material` key of each region, if given.
+void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
+                   const std::vector<std::optional<std::string>>& region_material) {
+    AnalysisSpec& an = mf.analysis;
+    Names regions{"region", "regions", "region", {}, mf.source.region_line};
+    for (const RegionSpec& r : mf.geometry.regions)
+        regions.names.push_back(r.name);
+
+    Names materials{"material", "materials", "material", {}, {}};
+    read_tables(c, doc, "material", [&](const toml::table& t, const Path& p, std::size_t) {
+        an.materials.push_back(read_material(c, t, p, materials));
+    });
+    for (std::size_t i = 0; i < region_material.size(); ++i) {
+        if (!region_material[i]) continue;
+        const Path p{"region[" + std::to_string(i) + "].material", ""};
+        check_ref(c, mf.source.key_line[i].at("material"), p, *region_material[i], materials);
+        an.region_material.emplace_back(regions.names[i], *region_material[i]);
+    }
+
+    Names properties{"joint property", "joint properties", "joint_property", {}, {}};
+    read_tables(c, doc, "joint_property", [&](const toml::table& t, const Path& p, std::size_t) {
+        an.joint_properties.push_back(read_joint_property(c, t, p, properties));
+    });
+    read_tables(c, doc, "joint_assignment", [&](const toml::table& t, const Path& p, std::size_t) {
+        an.joint_assignments.push_back(read_joint_assignment(c, t, p, properties, regions));
+    });
+    Names boundaries{"boundary", "boundaries", "boundary", {}, {}};
+    read_tables(c, doc, "boundary", [&](const toml::table& t, const Path& p, std::size_t) {
+        an.boundaries.push_back(read_boundary(c, t, p, boundaries, regions));
+    });
+    if (const toml::node* n = find(c, doc, Path{}, "solver"))
+        an.solver = read_solver(c, *n, Path{}.key("solver"), properties);
+    Names histories{"history", "histories", "history", {}, {}};
+    read_tables(c, doc, "history", [&](const toml::table& t, const Path& p, std::size_t) {
+        an.histories.push_back(read_history(c, t, p, histories, boundaries));
+    });
+    Names stages{"stage", "stages", "stage", {}, {}};
+    read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
+        an.stages.push_back(read_stage(c, t, p, i, stages, regions));
+    });
+}
+
 } // namespace
 
 int ModelSource::line_of(int region, const std::string& key) const {
@@ -653,6 +1174,16 @@ int ModelSource::line_of(int region, const std::string& key) const {
         k.resize(cut == std::string::npos ? 0 : cut);
     }
     return region_line[static_cast<std::size_t>(region)];
+}
+
+int ModelSource::line_of(const std::string& key) const {
+    std::string k = key;
+    while (!k.empty()) {
+        if (const auto it = analysis_line.find(k); it != analysis_line.end()) return it->second;
+        const auto cut = k.find_last_of(".[");
+        k.resize(cut == std::string::npos ? 0 : cut);
+    }
+    return 0;
 }
 
 ModelFile parse_model(std::string_view text, const std::string& name) {
@@ -670,7 +1201,9 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     c.file = name;
     c.source = &mf.source;
     const Path root{};
-    static constexpr std::array<std::string_view, 2> top_keys{"model", "region"};
+    static constexpr std::array<std::string_view, 9> top_keys{
+        "model",    "region", "material", "joint_property", "joint_assignment",
+        "boundary", "solver", "history",  "stage"};
     check_keys(c, doc, root, top_keys);
 
     if (const toml::node* n = find(c, doc, root, "model")) {
@@ -690,17 +1223,19 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
         to_array(c, *rn, root.key("region"), "an array of [[region]] tables (double brackets)");
     if (regions.empty())
         c.fail(*rn, root.key("region"), "a model needs at least one region, found none");
+    std::vector<std::optional<std::string>> region_material(regions.size());
     for (std::size_t i = 0; i < regions.size(); ++i) {
         mf.source.region_line.push_back(line(regions[i]));
         mf.source.key_line.emplace_back();
         c.region = static_cast<int>(i);
-        c.region_name.clear();
-        mf.geometry.regions.push_back(
-            read_region(c, regions[i], {"region[" + std::to_string(i) + "]", ""}));
+        c.owner.clear();
+        mf.geometry.regions.push_back(read_region(
+            c, regions[i], {"region[" + std::to_string(i) + "]", ""}, region_material[i]));
     }
     c.region = -1;
-    c.region_name.clear();
+    c.owner.clear();
     check_names(c, mf);
+    read_analysis(c, doc, mf, region_material);
     return mf;
 }
 

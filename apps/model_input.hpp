@@ -1,11 +1,14 @@
-// bbm apps: the model file — TOML text in, a checked geometry description out.
+// bbm apps: the model file — TOML text in, a checked model description out.
 //
 // read_model() turns a model file (format and every key: docs/input.md) into the
-// plain-data ModelGeometrySpec that meshing/ consumes. Everything a user can get
-// wrong without drawing a picture is caught here, at once, as an InputError that
-// names file, line and the full key ("tunnel.toml:14: region[1].pattern.size:
-// must be > 0 m, got -0.3"): syntax, unknown keys (with a "did you mean"), types,
-// missing keys, ranges, enum strings, region names. Geometry proper (self-crossing
+// plain-data ModelGeometrySpec that meshing/ consumes and the AnalysisSpec
+// (materials, joint properties, boundaries, solver, histories, stages) that core/
+// consumes. Everything a user can get wrong without drawing a picture is caught
+// here, at once, as an InputError that names file, line and the full key
+// ("tunnel.toml:14: region[1].pattern.size: must be > 0 m, got -0.3"): syntax,
+// unknown keys (with a "did you mean"), types, missing keys, ranges, enum strings,
+// names and the references between tables (a boundary's regions, a history's
+// boundary, softening curves that snap back). Geometry proper (self-crossing
 // outlines, holes outside, overlaps) is judged by meshing/, which knows nothing of
 // files and reports a GeometryError by region index and key; ModelSource keeps the
 // line of every key read so that to_input_error() can point the user back at the
@@ -16,6 +19,7 @@
 #pragma once
 
 #include "core/error.hpp"
+#include "core/model_spec.hpp"
 #include "meshing/spec.hpp"
 
 #include <map>
@@ -38,10 +42,19 @@ struct ModelSource {
     /// parent ("holes[0].radius" -> "holes[0]" -> "holes"), else the region's line;
     /// 0 for a region index out of range.
     int line_of(int region, const std::string& key) const;
+
+    /// Outside regions: full key ("solver.gravity", "boundary[0]", "boundary[0].box",
+    /// "stage[2].regions[1]") -> line, for errors found later by the solver.
+    std::map<std::string, int> analysis_line;
+    /// Best line for such a key, as above (nearest recorded parent); 0 if none.
+    int line_of(const std::string& key) const;
 };
 
 struct ModelFile {
     meshing::ModelGeometrySpec geometry;
+    /// Materials, joint properties, boundaries, solver, histories, stages: each
+    /// table optional; defaults as in core/model_spec.hpp.
+    AnalysisSpec analysis;
     ModelSource source;
     std::string title;
 };

@@ -11,6 +11,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -28,11 +29,13 @@ public:
 private:
     static std::string format(const std::string& file, int line, const std::string& key,
                               const std::string& message) {
-        std::string s = file;
-        if (line > 0) s += ":" + std::to_string(line);
-        s += ": ";
-        if (!key.empty()) s += key + ": ";
-        return s + message;
+        std::ostringstream s;
+        s << file;
+        if (line > 0) s << ':' << line;
+        s << ": ";
+        if (!key.empty()) s << key << ": ";
+        s << message;
+        return s.str();
     }
     std::string file_;
     int line_;

@@ -14,6 +14,7 @@ using bbm::GeometryError;
 using bbm::InputError;
 using bbm::Vec2;
 using bbm::io::parse_model;
+using bbm::meshing::JointTag;
 using bbm::meshing::OutlineSpec;
 using bbm::meshing::PatternSpec;
 
@@ -240,8 +241,8 @@ TEST_CASE("TOML syntax errors give the line of the parser") {
 }
 
 TEST_CASE("unknown keys are errors, with a suggestion when one is close") {
-    check_error(std::string(one_region) + "[material]\nE = 1\n", "[material]", "material",
-                "unknown key 'material' at top level");
+    check_error(std::string(one_region) + "[materials]\nE = 1\n", "[materials]", "materials",
+                "unknown key 'materials' at top level (did you mean 'material'?)");
     check_error("[model]\ntitel = \"x\"\n" + std::string(one_region), "titel", "model.titel",
                 "did you mean 'title'?");
     check_error(R"([[region]]
@@ -484,4 +485,534 @@ TEST_CASE("reading a file") {
     std::remove(path.c_str());
     CHECK(mf.source.file == path);
     CHECK(mf.geometry.regions.size() == 3);
+}
+
+// --- the analysis tables -------------------------------------------------------------
+
+namespace {
+
+// A model with every analysis table, every key given at least once.
+constexpr std::string_view analysis = R"([[region]]
+name = "outer"
+outline = { type = "rectangle", min = [0, -20], max = [20.0, 20.0] }
+minus = ["bonded"]
+pattern = { type = "single" }
+material = "rock"
+
+[[region]]
+name = "bonded"
+outline = { type = "rectangle", min = [0.0, -8.0], max = [8.0, 8.0] }
+minus = ["opening"]
+pattern = { type = "voronoi", size = 0.3 }
+material = "soft"
+
+[[region]]
+name = "opening"
+outline = { type = "circle", center = [0, 0], radius = 4 }
+pattern = { type = "voronoi", size = 0.3 }
+
+[solver]
+mode = "dynamic"
+damping = 0.1
+safety = 0.2
+timestep = 1e-5
+gravity = [0.0, -9.81]
+detection_tolerance = 0.01
+new_contact_property = "unbonded"
+output_every = 1000
+history_every = 20
+
+[[material]]
+name = "rock"
+density = 2650
+
+[[material]]
+name = "soft"
+
+[[joint_property]]
+name = "bond"
+law = "softening"
+kn = 96.6e9
+ks = 40.3e9
+friction = 35.0
+residual_friction = 25.0
+cohesion = 9.5e6
+tensile = 3.0e6
+tension_softening = [[1.7, 0.5], [4.0, 0.0]]
+shear_softening = [[1.3, 0.5], [2.1, 0.0]]
+
+[[joint_property]]
+name = "unbonded"
+law = "coulomb"
+kn = 10e9
+ks = 5e9
+
+[[joint_property]]
+name = "glue"
+law = "elastic"
+kn = 1e10
+ks = 4e9
+
+[[joint_assignment]]
+property = "bond"
+
+[[joint_assignment]]
+property = "glue"
+tags = ["interface", "real_joint"]
+regions = ["outer", "bonded"]
+
+[[boundary]]
+name = "top"
+type = "stress"
+box = { min = [0.0, 19.9], max = [20.0, 20.1] }
+sxx = -7.5e6
+syy = -15e6
+sxy = 2
+y_ref = 20.0
+dsxx_dy = 13.5e3
+dsyy_dy = 27e3
+dsxy_dy = 3
+
+[[boundary]]
+name = "sides"
+type = "velocity"
+regions = ["outer"]
+vx = 0
+
+[[boundary]]
+name = "spin"
+type = "velocity"
+vy = -0.5
+omega = 0.25
+
+[[history]]
+name = "ratio"
+quantity = "unbalanced_ratio"
+
+[[history]]
+name = "crown"
+quantity = "displacement_y"
+point = [0.0, 4.0]
+
+[[history]]
+name = "top force"
+quantity = "boundary_force_y"
+boundary = "top"
+
+[[stage]]
+name = "insitu"
+type = "initialize"
+sxx = -7.5e6
+syy = -15e6
+sxy = 1e5
+y_ref = 20
+dsxx_dy = 13.5e3
+dsyy_dy = 27e3
+dsxy_dy = 1.0
+
+[[stage]]
+type = "solve"
+ratio = 1e-6
+max_steps = 50000
+
+[[stage]]
+name = "dig"
+type = "excavate"
+regions = ["opening"]
+relax_steps = 2000
+
+[[stage]]
+type = "cycle"
+steps = 100
+
+[[stage]]
+type = "solve"
+)";
+
+// A softening property to which tests add one line, and the model it sits in.
+constexpr std::string_view bond = R"(
+[[joint_property]]
+name = "bond"
+law = "softening"
+kn = 1e10
+ks = 4e9
+cohesion = 1e6
+tensile = 5e5
+)";
+
+std::string with(std::string_view extra) {
+    return std::string(one_region) + std::string(extra);
+}
+
+} // namespace
+
+TEST_CASE("a complete analysis reads into the analysis description") {
+    using bbm::BoundarySpec;
+    using bbm::HistorySpec;
+    using bbm::JointPropertySpec;
+    using bbm::SolverSpec;
+    using bbm::StageSpec;
+    const auto mf = parse_model(analysis, "a.toml");
+    const auto& an = mf.analysis;
+
+    CHECK(an.solver.mode == SolverSpec::Mode::dynamic);
+    CHECK(an.solver.damping == 0.1);
+    CHECK(an.solver.safety == 0.2);
+    CHECK(an.solver.timestep == 1e-5);
+    CHECK(an.solver.gravity == Vec2{0.0, -9.81});
+    CHECK(an.solver.detection_tolerance == 0.01);
+    CHECK(an.solver.new_contact_property == "unbonded");
+    CHECK(an.solver.output_every == 1000);
+    CHECK(an.solver.history_every == 20);
+
+    REQUIRE(an.materials.size() == 2);
+    CHECK(an.materials[0].name == "rock");
+    CHECK(an.materials[0].density == 2650.0);
+    CHECK(an.materials[1].name == "soft");
+    CHECK(an.materials[1].density == 2700.0);
+    using Pair = std::pair<std::string, std::string>;
+    CHECK(an.region_material == std::vector<Pair>{{"outer", "rock"}, {"bonded", "soft"}});
+
+    REQUIRE(an.joint_properties.size() == 3);
+    const auto& b = an.joint_properties[0];
+    CHECK(b.name == "bond");
+    CHECK(b.law == JointPropertySpec::Law::softening);
+    CHECK(b.kn == 96.6e9);
+    CHECK(b.ks == 40.3e9);
+    CHECK(b.friction == 35.0);
+    CHECK(b.residual_friction == 25.0);
+    CHECK(b.cohesion == 9.5e6);
+    CHECK(b.tensile == 3.0e6);
+    using Curve = std::vector<std::pair<double, double>>;
+    CHECK(b.tension_softening == Curve{{1.7, 0.5}, {4.0, 0.0}});
+    CHECK(b.shear_softening == Curve{{1.3, 0.5}, {2.1, 0.0}});
+    const auto& u = an.joint_properties[1];
+    CHECK(u.law == JointPropertySpec::Law::coulomb);
+    CHECK(u.friction == 30.0);
+    CHECK(u.residual_friction == -1.0);
+    CHECK(u.cohesion == 0.0);
+    CHECK(u.tensile == 0.0);
+    CHECK(an.joint_properties[2].law == JointPropertySpec::Law::elastic);
+    CHECK(an.joint_properties[2].kn == 1e10);
+
+    REQUIRE(an.joint_assignments.size() == 2);
+    CHECK(an.joint_assignments[0].property == "bond");
+    CHECK(an.joint_assignments[0].tags.empty());
+    CHECK(an.joint_assignments[0].regions.empty());
+    CHECK(an.joint_assignments[1].property == "glue");
+    CHECK(an.joint_assignments[1].tags ==
+          std::vector<JointTag>{JointTag::interface, JointTag::real_joint});
+    CHECK(an.joint_assignments[1].regions == std::vector<std::string>{"outer", "bonded"});
+
+    REQUIRE(an.boundaries.size() == 3);
+    const auto& top = an.boundaries[0];
+    CHECK(top.name == "top");
+    CHECK(top.kind == BoundarySpec::Kind::stress);
+    CHECK(top.select.regions.empty());
+    REQUIRE(top.select.box);
+    CHECK(top.select.box->lo == Vec2{0.0, 19.9});
+    CHECK(top.select.box->hi == Vec2{20.0, 20.1});
+    CHECK(top.stress.sxx == -7.5e6);
+    CHECK(top.stress.syy == -15e6);
+    CHECK(top.stress.sxy == 2.0);
+    CHECK(top.stress.y_ref == 20.0);
+    CHECK(top.stress.dsxx_dy == 13.5e3);
+    CHECK(top.stress.dsyy_dy == 27e3);
+    CHECK(top.stress.dsxy_dy == 3.0);
+    CHECK_FALSE(top.vx);
+    const auto& sides = an.boundaries[1];
+    CHECK(sides.kind == BoundarySpec::Kind::velocity);
+    CHECK(sides.select.regions == std::vector<std::string>{"outer"});
+    CHECK_FALSE(sides.select.box);
+    CHECK(sides.vx == 0.0);
+    CHECK_FALSE(sides.vy);
+    CHECK_FALSE(sides.omega);
+    CHECK_FALSE(an.boundaries[2].vx);
+    CHECK(an.boundaries[2].vy == -0.5);
+    CHECK(an.boundaries[2].omega == 0.25);
+
+    REQUIRE(an.histories.size() == 3);
+    CHECK(an.histories[0].name == "ratio");
+    CHECK(an.histories[0].quantity == HistorySpec::Quantity::unbalanced_ratio);
+    CHECK_FALSE(an.histories[0].point);
+    CHECK(an.histories[1].quantity == HistorySpec::Quantity::displacement_y);
+    CHECK(an.histories[1].point == Vec2{0.0, 4.0});
+    CHECK(an.histories[2].quantity == HistorySpec::Quantity::boundary_force_y);
+    CHECK(an.histories[2].boundary == "top");
+
+    REQUIRE(an.stages.size() == 5);
+    const auto& init = an.stages[0];
+    CHECK(init.name == "insitu");
+    CHECK(init.kind == StageSpec::Kind::initialize);
+    CHECK(init.stress.sxx == -7.5e6);
+    CHECK(init.stress.syy == -15e6);
+    CHECK(init.stress.sxy == 1e5);
+    CHECK(init.stress.y_ref == 20.0);
+    CHECK(init.stress.dsxx_dy == 13.5e3);
+    CHECK(init.stress.dsyy_dy == 27e3);
+    CHECK(init.stress.dsxy_dy == 1.0);
+    CHECK(an.stages[1].name == "stage 2");
+    CHECK(an.stages[1].kind == StageSpec::Kind::solve);
+    CHECK(an.stages[1].ratio == 1e-6);
+    CHECK(an.stages[1].max_steps == 50000);
+    CHECK(an.stages[2].name == "dig");
+    CHECK(an.stages[2].kind == StageSpec::Kind::excavate);
+    CHECK(an.stages[2].regions == std::vector<std::string>{"opening"});
+    CHECK(an.stages[2].relax_steps == 2000);
+    CHECK(an.stages[3].kind == StageSpec::Kind::cycle);
+    CHECK(an.stages[3].steps == 100);
+    CHECK(an.stages[4].ratio == 1e-5);
+    CHECK(an.stages[4].max_steps == 200000);
+
+    // Lines of analysis keys, for errors the solver finds later.
+    CHECK(mf.source.line_of("boundary[0].box") == line_of(analysis, "box = {"));
+    CHECK(mf.source.line_of("boundary[0].box.min[1]") == line_of(analysis, "box = {"));
+    CHECK(mf.source.line_of("stage[2].regions[0]") == line_of(analysis, "regions = [\"opening\"]"));
+    CHECK(mf.source.line_of("history[1]") == line_of(analysis, "[[history]]\nname = \"crown\""));
+    CHECK(mf.source.line_of("solver.gravity") == line_of(analysis, "gravity"));
+    CHECK(mf.source.line_of("nothing[3]") == 0);
+    CHECK(mf.source.line_of(0, "material") == line_of(analysis, "material = \"rock\""));
+}
+
+TEST_CASE("a model without analysis tables gets the defaults") {
+    const auto an = parse_model(one_region, "t.toml").analysis;
+    CHECK(an.materials.empty());
+    CHECK(an.region_material.empty());
+    CHECK(an.joint_properties.empty());
+    CHECK(an.joint_assignments.empty());
+    CHECK(an.boundaries.empty());
+    CHECK(an.histories.empty());
+    CHECK(an.stages.empty());
+    CHECK(an.solver.mode == bbm::SolverSpec::Mode::quasi_static);
+    CHECK(an.solver.damping == 0.8);
+    CHECK(an.solver.safety == 0.5);
+    CHECK(an.solver.timestep == 0.0);
+    CHECK(an.solver.gravity == Vec2{0, 0});
+    CHECK(an.solver.new_contact_property.empty());
+    CHECK(an.solver.output_every == 0);
+    CHECK(an.solver.history_every == 10);
+    // A softening law without curves is brittle.
+    const auto j = parse_model(with(bond), "t.toml").analysis.joint_properties.at(0);
+    CHECK(j.tension_softening.empty());
+    CHECK(j.shear_softening.empty());
+    CHECK(j.friction == 30.0);
+    CHECK(j.residual_friction == -1.0);
+}
+
+TEST_CASE("solver and material mistakes") {
+    check_error(with("[solver]\ndampng = 0.5\n"), "dampng", "solver.dampng",
+                "unknown key 'dampng' in solver (did you mean 'damping'?)");
+    check_error(with("[solver]\ndamping = 1\n"), "damping", "solver.damping",
+                "must be in [0, 1), got 1");
+    check_error(with("[solver]\nsafety = 0\n"), "safety", "solver.safety",
+                "must be in (0, 1], got 0");
+    check_error(with("[solver]\nmode = \"static\"\n"), "mode", "solver.mode",
+                "unknown solver mode 'static'; expected one of: quasi_static, dynamic");
+    check_error(with("[solver]\nhistory_every = 0\n"), "history_every", "solver.history_every",
+                "must be an integer >= 1, got 0");
+    check_error(with("[solver]\ngravity = -9.81\n"), "gravity", "solver.gravity",
+                "expected a point [x, y], got float -9.81");
+    check_error(with("[solver]\nnew_contact_property = \"slip\"\n"), "new_contact_property",
+                "solver.new_contact_property",
+                "unknown joint property 'slip': the file has no [[joint_property]] tables");
+    check_error(with(std::string(bond) + "[solver]\nnew_contact_property = \"bnd\"\n"),
+                "new_contact_property", "solver.new_contact_property",
+                "unknown joint property 'bnd' (did you mean 'bond'?); joint properties are: bond");
+    check_error(with("[material]\nname = \"rock\"\n"), "[material]", "material",
+                "expected an array of [[material]] tables (double brackets), got a table");
+    check_error(with("[[material]]\ndensity = 2000\n"), "[[material]]", "material[0].name",
+                "missing required key 'name'");
+    check_error(with("[[material]]\nname = \"rock\"\ndensity = 0\n"), "density",
+                "material[0].density", "must be > 0 kg/m³, got 0");
+    check_error(with("[[material]]\nname = \"rock\"\n\n[[material]]\nname = \"rock\" # again\n"),
+                "# again", "material[1].name",
+                "material name 'rock' is already used by material[0] (line 5)");
+    const std::string region_rock = std::string(one_region) + "material = \"rok\"\n";
+    check_error(region_rock + "[[material]]\nname = \"rock\"\n", "rok", "region[0].material",
+                "unknown material 'rok' (did you mean 'rock'?); materials are: rock");
+    check_error(region_rock, "rok", "region[0].material",
+                "unknown material 'rok': the file has no [[material]] tables");
+}
+
+TEST_CASE("joint property mistakes") {
+    check_error(with(std::string(bond) + "law2 = 1\n"), "law2", "joint_property[0].law2",
+                "did you mean 'law'?");
+    std::string unknown_law = with(bond);
+    unknown_law.replace(unknown_law.find("\"softening\""), 11, "\"softning\"");
+    check_error(unknown_law, "softning", "joint_property[0].law",
+                "unknown joint law 'softning' (did you mean 'softening'?); expected one of: "
+                "elastic, coulomb, softening");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"elastic\"\nks = 1e9\n"),
+                "[[joint_property]]", "joint_property[0].kn",
+                "joint property 'j': missing required key 'kn': expected a number > 0 Pa/m");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"coulomb\"\nkn = -1\nks = 1\n"),
+                "kn", "joint_property[0].kn", "must be > 0 Pa/m, got -1");
+    check_error(with(std::string(bond) + "friction = 90\n"), "friction",
+                "joint_property[0].friction", "must be in [0, 90) degrees, got 90");
+    // A softening law needs both peaks; a curve only belongs to a softening law.
+    std::string no_peak = with(bond);
+    no_peak.replace(no_peak.find("tensile = 5e5"), 13, "tensile = 0  ");
+    check_error(no_peak, "tensile = 0", "joint_property[0].tensile",
+                "a softening law needs tensile > 0 Pa, the peak the tension softening curve is "
+                "normalised by; got 0");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"softening\"\nkn = 1\nks = 1\n"
+                     "tensile = 1\n"),
+                "[[joint_property]]", "joint_property[0].cohesion",
+                "joint property 'j': missing required key 'cohesion'");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"coulomb\"\nkn = 1\nks = 1\n"
+                     "tension_softening = [[2, 0]]\n"),
+                "tension_softening", "joint_property[0].tension_softening",
+                "key 'tension_softening' does not apply to a coulomb joint property; its keys "
+                "are: name, law, kn, ks, friction, residual_friction, cohesion, tensile");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"elastic\"\nkn = 1\nks = 1\n"
+                     "friction = 30\n"),
+                "friction", "joint_property[0].friction",
+                "key 'friction' does not apply to an elastic joint property");
+    check_error(with(std::string(bond) + "[[joint_property]]\nname = \"bond\" # again\n"),
+                "# again", "joint_property[1].name",
+                "joint property name 'bond' is already used by joint_property[0]");
+}
+
+TEST_CASE("softening curves must soften") {
+    const std::string b = with(bond);
+    check_error(b + "tension_softening = [[1.7, 0.5], [4.0, 0.1]]\n", "tension_softening",
+                "joint_property[0].tension_softening[1][1]",
+                "the last point must have beta = 0 (the curve must end at zero strength), got 0.1");
+    check_error(b + "shear_softening = [[2.0, 0.2], [2.1, 0.6], [3, 0]]\n", "shear_softening",
+                "joint_property[0].shear_softening[1]",
+                "the curve snaps back: alpha - beta (the plastic displacement) must increase "
+                "from point to point, got 2.1 - 0.6 = 1.5 after 2 - 0.2 = 1.8 at "
+                "shear_softening[0]");
+    check_error(b + "tension_softening = [[1.7, 0.5], [1.5, 0.0]]\n", "tension_softening",
+                "joint_property[0].tension_softening[1][0]",
+                "the curve snaps back: alpha must increase from point to point, got 1.5 after 1.7");
+    check_error(b + "tension_softening = [[1.0, 0.5], [4.0, 0.0]]\n", "tension_softening",
+                "joint_property[0].tension_softening[0][0]",
+                "the first alpha must be > 1 (alpha = 1 is the peak), got 1");
+    check_error(b + "tension_softening = [[1.7, 1.5], [4.0, 0.0]]\n", "tension_softening",
+                "joint_property[0].tension_softening[0][1]", "must be in [0, 1], got 1.5");
+    check_error(b + "tension_softening = [[1.7, 0.0], [4.0, 0.0]]\n", "tension_softening",
+                "joint_property[0].tension_softening[1]",
+                "the curve already ends at tension_softening[0]");
+    check_error(b + "tension_softening = [[1.7, 0.5, 1]]\n", "tension_softening",
+                "joint_property[0].tension_softening[0]",
+                "expected a point [alpha, beta] of 2 numbers, got an array of 3");
+    // Each point on its own line: the error is at the point's line.
+    check_error(b + "tension_softening = [\n  [1.7, 0.5],\n  [4.0, 0.2],\n]\n", "[4.0, 0.2]",
+                "joint_property[0].tension_softening[1][1]", "the last point must have beta = 0");
+}
+
+TEST_CASE("joint assignment and boundary mistakes") {
+    const std::string b = with(bond);
+    check_error(b + "[[joint_assignment]]\nproperty = \"bnd\"\n", "bnd",
+                "joint_assignment[0].property",
+                "unknown joint property 'bnd' (did you mean 'bond'?); joint properties are: bond");
+    check_error(b + "[[joint_assignment]]\ntags = [\"inner\"]\n", "[[joint_assignment]]",
+                "joint_assignment[0].property", "missing required key 'property'");
+    check_error(b + "[[joint_assignment]]\nproperty = \"bond\"\ntags = [\"inner\", \"radail\"]\n",
+                "radail", "joint_assignment[0].tags[1]",
+                "unknown joint tag 'radail' (did you mean 'radial'?); expected one of: inner, "
+                "radial, peripheral, real_joint, interface");
+    check_error(b + "[[joint_assignment]]\nproperty = \"bond\"\ntags = [\"inner\", \"inner\"]\n",
+                "tags", "joint_assignment[0].tags[1]", "'inner' is already listed as tags[0]");
+    check_error(b + "[[joint_assignment]]\nproperty = \"bond\"\nregions = []\n", "regions",
+                "joint_assignment[0].regions",
+                "must list at least one region, got an empty array; leave 'regions' out for "
+                "joints of any region");
+    check_error(b + "[[joint_assignment]]\nproperty = \"bond\"\nregions = [\"b\"]\n", "regions",
+                "joint_assignment[0].regions[0]", "unknown region 'b'; regions are: a");
+
+    check_error(with("[[boundary]]\nname = \"top\"\ntype = \"stress\"\nsyy = -1e6\nvx = 0\n"), "vx",
+                "boundary[0].vx",
+                "key 'vx' does not apply to a stress boundary; its keys are: name, type, "
+                "regions, box, sxx, syy, sxy, y_ref, dsxx_dy, dsyy_dy, dsxy_dy");
+    check_error(with("[[boundary]]\nname = \"fix\"\ntype = \"velocity\"\nsyy = 0\n"), "syy",
+                "boundary[0].syy", "key 'syy' does not apply to a velocity boundary");
+    check_error(with("[[boundary]]\nname = \"fix\"\ntype = \"velocity\"\nregions = [\"a\"]\n"),
+                "[[boundary]]", "boundary[0]",
+                "boundary 'fix': a velocity boundary needs at least one of vx, vy, omega");
+    check_error(with("[[boundary]]\nname = \"fix\"\ntype = \"traction\"\n"), "traction",
+                "boundary[0].type", "unknown boundary type 'traction'");
+    check_error(with("[[boundary]]\nname = \"fix\"\ntype = \"velocity\"\nvx = 0\n"
+                     "box = { min = [0, 1], max = [1, 1] }\n"),
+                "box", "boundary[0].box.max",
+                "must exceed min = [0, 1] in both x and y, got [1, 1]");
+    check_error(with("[[boundary]]\nname = \"fix\"\ntype = \"velocity\"\nvx = 0\n"
+                     "box = { min = [0, 1] }\n"),
+                "box", "boundary[0].box.max", "missing required key 'max'");
+    check_error(with("[[boundary]]\nname = \"fix\"\ntype = \"velocity\"\nvx = \"0\"\n"),
+                "vx =", "boundary[0].vx", "expected a number, got string \"0\"");
+}
+
+TEST_CASE("history and stage mistakes") {
+    const std::string top = with("[[boundary]]\nname = \"top\"\ntype = \"stress\"\nsyy = -1e6\n");
+    check_error(top + "[[history]]\nname = \"crown\"\nquantity = \"displacement_y\"\n",
+                "[[history]]", "history[0].point",
+                "history 'crown': missing required key 'point': expected a point [x, y]");
+    check_error(top + "[[history]]\nname = \"r\"\nquantity = \"unbalanced_ratio\"\n"
+                      "point = [0, 0]\n",
+                "point", "history[0].point",
+                "key 'point' does not apply to an unbalanced_ratio history; its keys are: name, "
+                "quantity");
+    check_error(top + "[[history]]\nname = \"f\"\nquantity = \"boundary_force_x\"\n"
+                      "boundary = \"tpo\"\n",
+                "tpo", "history[0].boundary",
+                "unknown boundary 'tpo' (did you mean 'top'?); boundaries are: top");
+    check_error(top + "[[history]]\nname = \"f\"\nquantity = \"boundary_force_x\"\n", "[[history]]",
+                "history[0].boundary", "missing required key 'boundary'");
+    check_error(top + "[[history]]\nname = \"f\"\nquantity = \"displacment_x\"\n", "displacment_x",
+                "history[0].quantity", "(did you mean 'displacement_x'?)");
+
+    check_error(with("[[stage]]\ntype = \"solve\"\n\n[[stage]]\nname = \"dig\"\n"
+                     "type = \"excavate\"\nregions = [\"a\", \"tunnel\"]\n"),
+                "regions", "stage[1].regions[1]", "unknown region 'tunnel'; regions are: a");
+    check_error(with("[[stage]]\ntype = \"excavate\"\n"), "[[stage]]", "stage[0].regions",
+                "stage 'stage 1': missing required key 'regions': expected a non-empty array of "
+                "region names");
+    check_error(with("[[stage]]\ntype = \"excavate\"\nregions = []\n"), "regions",
+                "stage[0].regions", "must list at least one region, got an empty array");
+    check_error(with("[[stage]]\ntype = \"cycle\"\nsteps = 10\nratio = 1e-4\n"), "ratio",
+                "stage[0].ratio",
+                "key 'ratio' does not apply to a cycle stage; its keys are: name, type, steps");
+    check_error(with("[[stage]]\ntype = \"cycle\"\n"), "[[stage]]", "stage[0].steps",
+                "missing required key 'steps': expected an integer >= 1");
+    check_error(with("[[stage]]\ntype = \"cycle\"\nsteps = 0\n"), "steps", "stage[0].steps",
+                "must be an integer >= 1, got 0");
+    check_error(with("[[stage]]\ntype = \"solve\"\nratio = 1\n"), "ratio", "stage[0].ratio",
+                "must be in (0, 1), got 1");
+    check_error(with("[[stage]]\ntype = \"solve\"\nmax_steps = 1.5\n"), "max_steps",
+                "stage[0].max_steps", "expected an integer >= 1, got float 1.5");
+    check_error(with("[[stage]]\ntype = \"initialize\"\nratio = 1e-5\n"), "ratio", "stage[0].ratio",
+                "does not apply to an initialize stage");
+    check_error(with("[[stage]]\ntype = \"run\"\n"), "run", "stage[0].type",
+                "unknown stage type 'run'; expected one of: initialize, solve, excavate, cycle");
+    check_error(with("[[stage]]\ntype = \"solve\"\n\n[[stage]]\nname = \"stage 1\"\n"
+                     "type = \"solve\"\n"),
+                "name = \"stage 1\"", "stage[1].name",
+                "stage name 'stage 1' is already used by stage[0] (line 5)");
+}
+
+TEST_CASE("analysis tables may come before the tables they name") {
+    const std::string text = R"([[history]]
+name = "f"
+quantity = "boundary_force_y"
+boundary = "top"
+
+[[boundary]]
+name = "top"
+type = "velocity"
+regions = ["a"]
+vy = -1e-6
+
+[[stage]]
+type = "excavate"
+regions = ["a"]
+
+)" + std::string(one_region) +
+                             "material = \"rock\"\n\n[[material]]\nname = \"rock\"\n";
+    const auto an = parse_model(text, "t.toml").analysis;
+    CHECK(an.histories.at(0).boundary == "top");
+    CHECK(an.boundaries.at(0).select.regions == std::vector<std::string>{"a"});
+    CHECK(an.stages.at(0).name == "stage 1");
+    CHECK(an.region_material.size() == 1);
 }

@@ -1,0 +1,185 @@
+#include "contact/joint_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace bbm::contact {
+
+namespace {
+double tan_deg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
+double residual(const JointPropertySpec& p) { return p.residual_friction >= 0 ? p.residual_friction : p.friction; }
+double sign(double x) { return x < 0 ? -1.0 : 1.0; }
+
+/// Frictional contact without a bond: no tension, |τ| <= σn tan φ. Upn is zero here:
+/// crack faces meet again at their original position.
+void unbonded_update(JointHistory& h, double kn, double ks, double tan_phi, double dus) {
+    h.upn = 0.0;
+    h.sn = std::max(0.0, -kn * h.un);
+    h.tau += ks * dus;
+    const double cap = h.sn * tan_phi;
+    h.slipping = std::abs(h.tau) > cap;
+    if (h.slipping) {
+        const double excess = (std::abs(h.tau) - cap) / ks;
+        h.dissipated += cap * excess;
+        h.ups += excess;
+        h.tau = sign(h.tau) * cap;
+    }
+}
+} // namespace
+
+SofteningCurve::SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0) {
+    for (const auto& [alpha, beta] : points) {
+        up_.push_back((alpha - beta) * u0);
+        s_.push_back(beta);
+    }
+}
+
+double SofteningCurve::operator()(double up) const {
+    if (up <= 0.0) return 1.0;
+    if (brittle()) return 0.0;
+    for (std::size_t k = 0; k + 1 < up_.size(); ++k)
+        if (up < up_[k + 1]) return s_[k] + (s_[k + 1] - s_[k]) * (up - up_[k]) / (up_[k + 1] - up_[k]);
+    return s_.back();
+}
+
+double SofteningCurve::plastic_increment(double excess, double k, double peak, double up, double other,
+                                         double extra) const {
+    auto cap = [&](double d) { return peak * std::min((*this)(up + d), other) + extra; };
+    if (brittle()) return std::max(0.0, (excess - cap(1e300)) / k);
+    // Walk the breakpoints ahead of `up` (plus where the curve crosses `other`):
+    // h(δ) = excess − kδ − cap(δ) is linear between them, so its root is exact.
+    std::vector<double> ahead;
+    for (std::size_t i = 0; i < up_.size(); ++i) {
+        if (up_[i] > up) ahead.push_back(up_[i] - up);
+        if (i + 1 < up_.size()) {
+            const double s0 = s_[i] - other, s1 = s_[i + 1] - other;
+            if (s0 * s1 < 0) {
+                const double x = up_[i] + (up_[i + 1] - up_[i]) * s0 / (s0 - s1);
+                if (x > up) ahead.push_back(x - up);
+            }
+        }
+    }
+    std::sort(ahead.begin(), ahead.end());
+    double d0 = 0.0, h0 = excess - cap(0.0);
+    for (const double d1 : ahead) {
+        const double h1 = excess - k * d1 - cap(d1);
+        if (h1 <= 0.0) return d0 + h0 * (d1 - d0) / (h0 - h1);
+        d0 = d1, h0 = h1;
+    }
+    return d0 + h0 / k; // beyond the last point the strength is constant
+}
+
+void ElasticLaw::update(JointHistory& h, double dun, double dus) const {
+    h.un += dun;
+    h.us += dus;
+    h.sn = -kn * h.un;
+    h.tau += ks * dus;
+}
+
+CoulombLaw::CoulombLaw(const JointPropertySpec& p)
+    : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
+      cohesion(p.cohesion), tensile(p.tensile) {}
+
+void CoulombLaw::update(JointHistory& h, double dun, double dus) const {
+    h.un += dun;
+    h.us += dus;
+    if (h.bonded) {
+        h.sn = -kn * h.un;
+        h.tau += ks * dus;
+        if (-h.sn > tensile) {
+            h.bonded = false;
+            h.broken = JointState::broken_tension;
+        } else if (std::abs(h.tau) > cohesion + std::max(h.sn, 0.0) * tan_phi) {
+            h.bonded = false;
+            h.broken = JointState::broken_shear;
+        } else {
+            h.slipping = false;
+            return;
+        }
+        h.damage = 1.0;
+        h.tau -= ks * dus; // the unbonded update below re-applies the increment
+    }
+    unbonded_update(h, kn, ks, h.broken == JointState::intact ? tan_phi : tan_phi_r, dus);
+}
+
+SofteningLaw::SofteningLaw(const JointPropertySpec& p)
+    : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
+      cohesion(p.cohesion), tensile(p.tensile), tension(p.tension_softening, p.tensile / p.kn),
+      shear(p.shear_softening, p.cohesion / p.ks) {}
+
+void SofteningLaw::update(JointHistory& h, double dun, double dus) const {
+    h.un += dun;
+    h.us += dus;
+    if (!h.bonded) {
+        unbonded_update(h, kn, ks, h.broken == JointState::intact ? tan_phi : tan_phi_r, dus);
+        return;
+    }
+    h.sn = -kn * (h.un - h.upn);
+    h.tau += ks * dus;
+    double sn_strength = tension(h.upn), ss_strength = shear(h.ups);
+
+    // Tension cut-off: −σn <= σt·min(Sn, Ss).
+    const double t = -h.sn, cap_t = tensile * std::min(sn_strength, ss_strength);
+    if (t > cap_t) {
+        const double d = tension.plastic_increment(t, kn, tensile, h.upn, ss_strength, 0.0);
+        const double t_after = t - kn * d;
+        h.dissipated += 0.5 * (std::min(t, cap_t) + t_after) * d;
+        h.upn += d;
+        h.sn = -t_after;
+        sn_strength = tension(h.upn);
+    }
+    // Coulomb cap with softened cohesion: |τ| <= c·min(Sn, Ss) + max(σn, 0) tan φ.
+    const double friction = std::max(h.sn, 0.0) * tan_phi;
+    const double cap_s = cohesion * std::min(sn_strength, ss_strength) + friction;
+    const double a = std::abs(h.tau);
+    h.slipping = a > cap_s;
+    if (h.slipping) {
+        const double d = shear.plastic_increment(a, ks, cohesion, h.ups, sn_strength, friction);
+        const double a_after = a - ks * d;
+        h.dissipated += 0.5 * (cap_s + a_after) * d;
+        h.ups += d;
+        h.tau = sign(h.tau) * a_after;
+        ss_strength = shear(h.ups);
+    }
+    h.damage = 1.0 - std::min(sn_strength, ss_strength);
+    if (h.damage >= 1.0) {
+        h.damage = 1.0;
+        h.bonded = false;
+        h.broken = sn_strength <= ss_strength ? JointState::broken_tension : JointState::broken_shear;
+        h.upn = 0.0;
+        h.sn = std::max(0.0, -kn * h.un);
+        const double cap = h.sn * tan_phi_r;
+        if (std::abs(h.tau) > cap) h.tau = sign(h.tau) * cap;
+    }
+}
+
+JointLaw make_law(const JointPropertySpec& p) {
+    switch (p.law) {
+    case JointPropertySpec::Law::elastic: return ElasticLaw(p);
+    case JointPropertySpec::Law::coulomb: return CoulombLaw(p);
+    case JointPropertySpec::Law::softening: return SofteningLaw(p);
+    }
+    return ElasticLaw(p);
+}
+
+double normal_stiffness(const JointLaw& law) {
+    return std::visit([](const auto& l) { return l.kn; }, law);
+}
+double shear_stiffness(const JointLaw& law) {
+    return std::visit([](const auto& l) { return l.ks; }, law);
+}
+
+bool starts_bonded(const JointLaw& law) {
+    if (std::holds_alternative<ElasticLaw>(law)) return true;
+    if (const auto* c = std::get_if<CoulombLaw>(&law)) return c->tensile > 0 || c->cohesion > 0;
+    return true;
+}
+
+JointState state_of(const JointHistory& h) {
+    if (h.broken != JointState::intact) return h.broken;
+    if (h.slipping) return JointState::sliding;
+    return h.damage > 0 ? JointState::softening : JointState::intact;
+}
+
+} // namespace bbm::contact

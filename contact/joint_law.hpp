@@ -1,0 +1,118 @@
+// bbm contact: joint constitutive laws (SPEC §4), stress per unit joint area.
+//
+// A law maps the relative displacement increments of one point contact (Δun,
+// opening positive; Δus) to its stresses (σn compression positive; τ), updating
+// the contact's history in place. Laws are values validated once from the model
+// file, and the solver calls them per batch of contacts sharing a property set
+// (update_batch below: one dispatch per batch, not a virtual call per contact).
+//
+// Lemos–Sarhosis softening (paper §3.3, SPEC §4), as implemented:
+//   normal:  σn = −kn (un − upn)                     (total form; compression elastic)
+//   shear:   τ ← τ + ks Δus                           (incremental)
+//   strengths soften with plastic displacement: σt·Sn(upn), c·Ss(ups), where Sn, Ss
+//   are the normalised post-peak curves written in plastic displacement, through
+//   (0, 1), ((α_k − β_k)·u0, β_k) with u0 = σt/kn (tension) or c/ks (shear);
+//   coupled damage D = 1 − min(Sn(upn), Ss(ups)); strengths used σt(1−D), c(1−D);
+//   tension cut-off −σn ≤ σt(1−D) and Coulomb cap |τ| ≤ c(1−D) + max(σn, 0) tan φ are
+//   enforced by an exact return on the piecewise-linear curves (so monotonic
+//   loading passes through the curve points whatever the step size).
+//   At D = 1 the bond is broken: a crack, tensile if the tensile curve drove D to
+//   1, shear otherwise; from then on Coulomb friction with φr and no tension, the
+//   crack faces meeting again at their original position (upn reset to 0).
+//   Unloading is elastic with the initial stiffness.
+#pragma once
+
+#include "core/model_spec.hpp"
+
+#include <cstdint>
+#include <span>
+#include <variant>
+#include <vector>
+
+namespace bbm::contact {
+
+/// Contact state as output (ParaView `state` cell data).
+enum class JointState : std::uint8_t { intact, softening, broken_tension, broken_shear, sliding };
+
+/// Persistent history of one contact. Stresses in Pa, displacements in m.
+struct JointHistory {
+    double sn = 0.0;  ///< normal stress, compression positive
+    double tau = 0.0; ///< shear stress
+    double un = 0.0;  ///< normal displacement since bonding, opening positive
+    double us = 0.0;  ///< shear displacement
+    double upn = 0.0; ///< plastic (irreversible) opening
+    double ups = 0.0; ///< accumulated plastic shear displacement (magnitude)
+    double damage = 0.0;
+    double dissipated = 0.0; ///< plastic work per unit area, J/m²
+    bool bonded = true;      ///< false once broken, or for contacts formed unbonded
+    bool slipping = false;   ///< plastic shear in the last update
+    JointState broken = JointState::intact; ///< broken_tension / broken_shear once broken
+};
+
+/// Piecewise-linear normalised strength S(up) over plastic displacement up:
+/// S(0) = 1, linear between breakpoints, 0 beyond the last. No breakpoint after 0
+/// = brittle (S = 0 for any up > 0).
+class SofteningCurve {
+public:
+    SofteningCurve() = default;
+    /// points (α, β) as in SPEC §4, u0 the elastic displacement at peak.
+    SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0);
+    double operator()(double up) const;
+    /// Smallest δ >= 0 with  excess − k δ <= peak·min(S(up + δ), other)  (the
+    /// return of a trial stress `excess` above the cap, stiffness k). `other` is
+    /// the normalised strength of the other mode (coupled damage), `extra` a
+    /// constant added to the cap (the frictional part of the shear cap).
+    double plastic_increment(double excess, double k, double peak, double up, double other,
+                             double extra) const;
+    bool brittle() const { return up_.size() <= 1; }
+
+private:
+    std::vector<double> up_{0.0}; ///< breakpoints in plastic displacement
+    std::vector<double> s_{1.0};  ///< normalised strength at them
+};
+
+struct ElasticLaw {
+    double kn, ks;
+    explicit ElasticLaw(const JointPropertySpec& p) : kn(p.kn), ks(p.ks) {}
+    void update(JointHistory& h, double dun, double dus) const;
+};
+
+/// Coulomb slip with an optional brittle bond (tensile strength and cohesion that
+/// vanish at the first failure).
+struct CoulombLaw {
+    double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
+    explicit CoulombLaw(const JointPropertySpec& p);
+    void update(JointHistory& h, double dun, double dus) const;
+};
+
+struct SofteningLaw {
+    double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
+    SofteningCurve tension, shear;
+    explicit SofteningLaw(const JointPropertySpec& p);
+    void update(JointHistory& h, double dun, double dus) const;
+};
+
+using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw>;
+
+JointLaw make_law(const JointPropertySpec& p);
+double normal_stiffness(const JointLaw& law);
+double shear_stiffness(const JointLaw& law);
+/// Does a contact with this law start bonded (can it carry tension)?
+bool starts_bonded(const JointLaw& law);
+
+/// One dispatch per batch: contacts `ids` all use `law`.
+template <class Law>
+inline void update_batch(const Law& law, std::span<const int> ids, JointHistory* history,
+                         const double* dun, const double* dus) {
+    for (const int c : ids) law.update(history[c], dun[c], dus[c]);
+}
+
+inline void update_batch(const JointLaw& law, std::span<const int> ids, JointHistory* history,
+                         const double* dun, const double* dus) {
+    std::visit([&](const auto& l) { update_batch(l, ids, history, dun, dus); }, law);
+}
+
+/// Output state of a contact.
+JointState state_of(const JointHistory& h);
+
+} // namespace bbm::contact

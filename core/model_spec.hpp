@@ -1,0 +1,126 @@
+// bbm core: the analysis part of a model file — materials, joint properties,
+// boundary conditions, the solver settings, histories and the stages to run.
+//
+// Like meshing/spec.hpp these are plain data filled by the input layer (apps/)
+// and checked there for types and ranges; the solver (core/solver.hpp) turns
+// them into flat arrays once. SI units throughout (SPEC §2): stresses in Pa with
+// tension positive for continuum stress tensors (a 15 MPa overburden is
+// syy = -15e6), joint stiffness in Pa/m, angles in degrees.
+#pragma once
+
+#include "core/vec2.hpp"
+#include "meshing/blocks.hpp"
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace bbm {
+
+struct MaterialSpec {
+    std::string name;
+    double density = 2700.0; ///< kg/m³
+};
+
+/// One joint property set (SPEC §4). Which law is used follows `law`.
+struct JointPropertySpec {
+    enum class Law { elastic, coulomb, softening };
+    std::string name;
+    Law law = Law::softening;
+    double kn = 0.0;              ///< normal stiffness, Pa/m (> 0)
+    double ks = 0.0;              ///< shear stiffness, Pa/m (> 0)
+    double friction = 30.0;       ///< friction angle φ, degrees
+    double residual_friction = -1; ///< φr after failure, degrees; < 0 = friction
+    double cohesion = 0.0;        ///< c, Pa (coulomb: brittle bond; softening: peak cohesion)
+    double tensile = 0.0;         ///< σt, Pa
+    /// Post-peak points (α, β) of the softening curves, normalised as in SPEC §4
+    /// (α: displacement over the elastic displacement at peak, β: stress over peak),
+    /// in increasing α, the last with β = 0. Empty = brittle (drops to 0 at once).
+    std::vector<std::pair<double, double>> tension_softening;
+    std::vector<std::pair<double, double>> shear_softening;
+};
+
+/// Which property set the joints of given tags (and regions) get. Rules are applied
+/// in order; a later matching rule overrides an earlier one.
+struct JointAssignmentSpec {
+    std::string property;
+    std::vector<meshing::JointTag> tags;  ///< empty = every tag
+    std::vector<std::string> regions;     ///< joint between blocks of these regions; empty = any
+};
+
+/// Blocks (or block edges) selected by region and/or box. Empty = everything.
+struct SelectionSpec {
+    std::vector<std::string> regions;
+    std::optional<Box2> box; ///< block centroid (or edge midpoint) inside the box
+};
+
+/// A stress field σ(y) = σ0 + (y − y_ref)·dσ/dy, tension positive.
+struct StressFieldSpec {
+    double sxx = 0, syy = 0, sxy = 0;
+    double y_ref = 0;
+    double dsxx_dy = 0, dsyy_dy = 0, dsxy_dy = 0;
+};
+
+struct BoundarySpec {
+    enum class Kind { velocity, stress };
+    std::string name;
+    Kind kind = Kind::velocity;
+    SelectionSpec select;
+    /// velocity: the components given are prescribed (fixed if 0), others free.
+    std::optional<double> vx, vy, omega;
+    /// stress: traction σ·n on the exposed (unjointed) block edges selected.
+    StressFieldSpec stress;
+};
+
+struct SolverSpec {
+    enum class Mode { quasi_static, dynamic };
+    Mode mode = Mode::quasi_static;
+    double damping = 0.8;   ///< local non-viscous damping coefficient (quasi-static default 0.8)
+    double safety = 0.5;    ///< time step / critical time step
+    double timestep = 0.0;  ///< s; 0 = automatic (dynamic) or 1 (quasi-static, scaled masses)
+    Vec2 gravity{0.0, 0.0}; ///< m/s²
+    /// Contact detection tolerance (m) for new contacts; 0 = 0.02 × mean block size.
+    double detection_tolerance = 0.0;
+    std::string new_contact_property; ///< property set of contacts formed during the run
+    int output_every = 0;             ///< steps between VTK outputs; 0 = at stage ends only
+    int history_every = 10;           ///< steps between history rows
+};
+
+struct HistorySpec {
+    enum class Quantity {
+        unbalanced_ratio, displacement_x, displacement_y, velocity_x, velocity_y, rotation,
+        boundary_force_x, boundary_force_y, cracks_tensile, cracks_shear, kinetic_energy,
+        strain_energy, dissipated_energy, work
+    };
+    std::string name;
+    Quantity quantity = Quantity::unbalanced_ratio;
+    std::optional<Vec2> point;   ///< block containing (or nearest to) this point
+    std::string boundary;        ///< for boundary forces
+};
+
+struct StageSpec {
+    enum class Kind { initialize, solve, excavate, cycle };
+    std::string name;
+    Kind kind = Kind::solve;
+    StressFieldSpec stress;            ///< initialize
+    double ratio = 1e-5;               ///< solve: target unbalanced-force ratio
+    long max_steps = 200000;           ///< solve: step limit
+    long steps = 0;                    ///< cycle
+    std::vector<std::string> regions;  ///< excavate
+    long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
+};
+
+struct AnalysisSpec {
+    std::vector<MaterialSpec> materials;
+    /// Material of each region by name (region name -> material name).
+    std::vector<std::pair<std::string, std::string>> region_material;
+    std::vector<JointPropertySpec> joint_properties;
+    std::vector<JointAssignmentSpec> joint_assignments;
+    std::vector<BoundarySpec> boundaries;
+    SolverSpec solver;
+    std::vector<HistorySpec> histories;
+    std::vector<StageSpec> stages;
+};
+
+} // namespace bbm

@@ -1,0 +1,124 @@
+// bbm core: the explicit solver for rigid blocks (SPEC §5).
+//
+// One step is the list of stages of SPEC §5:
+//   1. (when due) contact detection update          — contact/ (later issue)
+//   2. contact forces from displacement increments   — update_contact_forces()
+//   3. zone stresses of deformable blocks            — fem/ (later issue)
+//   4. gravity, boundary tractions, applied loads    — add_external_forces()
+//   5. damping and integration, prescribed velocities — integrate()
+//   6. convergence measure                           — the unbalanced-force ratio
+//
+// State is flat arrays indexed by block id (structure of arrays); vertices are
+// stored once in body coordinates (relative to the centroid, at zero rotation)
+// and their world positions recomputed at the start of each step. Nothing is
+// allocated inside step().
+//
+// Time step and masses: for one degree of freedom of mass m on springs of total
+// stiffness K, central differences are stable for Δt < 2√(m/K). K of a block sums
+// (kn + ks)·L over its contacts (translation) and the same times the squared
+// lever arm (rotation). Dynamic mode: real masses, Δt = safety × the smallest
+// limit. Quasi-static mode: Δt = 1 (or as given) and each block's mass and inertia
+// are set to K (Δt / (2 safety))², so every block converges at the same rate;
+// gravity still acts on the real mass. Local non-viscous damping (Cundall):
+// each force component is reduced by α|F| against the velocity.
+#pragma once
+
+#include "contact/contacts.hpp"
+#include "core/model_spec.hpp"
+#include "meshing/blocks.hpp"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace bbm {
+
+class Solver {
+public:
+    /// Builds blocks, property sets and the contacts of the initial assembly.
+    /// Throws InputError (file "" with the key) if a joint has no property set or a
+    /// name does not resolve.
+    Solver(const meshing::BlockAssembly& blocks, const AnalysisSpec& analysis);
+
+    // --- stages -------------------------------------------------------------
+    /// Joint stresses from a stress field, with the matching elastic displacements.
+    void initialize_stress(const StressFieldSpec& field);
+    /// Removes the blocks of these regions; the forces they exerted on the rest are
+    /// relaxed linearly to zero over relax_steps steps.
+    void excavate(const std::vector<std::string>& regions, long relax_steps);
+    void step();
+    /// Recomputes time step and (quasi-static) masses from the current contacts.
+    void update_timestep();
+
+    // --- measures -------------------------------------------------------------
+    double unbalanced_ratio() const { return ratio_; }
+    double time() const { return time_; }
+    long steps() const { return steps_; }
+    double timestep() const { return dt_; }
+    double kinetic_energy() const;
+    double strain_energy() const;
+    double dissipated_energy() const;
+    double external_work() const { return work_; }
+    int cracks(contact::JointState mode) const;
+    /// Total force the contacts and tractions of a boundary's blocks receive from
+    /// their prescribed velocities (reaction) or apply (stress), in N/m.
+    Vec2 boundary_force(const std::string& boundary) const;
+    /// Block-averaged stress (SPEC §7): σ = (1/A) Σ x ⊗ f over contacts and
+    /// boundary tractions, symmetrised; tension positive. {sxx, syy, sxy}.
+    std::array<double, 3> block_stress(int b) const;
+    int block_at(Vec2 p) const;
+
+    // --- state (read by output and tests) ------------------------------------
+    struct Blocks {
+        std::vector<Vec2> centroid, centroid0, velocity, force, applied;
+        std::vector<double> theta, omega, moment, applied_moment;
+        std::vector<double> mass, inertia, real_mass, real_inertia, area;
+        std::vector<std::uint8_t> fixed; ///< bit 0 vx, bit 1 vy, bit 2 ω prescribed
+        std::vector<Vec2> fixed_velocity;
+        std::vector<double> fixed_omega;
+        std::vector<std::uint8_t> removed;
+        std::vector<int> region, material;
+        std::vector<Vec2> local, vertex; ///< body and world vertex positions (CSR by first)
+        std::vector<std::uint32_t> first;
+        int count() const { return static_cast<int>(centroid.size()); }
+    };
+    const Blocks& blocks() const { return b_; }
+    Blocks& blocks() { return b_; }
+    const contact::Contacts& contacts() const { return c_; }
+    contact::Contacts& contacts() { return c_; }
+    const std::vector<contact::JointLaw>& laws() const { return laws_; }
+    const std::vector<std::string>& property_names() const { return property_names_; }
+    const std::vector<std::string>& region_names() const { return region_names_; }
+    /// Block lists by boundary name.
+    const std::vector<std::pair<std::string, std::vector<int>>>& boundary_blocks() const { return boundary_blocks_; }
+    std::uint64_t state_hash() const;
+
+private:
+    contact::BlockView view() const;
+    void update_vertices();
+    void update_contact_forces();
+    void add_external_forces();
+    void integrate();
+    void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
+    std::vector<int> select_blocks(const SelectionSpec& s) const;
+
+    Blocks b_;
+    contact::Contacts c_;
+    std::vector<contact::JointLaw> laws_;
+    std::vector<std::string> property_names_;
+    std::vector<std::string> region_names_;
+    SolverSpec settings_;
+    std::vector<std::pair<std::string, std::vector<int>>> boundary_blocks_;
+    std::vector<Vec2> boundary_force_; ///< per boundary_blocks_ entry, last step
+    struct Traction { int block; Vec2 offset; Vec2 force; }; ///< boundary point load, body frame
+    std::vector<Traction> tractions_;
+    double contact_force_sum_ = 0.0;
+    struct Relaxing { int block; Vec2 force; double moment; };
+    std::vector<Relaxing> relaxing_;
+    long relax_total_ = 0, relax_left_ = 0;
+    double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
+    long steps_ = 0;
+};
+
+} // namespace bbm

@@ -1,0 +1,177 @@
+// Joint laws (contact/joint_law.hpp) against SPEC §4: the softening curves pass
+// through their points, fracture energies equal the areas under the curves,
+// unloading is elastic with the initial stiffness, damage persists.
+#include "contact/joint_law.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+
+using namespace bbm;
+using namespace bbm::contact;
+
+namespace {
+
+/// The paper's Voronoi calibration (SPEC §8).
+JointPropertySpec paper_bond() {
+    JointPropertySpec p;
+    p.name = "bond";
+    p.law = JointPropertySpec::Law::softening;
+    p.kn = 96.6e9;
+    p.ks = 40.3e9;
+    p.tensile = 3e6;
+    p.cohesion = 9.5e6;
+    p.friction = 25;
+    p.tension_softening = {{1.7, 0.5}, {4.0, 0.0}};
+    p.shear_softening = {{1.3, 0.5}, {2.1, 0.0}};
+    return p;
+}
+
+double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
+
+/// Piecewise-linear reference curve (total displacement ratio -> stress ratio).
+double reference(double x, double a1, double b1, double a2) {
+    if (x <= 1) return x;
+    if (x <= a1) return 1 + (b1 - 1) * (x - 1) / (a1 - 1);
+    if (x <= a2) return b1 * (a2 - x) / (a2 - a1);
+    return 0;
+}
+
+} // namespace
+
+TEST_CASE("softening law, monotonic opening: SPEC §4 curve points and G_I") {
+    const auto p = paper_bond();
+    const SofteningLaw law(p);
+    const double u0 = p.tensile / p.kn;
+    for (int steps_per_u0 : {7, 100, 1000}) {
+        INFO("steps per u_t0: " << steps_per_u0);
+        JointHistory h;
+        const double du = u0 / steps_per_u0;
+        double work = 0.0, max_err = 0.0;
+        double prev = 0.0;
+        for (int k = 1; k <= 5 * steps_per_u0; ++k) {
+            law.update(h, du, 0.0);
+            const double tension = -h.sn;
+            work += 0.5 * (prev + tension) * du;
+            prev = tension;
+            const double x = h.un / u0;
+            max_err = std::max(max_err, std::abs(tension / p.tensile - reference(x, 1.7, 0.5, 4.0)));
+        }
+        // Exact return on the piecewise-linear curve: every sample is on it.
+        CHECK(max_err < 1e-6);
+        CHECK(h.broken == JointState::broken_tension);
+        CHECK(h.damage == 1.0);
+        const double gi = 1.6 * p.tensile * p.tensile / p.kn; // 149.07 J/m²
+        CHECK(gi == doctest::Approx(149.07).epsilon(1e-4));
+        if (steps_per_u0 >= 100) {
+            CHECK(work == doctest::Approx(gi).epsilon(0.01));
+            CHECK(h.dissipated == doctest::Approx(gi).epsilon(0.01));
+        }
+    }
+}
+
+TEST_CASE("softening law, shear at sigma_n = 0: curve points and G_II") {
+    const auto p = paper_bond();
+    const SofteningLaw law(p);
+    const double u0 = p.cohesion / p.ks;
+    JointHistory h;
+    const int n = 1000;
+    const double du = u0 / n;
+    double work = 0.0, prev = 0.0, max_err = 0.0;
+    for (int k = 1; k <= 3 * n; ++k) {
+        law.update(h, 0.0, du);
+        work += 0.5 * (prev + h.tau) * du;
+        prev = h.tau;
+        max_err = std::max(max_err, std::abs(h.tau / p.cohesion - reference(h.us / u0, 1.3, 0.5, 2.1)));
+    }
+    CHECK(max_err < 1e-6);
+    CHECK(h.broken == JointState::broken_shear);
+    const double gii = 0.925 * p.cohesion * p.cohesion / p.ks; // 2071.5 J/m²
+    CHECK(gii == doctest::Approx(2071.5).epsilon(1e-4));
+    CHECK(work == doctest::Approx(gii).epsilon(0.01));
+}
+
+TEST_CASE("softening law, shear at sigma_n = 5 MPa: peak c + sn tan phi, residual sn tan phi") {
+    const auto p = paper_bond();
+    const SofteningLaw law(p);
+    JointHistory h;
+    const double sn = 5e6;
+    law.update(h, -sn / p.kn, 0.0);
+    CHECK(h.sn == doctest::Approx(sn));
+    const double du = p.cohesion / p.ks / 1000;
+    double peak = 0;
+    for (int k = 0; k < 6000; ++k) {
+        law.update(h, 0.0, du);
+        peak = std::max(peak, h.tau);
+    }
+    // The sampled peak lies on the curve within the step that crosses the peak:
+    // at most one elastic increment ks·du below it, never above.
+    const double strength = p.cohesion + sn * tan_deg(25);
+    CHECK(peak <= strength * (1 + 1e-12));
+    CHECK(peak >= strength - p.ks * du);
+    CHECK(h.tau == doctest::Approx(sn * tan_deg(25)).epsilon(1e-9));
+    CHECK(h.broken == JointState::broken_shear);
+}
+
+TEST_CASE("softening law: unloading is elastic with the initial stiffness, damage persists") {
+    const auto p = paper_bond();
+    const SofteningLaw law(p);
+    const double u0 = p.cohesion / p.ks, du = u0 / 500;
+    JointHistory h;
+    // Load into softening, to 1.15 u0 (between the peak and the first point).
+    for (int k = 0; k < 575; ++k) law.update(h, 0.0, du);
+    const double tau_soft = h.tau, d = h.damage;
+    CHECK(d > 0.0);
+    CHECK(d < 1.0);
+    CHECK(tau_soft < p.cohesion);
+    // Unload by 100 steps: stress falls with the initial stiffness ks.
+    for (int k = 0; k < 100; ++k) law.update(h, 0.0, -du);
+    CHECK(h.tau == doctest::Approx(tau_soft - 100 * du * p.ks).epsilon(1e-12));
+    CHECK(h.damage == d);
+    // Reload: the cap is the softened strength, not c.
+    double peak = 0;
+    for (int k = 0; k < 101; ++k) {
+        law.update(h, 0.0, du);
+        peak = std::max(peak, h.tau);
+    }
+    CHECK(peak == doctest::Approx(tau_soft).epsilon(1e-9));
+    CHECK(peak < p.cohesion);
+    // Coupled damage: the tensile strength is softened by the same D.
+    JointHistory t = h;
+    for (int k = 0; k < 2000 && -t.sn < 2 * p.tensile; ++k) {
+        law.update(t, p.tensile / p.kn / 1000, 0.0);
+        if (t.upn > 0) break;
+    }
+    CHECK(-t.sn <= p.tensile * (1 - d) * (1 + 1e-9));
+}
+
+TEST_CASE("brittle softening (no post-peak points) and the Coulomb law") {
+    auto p = paper_bond();
+    p.tension_softening.clear();
+    const SofteningLaw brittle(p);
+    JointHistory h;
+    const double du = p.tensile / p.kn / 10;
+    for (int k = 0; k < 10; ++k) brittle.update(h, du, 0.0);
+    CHECK(-h.sn == doctest::Approx(p.tensile));
+    brittle.update(h, du, 0.0);
+    CHECK(h.sn == 0.0);
+    CHECK(h.broken == JointState::broken_tension);
+
+    JointPropertySpec c;
+    c.law = JointPropertySpec::Law::coulomb;
+    c.kn = 1e9;
+    c.ks = 1e9;
+    c.friction = 30;
+    const CoulombLaw coulomb(c);
+    JointHistory s;
+    s.bonded = false;
+    coulomb.update(s, -1e-3, 0.0); // 1 MPa compression
+    CHECK(s.sn == doctest::Approx(1e6));
+    for (int k = 0; k < 10; ++k) coulomb.update(s, 0.0, 1e-3);
+    CHECK(s.tau == doctest::Approx(1e6 * tan_deg(30)));
+    CHECK(s.slipping);
+    coulomb.update(s, 2e-3, 0.0); // opens: no tension, no shear
+    CHECK(s.sn == 0.0);
+    CHECK(s.tau == 0.0);
+}
