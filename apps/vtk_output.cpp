@@ -1,6 +1,8 @@
 // bbm io: VTK output of a block assembly (see vtk_output.hpp).
 #include "apps/vtk_output.hpp"
 
+#include "core/solver.hpp"
+
 // VTK 9.1's type macros end in a stray ';' that -Wpedantic reports in every file;
 // CMake passes VTK's directory with -isystem, this keeps a plain -I build quiet too.
 #pragma GCC diagnostic push
@@ -328,6 +330,108 @@ void write_text_atomically(const fs::path& file, std::string_view text) {
                                  std::generic_category().message(written ? errno : write_errno));
     }
     tmp.commit();
+}
+
+void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
+    const auto& b = s.blocks();
+    const auto stress = s.block_stresses();
+    std::vector<int> kept;
+    for (int i = 0; i < b.count(); ++i)
+        if (!b.removed[i]) kept.push_back(i);
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->InsertNextValue(0);
+    for (int i : kept) {
+        for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v)
+            connectivity->InsertNextValue(points->InsertNextPoint(b.vertex[v].x, b.vertex[v].y, 0.0));
+        offsets->InsertNextValue(connectivity->GetNumberOfValues());
+    }
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+    vtkNew<vtkUnstructuredGrid> grid;
+    grid->SetPoints(points);
+    grid->SetCells(VTK_POLYGON, cells);
+    const auto n = static_cast<vtkIdType>(kept.size());
+    auto id = int_array("block_id", n), region = int_array("region", n), material = int_array("material", n);
+    auto rotation = double_array("rotation", n);
+    auto disp = double_array("displacement", 0), vel = double_array("velocity", 0), sig = double_array("stress", 0);
+    disp->SetNumberOfComponents(3), disp->SetNumberOfTuples(n);
+    vel->SetNumberOfComponents(3), vel->SetNumberOfTuples(n);
+    sig->SetNumberOfComponents(6), sig->SetNumberOfTuples(n);
+    for (vtkIdType k = 0; k < n; ++k) {
+        const int i = kept[k];
+        id->SetValue(k, i);
+        region->SetValue(k, b.region[i]);
+        material->SetValue(k, b.material[i]);
+        rotation->SetValue(k, b.theta[i]);
+        const Vec2 u = b.centroid[i] - b.centroid0[i];
+        disp->SetTuple3(k, u.x, u.y, 0.0);
+        vel->SetTuple3(k, b.velocity[i].x, b.velocity[i].y, 0.0);
+        const double t[6] = {stress[i][0], stress[i][1], 0.0, stress[i][2], 0.0, 0.0};
+        sig->SetTuple(k, t);
+    }
+    vtkCellData* cd = grid->GetCellData();
+    for (vtkAbstractArray* a : {static_cast<vtkAbstractArray*>(id), static_cast<vtkAbstractArray*>(region),
+                                static_cast<vtkAbstractArray*>(material), static_cast<vtkAbstractArray*>(disp),
+                                static_cast<vtkAbstractArray*>(vel), static_cast<vtkAbstractArray*>(rotation),
+                                static_cast<vtkAbstractArray*>(sig)})
+        cd->AddArray(a);
+    grid->GetFieldData()->AddArray(string_array("region_names", s.region_names(), [](const std::string& x) { return x; }));
+    write_grid(grid, file);
+}
+
+void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
+    const auto& c = s.contacts();
+    const auto& b = s.blocks();
+    const auto n = static_cast<vtkIdType>(c.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(2 * n);
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->SetNumberOfValues(n + 1);
+    connectivity->SetNumberOfValues(2 * n);
+    auto sn = double_array("sn", n), tau = double_array("tau", n), un = double_array("un", n),
+         us = double_array("us", n), damage = double_array("damage", n), length = double_array("length", n);
+    auto state = int_array("state", n), property = int_array("property", n);
+    for (vtkIdType i = 0; i < n; ++i) {
+        // The contact's share of the joint: from its vertex along the edge inwards.
+        const Vec2 x = b.vertex[c.vertex_id[i]];
+        const int e0 = c.edge_id[i], e1 = contact::next_vertex(b.first.data(), c.edge_block[i], e0);
+        const Vec2 mid = 0.5 * (b.vertex[e0] + b.vertex[e1]);
+        const Vec2 t = c.tangent[i];
+        const Vec2 y = x + (dot(mid - x, t) >= 0 ? 1.0 : -1.0) * c.length[i] * t;
+        points->SetPoint(2 * i, x.x, x.y, 0.0);
+        points->SetPoint(2 * i + 1, y.x, y.y, 0.0);
+        offsets->SetValue(i, 2 * i);
+        connectivity->SetValue(2 * i, 2 * i);
+        connectivity->SetValue(2 * i + 1, 2 * i + 1);
+        const auto& h = c.history[i];
+        sn->SetValue(i, h.sn);
+        tau->SetValue(i, h.tau);
+        un->SetValue(i, h.un);
+        us->SetValue(i, h.us);
+        damage->SetValue(i, h.damage);
+        length->SetValue(i, c.length[i]);
+        state->SetValue(i, static_cast<int>(contact::state_of(h)));
+        property->SetValue(i, c.property[i]);
+    }
+    offsets->SetValue(n, 2 * n);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+    vtkNew<vtkUnstructuredGrid> grid;
+    grid->SetPoints(points);
+    grid->SetCells(VTK_LINE, cells);
+    vtkCellData* cd = grid->GetCellData();
+    for (vtkAbstractArray* a : {static_cast<vtkAbstractArray*>(sn), static_cast<vtkAbstractArray*>(tau),
+                                static_cast<vtkAbstractArray*>(un), static_cast<vtkAbstractArray*>(us),
+                                static_cast<vtkAbstractArray*>(damage), static_cast<vtkAbstractArray*>(state),
+                                static_cast<vtkAbstractArray*>(property), static_cast<vtkAbstractArray*>(length)})
+        cd->AddArray(a);
+    const std::vector<std::string> states{"intact", "softening", "broken_tension", "broken_shear", "sliding"};
+    grid->GetFieldData()->AddArray(string_array("state_names", states, [](const std::string& x) { return x; }));
+    grid->GetFieldData()->AddArray(string_array("property_names", s.property_names(), [](const std::string& x) { return x; }));
+    write_grid(grid, file);
 }
 
 } // namespace bbm::io

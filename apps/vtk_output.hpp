@@ -22,6 +22,10 @@
 
 #include "meshing/blocks.hpp"
 
+namespace bbm {
+class Solver;
+}
+
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -44,5 +48,15 @@ void write_pvd(const std::filesystem::path& file,
 
 /// Writes `text` to `file` atomically (summary.json, logs of a finished run).
 void write_text_atomically(const std::filesystem::path& file, std::string_view text);
+
+/// The solver's current state: blocks.vtu-like polygons at their current place
+/// (cell data block_id, region, material, displacement, velocity, rotation, stress
+/// as a symmetric tensor XX YY ZZ XY YZ XZ, tension positive); excavated blocks
+/// are left out.
+void write_state_blocks_vtu(const Solver& s, const std::filesystem::path& file);
+/// Contacts as line cells along their share of the joint (cell data sn, tau, un,
+/// us, damage, state (0 intact, 1 softening, 2 broken-tension, 3 broken-shear,
+/// 4 sliding), property, length).
+void write_state_contacts_vtu(const Solver& s, const std::filesystem::path& file);
 
 } // namespace bbm::io

@@ -21,10 +21,12 @@ class InputError : public std::runtime_error {
 public:
     InputError(std::string file, int line, std::string key, std::string message)
         : std::runtime_error(format(file, line, key, message)), file_(std::move(file)),
-          line_(line), key_(std::move(key)) {}
+          line_(line), key_(std::move(key)), message_(std::move(message)) {}
     const std::string& file() const { return file_; }
     int line() const { return line_; }
     const std::string& key() const { return key_; }
+    /// The message alone, without file, line and key.
+    const std::string& message() const { return message_; }
 
 private:
     static std::string format(const std::string& file, int line, const std::string& key,
@@ -40,6 +42,7 @@ private:
     std::string file_;
     int line_;
     std::string key_;
+    std::string message_;
 };
 
 /// A geometric defect in one region's description (self-intersection, hole outside,

@@ -418,26 +418,28 @@ Vec2 Solver::boundary_force(const std::string& name) const {
     return {};
 }
 
-std::array<double, 3> Solver::block_stress(int blk) const {
-    double sxx = 0, syy = 0, sxy = 0;
-    auto add = [&](Vec2 r, Vec2 f) {
-        sxx += r.x * f.x;
-        syy += r.y * f.y;
-        sxy += 0.5 * (r.x * f.y + r.y * f.x);
+std::vector<std::array<double, 3>> Solver::block_stresses() const {
+    std::vector<std::array<double, 3>> m(b_.count(), {0.0, 0.0, 0.0});
+    auto add = [&](int blk, Vec2 r, Vec2 f) {
+        m[blk][0] += r.x * f.x;
+        m[blk][1] += r.y * f.y;
+        m[blk][2] += 0.5 * (r.x * f.y + r.y * f.x);
     };
     for (int i = 0; i < c_.size(); ++i) {
         const int A = c_.vertex_block[i], B = c_.edge_block[i];
-        if (A != blk && B != blk) continue;
         const Vec2 x = b_.vertex[c_.vertex_id[i]], f = contact::contact_force(c_, i);
-        add(x - b_.centroid[blk], A == blk ? f : -1.0 * f);
+        add(A, x - b_.centroid[A], f);
+        add(B, x - b_.centroid[B], -1.0 * f);
     }
     // Boundary tractions are surface forces too (at their points, rotating with the
     // block); gravity, uniform over the block, has no first moment about the centroid.
-    const double cs = std::cos(b_.theta[blk]), sn = std::sin(b_.theta[blk]);
-    for (const auto& t : tractions_)
-        if (t.block == blk) add({cs * t.offset.x - sn * t.offset.y, sn * t.offset.x + cs * t.offset.y}, t.force);
-    const double a = b_.area[blk];
-    return {sxx / a, syy / a, sxy / a};
+    for (const auto& t : tractions_) {
+        const double cs = std::cos(b_.theta[t.block]), sn = std::sin(b_.theta[t.block]);
+        add(t.block, {cs * t.offset.x - sn * t.offset.y, sn * t.offset.x + cs * t.offset.y}, t.force);
+    }
+    for (int b = 0; b < b_.count(); ++b)
+        for (double& v : m[b]) v /= b_.area[b];
+    return m;
 }
 
 int Solver::block_at(Vec2 p) const {

@@ -64,9 +64,9 @@ public:
     /// Total force the contacts and tractions of a boundary's blocks receive from
     /// their prescribed velocities (reaction) or apply (stress), in N/m.
     Vec2 boundary_force(const std::string& boundary) const;
-    /// Block-averaged stress (SPEC §7): σ = (1/A) Σ x ⊗ f over contacts and
-    /// boundary tractions, symmetrised; tension positive. {sxx, syy, sxy}.
-    std::array<double, 3> block_stress(int b) const;
+    /// Block-averaged stress of every block (SPEC §7): σ = (1/A) Σ x ⊗ f over its
+    /// contacts and boundary tractions, symmetrised; tension positive. {sxx, syy, sxy}.
+    std::vector<std::array<double, 3>> block_stresses() const;
     int block_at(Vec2 p) const;
 
     // --- state (read by output and tests) ------------------------------------

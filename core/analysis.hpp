@@ -1,0 +1,52 @@
+// bbm core: running the stages of a model file, and sampling its histories.
+//
+// run_stages() drives the solver through initialize / solve / excavate / cycle
+// stages (core/model_spec.hpp) and tells an observer about every step and every
+// stage end; the program (apps/) writes output and progress from the observer,
+// so the loop knows nothing of files or terminals.
+#pragma once
+
+#include "core/solver.hpp"
+
+#include <string>
+#include <vector>
+
+namespace bbm {
+
+struct StageReport {
+    std::string name, kind;
+    long steps = 0;
+    double ratio = 0.0;
+    double seconds = 0.0;
+    bool converged = true; ///< solve: reached the ratio within the step limit
+};
+
+class StageObserver {
+public:
+    virtual ~StageObserver() = default;
+    virtual void stage_started(const Solver&, const StageSpec&) {}
+    /// After every step; `stage_step` counts from 1 within the stage.
+    virtual void step_done(const Solver&, const StageSpec&, long stage_step) { (void)stage_step; }
+    virtual void stage_done(const Solver&, const StageReport&) {}
+    /// Polled every step: true ends the run after the current step.
+    virtual bool stop_requested() { return false; }
+};
+
+std::vector<StageReport> run_stages(Solver& solver, const std::vector<StageSpec>& stages,
+                                    StageObserver& observer);
+
+/// Evaluates named history quantities; blocks named by a point are found once.
+class HistoryRecorder {
+public:
+    HistoryRecorder(const Solver& solver, std::vector<HistorySpec> histories);
+    const std::vector<HistorySpec>& histories() const { return histories_; }
+    std::vector<double> sample(const Solver& solver) const;
+
+private:
+    std::vector<HistorySpec> histories_;
+    std::vector<int> block_;
+};
+
+const char* to_string(StageSpec::Kind k);
+
+} // namespace bbm

@@ -1,0 +1,182 @@
+// Verification problems of the rigid-block engine (issue 3): the model files in
+// examples/verification/ run through the solver and compared with analytic answers.
+#include "apps/model_input.hpp"
+#include "core/analysis.hpp"
+#include "core/solver.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+
+using namespace bbm;
+
+namespace {
+
+struct Loaded {
+    io::ModelFile file;
+    meshing::BlockAssembly blocks;
+};
+
+Loaded load(const std::string& name) {
+    Loaded l;
+    l.file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/verification/" + name);
+    l.blocks = meshing::generate_blocks(l.file.geometry);
+    return l;
+}
+
+double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
+
+double reference(double x, double a1, double b1, double a2) {
+    if (x <= 1) return x;
+    if (x <= a1) return 1 + (b1 - 1) * (x - 1) / (a1 - 1);
+    if (x <= a2) return b1 * (a2 - x) / (a2 - a1);
+    return 0;
+}
+
+struct Silent : StageObserver {};
+
+} // namespace
+
+TEST_CASE("verification 1: a bonded joint opened monotonically follows the tension curve, work = G_I") {
+    auto m = load("joint_opening.toml");
+    Solver s(m.blocks, m.file.analysis);
+    REQUIRE(s.contacts().size() == 2);
+    const double kn = 96.6e9, st = 3e6, u0 = st / kn;
+    double work = 0.0, max_err = 0.0, prev_u = 0.0;
+    for (int k = 0; k < 500; ++k) {
+        s.step();
+        // The joint's tension is the pull the joint exerts back on the block, over 1 m.
+        const double stress = -s.boundary_force("pull").x;
+        const double u = s.blocks().centroid[1].x - s.blocks().centroid0[1].x;
+        // Stresses at step k come from the displacement reached at its start.
+        max_err = std::max(max_err, std::abs(stress / st - reference(prev_u / u0, 1.7, 0.5, 4.0)));
+        work += stress * (u - prev_u);
+        prev_u = u;
+    }
+    CHECK(max_err < 1e-6);
+    CHECK(s.cracks(contact::JointState::broken_tension) == 2);
+    CHECK(s.dissipated_energy() == doctest::Approx(149.07).epsilon(0.01));
+    CHECK(work == doctest::Approx(1.6 * st * st / kn).epsilon(0.01));
+}
+
+TEST_CASE("verification 2: a bonded joint in shear at sn = 0 and sn = 5 MPa") {
+    const double ks = 40.3e9, c = 9.5e6, u0 = c / ks;
+    for (double sn : {0.0, 5e6}) {
+        INFO("sigma_n = " << sn);
+        auto m = load("joint_shear.toml");
+        m.file.analysis.stages[0].stress.sxx = -sn;
+        Solver s(m.blocks, m.file.analysis);
+        Silent quiet;
+        run_stages(s, {m.file.analysis.stages[0]}, quiet);
+        double work = 0.0, prev_u = 0.0, peak = 0.0, max_err = 0.0;
+        for (int k = 0; k < 3000; ++k) {
+            s.step();
+            const double tau = -s.boundary_force("shear").y, u = s.blocks().centroid[1].y - s.blocks().centroid0[1].y;
+            peak = std::max(peak, tau);
+            if (sn == 0.0) max_err = std::max(max_err, std::abs(tau / c - reference(prev_u / u0, 1.3, 0.5, 2.1)));
+            work += tau * (u - prev_u);
+            prev_u = u;
+        }
+        const double residual = sn * tan_deg(25.0);
+        CHECK(peak <= (c + residual) * (1 + 1e-12));
+        CHECK(peak >= c + residual - ks * u0 / 1000);
+        CHECK(-s.boundary_force("shear").y == doctest::Approx(residual).epsilon(1e-9));
+        CHECK(s.cracks(contact::JointState::broken_shear) == 2);
+        if (sn == 0.0) {
+            CHECK(max_err < 1e-6);
+            CHECK(work == doctest::Approx(0.925 * c * c / ks).epsilon(0.01)); // 2071.5 J/m²
+        }
+    }
+}
+
+TEST_CASE("verification 3: a block on an inclined plane sticks below phi and slides above it") {
+    const double g = 9.81, phi = 20.0;
+    for (double theta : {15.0, 30.0, 45.0}) {
+        INFO("theta = " << theta);
+        auto m = load("sliding_block.toml");
+        const double t = theta * std::numbers::pi / 180.0;
+        m.file.analysis.solver.gravity = {g * std::sin(t), -g * std::cos(t)};
+        m.file.analysis.stages[0].stress.syy = -2000.0 * g * std::cos(t);
+        Solver s(m.blocks, m.file.analysis);
+        Silent quiet;
+        run_stages(s, {m.file.analysis.stages[0]}, quiet);
+        // Let the shear spring take up the load, then measure over a long window.
+        for (int k = 0; k < 200; ++k) s.step();
+        const double t0 = s.time(), v0 = s.blocks().velocity[1].x;
+        for (int k = 0; k < 2000; ++k) s.step();
+        const double a = (s.blocks().velocity[1].x - v0) / (s.time() - t0);
+        if (theta < phi) {
+            CHECK(std::abs(s.blocks().centroid[1].x - s.blocks().centroid0[1].x) < 1e-4);
+            CHECK(std::abs(a) < 1e-3);
+        } else {
+            const double expected = g * (std::sin(t) - std::cos(t) * tan_deg(phi));
+            CHECK(a == doctest::Approx(expected).epsilon(0.01));
+        }
+    }
+}
+
+TEST_CASE("verification 4: square lattice under uniaxial stress: E = kn d, nu = 0") {
+    auto m = load("square_lattice.toml");
+    Solver s(m.blocks, m.file.analysis);
+    Silent quiet;
+    const auto reports = run_stages(s, m.file.analysis.stages, quiet);
+    REQUIRE(reports[0].converged);
+    const auto& b = s.blocks();
+    const double kn = 10e9, d = 0.5, sigma = 1e4;
+    double max_ux = 0.0;
+    for (int i = 0; i < b.count(); ++i) {
+        max_ux = std::max(max_ux, std::abs(b.centroid[i].x - b.centroid0[i].x));
+        if (b.centroid0[i].y > 2.0) {
+            // Four joint layers above the fixed row, over a gauge of 4 d.
+            const double strain = -(b.centroid[i].y - b.centroid0[i].y) / (4 * d);
+            CHECK(sigma / strain == doctest::Approx(kn * d).epsilon(1e-6));
+        }
+    }
+    const double uy = 4 * sigma / kn;
+    CHECK(max_ux < 1e-6 * uy); // ν = 0 (to second order in the strain, see the model file)
+}
+
+TEST_CASE("verification 5: undamped oscillation on a joint conserves energy over 1000 periods") {
+    auto m = load("oscillator.toml");
+    Solver s(m.blocks, m.file.analysis);
+    Silent quiet;
+    run_stages(s, {m.file.analysis.stages[0]}, quiet);
+    const double e0 = s.strain_energy();
+    CHECK(e0 == doctest::Approx(500.0)); // σ²/(2 kn) × 1 m
+    const double period = 2 * std::numbers::pi * std::sqrt(1000.0 / 1e9);
+    const long per = std::lround(period / s.timestep());
+    // Amplitude of the strain energy in the first and the thousandth period.
+    auto peak_over_period = [&] {
+        double e = 0.0;
+        for (long k = 0; k < per + 2; ++k) {
+            s.step();
+            e = std::max(e, s.strain_energy());
+        }
+        return e;
+    };
+    const double first = peak_over_period();
+    while (s.time() < 999 * period) s.step();
+    const double last = peak_over_period();
+    INFO("first " << first << ", last " << last << ", steps per period " << per);
+    CHECK(first == doctest::Approx(e0).epsilon(0.005));
+    CHECK(last == doctest::Approx(first).epsilon(0.005));
+}
+
+TEST_CASE("verification 7: uniform in-situ stress of a Voronoi assembly is in equilibrium") {
+    auto m = load("insitu_voronoi.toml");
+    Solver s(m.blocks, m.file.analysis);
+    Silent quiet;
+    run_stages(s, m.file.analysis.stages, quiet);
+    CHECK(s.unbalanced_ratio() < 1e-6);
+    double max_u = 0.0;
+    for (int i = 0; i < s.blocks().count(); ++i)
+        max_u = std::max(max_u, norm(s.blocks().centroid[i] - s.blocks().centroid0[i]));
+    CHECK(max_u < 1e-12);
+    // Block-averaged stress equals the field in every block (SPEC §7).
+    for (const auto& st : s.block_stresses()) {
+        CHECK(st[0] == doctest::Approx(-10e6).epsilon(1e-9));
+        CHECK(st[1] == doctest::Approx(-20e6).epsilon(1e-9));
+        CHECK(st[2] == doctest::Approx(-3e6).epsilon(1e-9));
+    }
+}
