@@ -399,7 +399,7 @@ void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
         const Vec2 x = b.vertex[c.vertex_id[i]];
         const int e0 = c.edge_id[i], e1 = contact::next_vertex(b.first.data(), c.edge_block[i], e0);
         const Vec2 mid = 0.5 * (b.vertex[e0] + b.vertex[e1]);
-        const Vec2 t = c.tangent[i];
+        const Vec2 t = contact::tangent_of(c.normal[i]);
         const Vec2 y = x + (dot(mid - x, t) >= 0 ? 1.0 : -1.0) * c.length[i] * t;
         points->SetPoint(2 * i, x.x, x.y, 0.0);
         points->SetPoint(2 * i + 1, y.x, y.y, 0.0);

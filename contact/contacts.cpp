@@ -5,7 +5,8 @@
 
 namespace bbm::contact {
 
-void Contacts::add(int a, int vertex, int b, int edge, double l, int prop, const JointHistory& h) {
+void Contacts::add(int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h) {
+    edge_end.push_back(end);
     vertex_block.push_back(a);
     vertex_id.push_back(vertex);
     edge_block.push_back(b);
@@ -14,9 +15,6 @@ void Contacts::add(int a, int vertex, int b, int edge, double l, int prop, const
     property.push_back(prop);
     history.push_back(h);
     normal.push_back({});
-    tangent.push_back({});
-    dun.push_back(0.0);
-    dus.push_back(0.0);
 }
 
 void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
@@ -27,22 +25,17 @@ void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
         vertex_id[out] = vertex_id[i];
         edge_block[out] = edge_block[i];
         edge_id[out] = edge_id[i];
+        edge_end[out] = edge_end[i];
         length[out] = length[i];
         property[out] = property[i];
         history[out] = history[i];
         normal[out] = normal[i];
-        tangent[out] = tangent[i];
-        dun[out] = dun[i];
-        dus[out] = dus[i];
         ++out;
     }
-    for (auto* v : {&vertex_block, &vertex_id, &edge_block, &edge_id, &property}) v->resize(out);
+    for (auto* v : {&vertex_block, &vertex_id, &edge_block, &edge_id, &edge_end, &property}) v->resize(out);
     length.resize(out);
     history.resize(out);
     normal.resize(out);
-    tangent.resize(out);
-    dun.resize(out);
-    dus.resize(out);
 }
 
 void Contacts::rebuild_batches(int property_sets) {
@@ -50,56 +43,66 @@ void Contacts::rebuild_batches(int property_sets) {
     for (int i = 0; i < size(); ++i) batches[property[i]].push_back(i);
 }
 
-void update_kinematics(Contacts& c, const BlockView& b, double dt, double corner_radius) {
-    const int n = c.size();
-    for (int i = 0; i < n; ++i) {
-        const int A = c.vertex_block[i], B = c.edge_block[i];
-        const int e0 = c.edge_id[i], e1 = next_vertex(b.first, B, e0);
-        const Vec2 x = b.vertex[c.vertex_id[i]];
-        const Vec2 p = b.vertex[e0], q = b.vertex[e1];
-        const Vec2 d = q - p;
-        const double len = norm(d);
-        Vec2 t = d / len;
-        Vec2 nrm{t.y, -t.x}; // outward normal of a counter-clockwise polygon's edge
-        // Beyond an end of the edge: normal of the rounded corner (continuous).
-        const double s = dot(x - p, t);
-        if (s < 0.0 || s > len) {
-            const Vec2 corner = s < 0.0 ? p : q;
-            const Vec2 r = x - (corner - corner_radius * nrm);
-            const double rl = norm(r);
-            if (rl > 0.0) {
-                nrm = r / rl;
-                t = Vec2{-nrm.y, nrm.x};
-            }
-        }
-        c.normal[i] = nrm;
-        c.tangent[i] = t;
-        const Vec2 va = b.velocity[A] + b.omega[A] * perp(x - b.centroid[A]);
-        const Vec2 vb = b.velocity[B] + b.omega[B] * perp(x - b.centroid[B]);
-        const Vec2 vr = va - vb;
-        c.dun[i] = dot(vr, nrm) * dt;
-        c.dus[i] = dot(vr, t) * dt;
-    }
+void update_normals(Contacts& c, const BlockView& b, double corner_radius) {
+    for (int i = 0; i < c.size(); ++i) contact_kinematics(c, i, b, corner_radius);
 }
 
-void update_stresses(Contacts& c, const std::vector<JointLaw>& laws) {
-    for (std::size_t p = 0; p < c.batches.size(); ++p)
-        update_batch(laws[p], c.batches[p], c.history.data(), c.dun.data(), c.dus.data());
-}
-
-double accumulate_forces(const Contacts& c, const BlockView& b, Vec2* force, double* moment) {
-    const int n = c.size();
+namespace {
+// The fused loop reads everything through local restrict pointers: through the
+// Contacts members the compiler must assume the force stores alias them and would
+// reload every base pointer on every contact.
+template <class Law>
+double step_batch(const Law& law, const std::vector<int>& ids, Contacts& c, const BlockView& b, double dt,
+                  double corner_radius, Vec2* __restrict force, double* __restrict moment) {
+    const int* __restrict va = c.vertex_block.data();
+    const int* __restrict vid = c.vertex_id.data();
+    const int* __restrict eb = c.edge_block.data();
+    const int* __restrict e0 = c.edge_id.data();
+    const int* __restrict e1 = c.edge_end.data();
+    const double* __restrict len = c.length.data();
+    JointHistory* __restrict hist = c.history.data();
+    Vec2* __restrict normal = c.normal.data();
+    const Vec2* __restrict vertex = b.vertex;
+    const Vec2* __restrict centroid = b.centroid;
+    const Vec2* __restrict velocity = b.velocity;
+    const double* __restrict omega = b.omega;
+    const double* __restrict inv_edge = b.inv_edge_length;
     double sum = 0.0;
-    for (int i = 0; i < n; ++i) {
-        const int A = c.vertex_block[i], B = c.edge_block[i];
-        const Vec2 x = b.vertex[c.vertex_id[i]];
-        const Vec2 f = contact_force(c, i);
+    for (const int i : ids) {
+        const int A = va[i], B = eb[i];
+        const Vec2 x = vertex[vid[i]], p = vertex[e0[i]], q = vertex[e1[i]];
+        const double inv_len = inv_edge[e0[i]];
+        Vec2 t = inv_len * (q - p);
+        Vec2 n{t.y, -t.x};
+        const double s = dot(x - p, t) * inv_len, margin = 1e-6 * corner_radius * inv_len;
+        if (s < -margin || s > 1.0 + margin) [[unlikely]] {
+            const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * n);
+            const double rl = norm(r);
+            if (rl > 0.0) n = r / rl, t = Vec2{-n.y, n.x};
+        }
+        const Vec2 ra = x - centroid[A], rb = x - centroid[B];
+        const Vec2 vr = (velocity[A] + omega[A] * perp(ra)) - (velocity[B] + omega[B] * perp(rb));
+        const double du_n = dot(vr, n) * dt, du_s = dot(vr, t) * dt;
+        normal[i] = n;
+        JointHistory& h = hist[i];
+        law.update(h, du_n, du_s);
+        const Vec2 f = len[i] * (h.sn * n - h.tau * t);
         force[A] += f;
-        moment[A] += cross(x - b.centroid[A], f);
+        moment[A] += cross(ra, f);
         force[B] -= f;
-        moment[B] -= cross(x - b.centroid[B], f);
-        sum += norm(f);
+        moment[B] -= cross(rb, f);
+        sum += norm2(f);
     }
+    return sum;
+}
+} // namespace
+
+double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
+                     double corner_radius, Vec2* force, double* moment) {
+    double sum = 0.0;
+    for (std::size_t p = 0; p < c.batches.size(); ++p)
+        sum += std::visit([&](const auto& law) { return step_batch(law, c.batches[p], c, b, dt, corner_radius, force, moment); },
+                          laws[p]);
     return sum;
 }
 

@@ -37,23 +37,24 @@ struct BlockView {
     const double* omega;      ///< per block
     const Vec2* vertex;       ///< current vertex positions, all blocks, CSR by `first`
     const std::uint32_t* first;
+    const double* inv_edge_length; ///< 1 / length of the edge starting at each vertex (rigid: constant)
 };
 
 struct Contacts {
     // Topology (cold).
     std::vector<int> vertex_block, vertex_id; ///< A and the global id of its vertex
     std::vector<int> edge_block, edge_id;     ///< B and the global id of its edge's first vertex
+    std::vector<int> edge_end;                ///< global id of the edge's second vertex
     std::vector<double> length;               ///< L, m
     std::vector<int> property;                ///< property set (index into the law table)
     std::vector<JointHistory> history;
-    // Per step (hot), written by update_kinematics.
-    std::vector<Vec2> normal, tangent;
-    std::vector<double> dun, dus;
+    /// Current normal n (written every step); the tangent is t = (−n.y, n.x).
+    std::vector<Vec2> normal;
     /// Contacts of each property set, rebuilt when contacts are added or removed.
     std::vector<std::vector<int>> batches;
 
     int size() const { return static_cast<int>(length.size()); }
-    void add(int a, int vertex, int b, int edge, double l, int prop, const JointHistory& h);
+    void add(int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h);
     void remove_if_flagged(const std::vector<std::uint8_t>& remove);
     void rebuild_batches(int property_sets);
 };
@@ -63,20 +64,46 @@ inline int next_vertex(const std::uint32_t* first, int block, int v) {
     return (v + 1 == int(first[block + 1])) ? int(first[block]) : v + 1;
 }
 
-/// Normal/tangent of every contact, and the displacement increments over dt.
-void update_kinematics(Contacts& c, const BlockView& b, double dt, double corner_radius);
+inline Vec2 tangent_of(Vec2 n) { return {-n.y, n.x}; }
 
-/// Laws, one dispatch per batch.
-void update_stresses(Contacts& c, const std::vector<JointLaw>& laws);
+/// Normal of contact i from the current geometry (used outside the step loop,
+/// which inlines the same computation).
+inline void contact_kinematics(Contacts& c, int i, const BlockView& b, double corner_radius) {
+    const Vec2 x = b.vertex[c.vertex_id[i]];
+    const Vec2 p = b.vertex[c.edge_id[i]], q = b.vertex[c.edge_end[i]];
+    const double inv_len = b.inv_edge_length[c.edge_id[i]];
+    Vec2 t = inv_len * (q - p);
+    Vec2 nrm{t.y, -t.x}; // outward normal of a counter-clockwise polygon's edge
+    // Beyond an end of the edge (past a rounding-level margin, since bonded
+    // contacts sit exactly on edge ends): normal of the rounded corner.
+    const double s = dot(x - p, t) * inv_len, margin = 1e-6 * corner_radius * inv_len;
+    if (s < -margin || s > 1.0 + margin) [[unlikely]] {
+        const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * nrm);
+        const double rl = norm(r);
+        if (rl > 0.0) {
+            nrm = r / rl;
+            t = Vec2{-nrm.y, nrm.x};
+        }
+    }
+    c.normal[i] = nrm;
+}
 
-/// Adds contact forces and moments to the blocks' accumulators; returns Σ|F|
-/// (the scale of the unbalanced-force ratio).
-double accumulate_forces(const Contacts& c, const BlockView& b, Vec2* force, double* moment);
+/// Normals of every contact from the current geometry.
+void update_normals(Contacts& c, const BlockView& b, double corner_radius);
 
 /// Contact force on the vertex block (A); B gets the opposite.
 inline Vec2 contact_force(const Contacts& c, int i) {
     const JointHistory& h = c.history[i];
-    return c.length[i] * (h.sn * c.normal[i] - h.tau * c.tangent[i]);
+    const Vec2 n = c.normal[i];
+    return c.length[i] * (h.sn * n - h.tau * tangent_of(n));
 }
+
+/// Stage 2 of a step, fused per batch so each contact's data is loaded once:
+/// kinematics, the batch's law (one dispatch per batch), and the forces and
+/// moments added to the blocks' accumulators. Returns Σ|F|² over the contacts
+/// (the RMS contact force is the scale of the unbalanced-force ratio; squares
+/// spare a square root per contact).
+double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
+                     double corner_radius, Vec2* force, double* moment);
 
 } // namespace bbm::contact

@@ -70,20 +70,11 @@ double SofteningCurve::plastic_increment(double excess, double k, double peak, d
     return d0 + h0 / k; // beyond the last point the strength is constant
 }
 
-void ElasticLaw::update(JointHistory& h, double dun, double dus) const {
-    h.un += dun;
-    h.us += dus;
-    h.sn = -kn * h.un;
-    h.tau += ks * dus;
-}
-
 CoulombLaw::CoulombLaw(const JointPropertySpec& p)
     : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
       cohesion(p.cohesion), tensile(p.tensile) {}
 
-void CoulombLaw::update(JointHistory& h, double dun, double dus) const {
-    h.un += dun;
-    h.us += dus;
+void CoulombLaw::update_inelastic(JointHistory& h, double dus) const {
     if (h.bonded) {
         h.sn = -kn * h.un;
         h.tau += ks * dus;
@@ -97,7 +88,7 @@ void CoulombLaw::update(JointHistory& h, double dun, double dus) const {
             h.slipping = false;
             return;
         }
-        h.damage = 1.0;
+        h.damage = 1.0f;
         h.tau -= ks * dus; // the unbonded update below re-applies the increment
     }
     unbonded_update(h, kn, ks, h.broken == JointState::intact ? tan_phi : tan_phi_r, dus);
@@ -108,9 +99,7 @@ SofteningLaw::SofteningLaw(const JointPropertySpec& p)
       cohesion(p.cohesion), tensile(p.tensile), tension(p.tension_softening, p.tensile / p.kn),
       shear(p.shear_softening, p.cohesion / p.ks) {}
 
-void SofteningLaw::update(JointHistory& h, double dun, double dus) const {
-    h.un += dun;
-    h.us += dus;
+void SofteningLaw::update_inelastic(JointHistory& h, double dus) const {
     if (!h.bonded) {
         unbonded_update(h, kn, ks, h.broken == JointState::intact ? tan_phi : tan_phi_r, dus);
         return;
@@ -142,9 +131,10 @@ void SofteningLaw::update(JointHistory& h, double dun, double dus) const {
         h.tau = sign(h.tau) * a_after;
         ss_strength = shear(h.ups);
     }
-    h.damage = 1.0 - std::min(sn_strength, ss_strength);
-    if (h.damage >= 1.0) {
-        h.damage = 1.0;
+    const double damage = 1.0 - std::min(sn_strength, ss_strength);
+    h.damage = float(damage);
+    if (damage >= 1.0) {
+        h.damage = 1.0f;
         h.bonded = false;
         h.broken = sn_strength <= ss_strength ? JointState::broken_tension : JointState::broken_shear;
         h.upn = 0.0;

@@ -4,7 +4,7 @@
 // opening positive; Δus) to its stresses (σn compression positive; τ), updating
 // the contact's history in place. Laws are values validated once from the model
 // file, and the solver calls them per batch of contacts sharing a property set
-// (update_batch below: one dispatch per batch, not a virtual call per contact).
+// (contact::step_contacts: one dispatch per batch, not a virtual call per contact).
 //
 // Lemos–Sarhosis softening (paper §3.3, SPEC §4), as implemented:
 //   normal:  σn = −kn (un − upn)                     (total form; compression elastic)
@@ -24,6 +24,8 @@
 
 #include "core/model_spec.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <variant>
@@ -34,20 +36,22 @@ namespace bbm::contact {
 /// Contact state as output (ParaView `state` cell data).
 enum class JointState : std::uint8_t { intact, softening, broken_tension, broken_shear, sliding };
 
-/// Persistent history of one contact. Stresses in Pa, displacements in m.
-struct JointHistory {
+/// Persistent history of one contact, one 64-byte cache line. Stresses in Pa,
+/// displacements in m.
+struct alignas(64) JointHistory {
     double sn = 0.0;  ///< normal stress, compression positive
     double tau = 0.0; ///< shear stress
     double un = 0.0;  ///< normal displacement since bonding, opening positive
     double us = 0.0;  ///< shear displacement
     double upn = 0.0; ///< plastic (irreversible) opening
     double ups = 0.0; ///< accumulated plastic shear displacement (magnitude)
-    double damage = 0.0;
     double dissipated = 0.0; ///< plastic work per unit area, J/m²
+    float damage = 0.0f;     ///< D of SPEC §4 (output only: the law recomputes it)
     bool bonded = true;      ///< false once broken, or for contacts formed unbonded
     bool slipping = false;   ///< plastic shear in the last update
     JointState broken = JointState::intact; ///< broken_tension / broken_shear once broken
 };
+static_assert(sizeof(JointHistory) == 64);
 
 /// Piecewise-linear normalised strength S(up) over plastic displacement up:
 /// S(0) = 1, linear between breakpoints, 0 beyond the last. No breakpoint after 0
@@ -71,10 +75,17 @@ private:
     std::vector<double> s_{1.0};  ///< normalised strength at them
 };
 
+// Each law's update() is inline for the elastic path every contact takes most of
+// the time; plastic returns and failures go out of line.
 struct ElasticLaw {
     double kn, ks;
     explicit ElasticLaw(const JointPropertySpec& p) : kn(p.kn), ks(p.ks) {}
-    void update(JointHistory& h, double dun, double dus) const;
+    void update(JointHistory& h, double dun, double dus) const {
+        h.un += dun;
+        h.us += dus;
+        h.sn = -kn * h.un;
+        h.tau += ks * dus;
+    }
 };
 
 /// Coulomb slip with an optional brittle bond (tensile strength and cohesion that
@@ -82,14 +93,40 @@ struct ElasticLaw {
 struct CoulombLaw {
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     explicit CoulombLaw(const JointPropertySpec& p);
-    void update(JointHistory& h, double dun, double dus) const;
+    void update(JointHistory& h, double dun, double dus) const {
+        h.un += dun;
+        h.us += dus;
+        if (h.bonded) {
+            const double sn = -kn * h.un, tau = h.tau + ks * dus;
+            if (-sn <= tensile && std::abs(tau) <= cohesion + std::max(sn, 0.0) * tan_phi) {
+                h.sn = sn, h.tau = tau, h.slipping = false;
+                return;
+            }
+        }
+        update_inelastic(h, dus);
+    }
+    /// Bond failure or frictional contact; un, us already incremented.
+    void update_inelastic(JointHistory& h, double dus) const;
 };
 
 struct SofteningLaw {
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     SofteningCurve tension, shear;
     explicit SofteningLaw(const JointPropertySpec& p);
-    void update(JointHistory& h, double dun, double dus) const;
+    void update(JointHistory& h, double dun, double dus) const {
+        h.un += dun;
+        h.us += dus;
+        if (h.bonded && h.upn == 0.0 && h.ups == 0.0) { // intact: below both peaks?
+            const double sn = -kn * h.un, tau = h.tau + ks * dus;
+            if (-sn <= tensile && std::abs(tau) <= cohesion + std::max(sn, 0.0) * tan_phi) {
+                h.sn = sn, h.tau = tau, h.slipping = false;
+                return;
+            }
+        }
+        update_inelastic(h, dus);
+    }
+    /// Softening, failure or friction; un, us already incremented.
+    void update_inelastic(JointHistory& h, double dus) const;
 };
 
 using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw>;
@@ -99,18 +136,6 @@ double normal_stiffness(const JointLaw& law);
 double shear_stiffness(const JointLaw& law);
 /// Does a contact with this law start bonded (can it carry tension)?
 bool starts_bonded(const JointLaw& law);
-
-/// One dispatch per batch: contacts `ids` all use `law`.
-template <class Law>
-inline void update_batch(const Law& law, std::span<const int> ids, JointHistory* history,
-                         const double* dun, const double* dus) {
-    for (const int c : ids) law.update(history[c], dun[c], dus[c]);
-}
-
-inline void update_batch(const JointLaw& law, std::span<const int> ids, JointHistory* history,
-                         const double* dun, const double* dus) {
-    std::visit([&](const auto& l) { update_batch(l, ids, history, dun, dus); }, law);
-}
 
 /// Output state of a contact.
 JointState state_of(const JointHistory& h);

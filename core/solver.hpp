@@ -80,6 +80,7 @@ public:
         std::vector<std::uint8_t> removed;
         std::vector<int> region, material;
         std::vector<Vec2> local, vertex; ///< body and world vertex positions (CSR by first)
+        std::vector<double> inv_edge_length; ///< per vertex: 1 / length of the edge it starts
         std::vector<std::uint32_t> first;
         int count() const { return static_cast<int>(centroid.size()); }
     };
@@ -113,7 +114,7 @@ private:
     std::vector<Vec2> boundary_force_; ///< per boundary_blocks_ entry, last step
     struct Traction { int block; Vec2 offset; Vec2 force; }; ///< boundary point load, body frame
     std::vector<Traction> tractions_;
-    double contact_force_sum_ = 0.0;
+    double contact_force_sum_ = 0.0; ///< Σ|F|² of the last step
     struct Relaxing { int block; Vec2 force; double moment; };
     std::vector<Relaxing> relaxing_;
     long relax_total_ = 0, relax_left_ = 0;

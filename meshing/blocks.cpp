@@ -249,6 +249,36 @@ void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& danglin
     }
 }
 
+/// Z-order (Morton) key of a point in a box, 16 bits per axis.
+std::uint32_t morton(Vec2 p, const Box2& box) {
+    auto spread = [](std::uint32_t v) {
+        v &= 0xffff;
+        v = (v | (v << 8)) & 0x00ff00ff;
+        v = (v | (v << 4)) & 0x0f0f0f0f;
+        v = (v | (v << 2)) & 0x33333333;
+        return (v | (v << 1)) & 0x55555555;
+    };
+    const double sx = 65535.0 / std::max(box.width(), 1e-300), sy = 65535.0 / std::max(box.height(), 1e-300);
+    return spread(std::uint32_t((p.x - box.lo.x) * sx)) | (spread(std::uint32_t((p.y - box.lo.y) * sy)) << 1);
+}
+
+/// Blocks in space-filling-curve order, so that neighbours have nearby ids: the
+/// contact loop then reads block data from cache, not from random memory.
+void order_along_curve(RegionBlocks& rb) {
+    Box2 box;
+    std::vector<Vec2> c;
+    for (const auto& p : rb.polygons) c.push_back(centroid(p)), box.add(c.back());
+    std::vector<std::pair<std::uint32_t, int>> keys;
+    for (int k = 0; k < int(c.size()); ++k) keys.push_back({morton(c[k], box), k});
+    std::stable_sort(keys.begin(), keys.end());
+    RegionBlocks sorted;
+    for (const auto& [key, k] : keys) {
+        sorted.polygons.push_back(std::move(rb.polygons[k]));
+        sorted.parent.push_back(rb.parent[k]);
+    }
+    rb = std::move(sorted);
+}
+
 } // namespace
 
 BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats) {
@@ -342,6 +372,7 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
             }
         }
         split_by_dangling(rb, cut.dangling, tol);
+        order_along_curve(rb);
         const int parent_base = a.block_count();
         for (std::size_t k = 0; k < rb.polygons.size(); ++k)
             a.add_block(rb.polygons[k], r, reg.pattern.kind, parent_base + rb.parent[k]);

@@ -1,0 +1,105 @@
+// Benchmark: the explicit loop on a bonded Voronoi assembly in uniaxial
+// compression (issue 3): a W × 2W specimen of ~N blocks with the paper's joint
+// properties (SPEC §8), bottom row fixed, top row pushed down at a constant
+// velocity, quasi-static mode. Prints and writes JSON: blocks, contacts, steps,
+// seconds, steps/s and contact-updates/s (contacts × steps / s), peak memory.
+// Each scene is timed 3 times (the machine is a shared VM: run-to-run spread is
+// large); best and median are reported.
+// Usage: bench_solver [out.json] [steps]
+#include "core/solver.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <numbers>
+#include <sys/resource.h>
+
+using namespace bbm;
+
+namespace {
+
+AnalysisSpec paper_analysis(double width, double height, double rows) {
+    AnalysisSpec an;
+    JointPropertySpec p;
+    p.name = "bond";
+    p.law = JointPropertySpec::Law::softening;
+    p.kn = 96.6e9;
+    p.ks = 40.3e9;
+    p.tensile = 3e6;
+    p.cohesion = 9.5e6;
+    p.friction = 25;
+    p.tension_softening = {{1.7, 0.5}, {4.0, 0.0}};
+    p.shear_softening = {{1.3, 0.5}, {2.1, 0.0}};
+    an.joint_properties.push_back(p);
+    an.joint_assignments.push_back({"bond", {}, {}});
+    BoundarySpec bottom;
+    bottom.name = "bottom";
+    bottom.select.box = Box2{{-1, -1}, {width + 1, rows}};
+    bottom.vx = bottom.vy = bottom.omega = 0.0;
+    BoundarySpec top = bottom;
+    top.name = "top";
+    top.select.box = Box2{{-1, height - rows}, {width + 1, height + 1}};
+    top.vy = -1e-7;
+    an.boundaries = {bottom, top};
+    return an;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const char* out = argc > 1 ? argv[1] : "bench_solver.json";
+    const long steps = argc > 2 ? std::atol(argv[2]) : 2000;
+    nlohmann::json runs = nlohmann::json::array();
+    std::printf("%8s %9s %7s %9s %10s %14s %14s\n", "blocks", "contacts", "steps", "best s", "steps/s",
+                "c-upd/s best", "c-upd/s median");
+    for (int target : {2500, 10000, 40000}) {
+        const double d = 0.3, width = std::sqrt(target * std::numbers::pi * d * d / 4.0 / 2.0);
+        meshing::RegionSpec r;
+        r.name = "specimen";
+        r.outline.min = {0, 0};
+        r.outline.max = {width, 2 * width};
+        r.pattern.kind = meshing::PatternSpec::Kind::voronoi;
+        r.pattern.size = d;
+        r.pattern.lloyd_iterations = 2;
+        meshing::ModelGeometrySpec g;
+        g.regions.push_back(r);
+        const auto blocks = meshing::generate_blocks(g);
+        Solver s(blocks, paper_analysis(width, 2 * width, 0.5 * d));
+        for (int k = 0; k < 20; ++k) s.step(); // warm up
+        std::vector<double> secs;
+        for (int rep = 0; rep < 3; ++rep) {
+            const auto t0 = std::chrono::steady_clock::now();
+            for (long k = 0; k < steps; ++k) s.step();
+            secs.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        }
+        std::sort(secs.begin(), secs.end());
+        const double best = secs[0], median = secs[1];
+        const double updates = double(s.contacts().size()) * double(steps);
+        std::printf("%8d %9d %7ld %9.3f %10.1f %14.3e %14.3e\n", blocks.block_count(), s.contacts().size(), steps,
+                    best, steps / best, updates / best, updates / median);
+        runs.push_back({{"blocks", blocks.block_count()},
+                        {"contacts", s.contacts().size()},
+                        {"steps", steps},
+                        {"seconds_best", best},
+                        {"seconds_median", median},
+                        {"steps_per_second_best", steps / best},
+                        {"contact_updates_per_second_best", updates / best},
+                        {"contact_updates_per_second_median", updates / median},
+                        {"ratio", s.unbalanced_ratio()}});
+    }
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    std::printf("peak memory %.1f MB, threads 1\n", ru.ru_maxrss / 1024.0);
+    std::ofstream(out) << nlohmann::json{{"benchmark", "solver_bonded_voronoi_uniaxial"},
+                                         {"threads", 1},
+                                         {"runs", runs},
+                                         {"peak_rss_mb", ru.ru_maxrss / 1024.0}}
+                              .dump(2)
+                       << "\n";
+}
