@@ -149,6 +149,40 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     }
     if (!a.joints.empty()) mean_edge /= double(a.joints.size());
     corner_radius_ = 0.05 * mean_edge;
+
+    // Contacts formed during the run: the named set, or a built-in frictional one
+    // (φ 30°, no bond) as stiff as the stiffest set of the model.
+    if (!settings_.new_contact_property.empty()) {
+        const auto it = std::find(property_names_.begin(), property_names_.end(), settings_.new_contact_property);
+        if (it == property_names_.end())
+            throw InputError("", 0, "solver.new_contact_property",
+                             "unknown joint property '" + settings_.new_contact_property + "'");
+        new_contact_property_ = int(it - property_names_.begin());
+    } else {
+        JointPropertySpec unbonded;
+        unbonded.name = "unbonded (built-in)";
+        unbonded.law = JointPropertySpec::Law::coulomb;
+        unbonded.kn = unbonded.ks = 0.0;
+        for (const auto& l : laws_) {
+            unbonded.kn = std::max(unbonded.kn, contact::normal_stiffness(l));
+            unbonded.ks = std::max(unbonded.ks, contact::shear_stiffness(l));
+        }
+        if (unbonded.kn <= 0.0) unbonded.kn = unbonded.ks = 1e9;
+        unbonded.friction = 30.0;
+        new_contact_property_ = int(laws_.size());
+        laws_.push_back(contact::make_law(unbonded));
+        property_names_.push_back(unbonded.name);
+    }
+    double mean_area = 0.0;
+    for (double x : b_.area) mean_area += x;
+    mean_area /= std::max(1, nb);
+    tolerance_ = settings_.detection_tolerance > 0 ? settings_.detection_tolerance
+                                                   : 0.02 * std::sqrt(4.0 * mean_area / 3.141592653589793);
+    radius_.assign(nb, 0.0);
+    for (int i = 0; i < nb; ++i)
+        for (std::uint32_t v = a.first[i]; v < a.first[i + 1]; ++v) radius_[i] = std::max(radius_[i], norm(b_.local[v]));
+    detected_at_ = b_.centroid;
+    detected_theta_.assign(nb, 0.0);
     c_.rebuild_batches(int(laws_.size()));
 
     apply_boundaries(an, a);
@@ -377,8 +411,31 @@ void Solver::integrate() {
     ratio_ = mean_force > 0.0 ? max_unbalanced / mean_force : 0.0;
 }
 
+void Solver::detect_if_due() {
+    // Cheap check every few steps: has any block moved a good part of the tolerance?
+    if (steps_ % 4 != 0) return;
+    double moved = 0.0;
+    for (int i = 0; i < b_.count(); ++i)
+        if (!b_.removed[i])
+            moved = std::max(moved, norm(b_.centroid[i] - detected_at_[i]) +
+                                        std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i]);
+    if (moved < 0.25 * tolerance_) return;
+    contact::DetectionInput in{view(), b_.count(), b_.removed.data(), tolerance_, new_contact_property_, dt_};
+    const auto r = contact::update_contacts(c_, in);
+    detected_at_ = b_.centroid;
+    detected_theta_ = b_.theta;
+    detection_totals_.created += r.created;
+    detection_totals_.removed += r.removed;
+    detection_totals_.transferred += r.transferred;
+    if (r.created > 0 || r.removed > 0) {
+        c_.rebuild_batches(int(laws_.size()));
+        update_timestep();
+    }
+}
+
 void Solver::step() {
     update_vertices();
+    detect_if_due();
     update_contact_forces();
     add_external_forces();
     integrate();

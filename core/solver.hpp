@@ -1,7 +1,7 @@
 // bbm core: the explicit solver for rigid blocks (SPEC §5).
 //
 // One step is the list of stages of SPEC §5:
-//   1. (when due) contact detection update          — contact/ (later issue)
+//   1. (when due) contact detection update          — detect_if_due()
 //   2. contact forces from displacement increments   — update_contact_forces()
 //   3. zone stresses of deformable blocks            — fem/ (later issue)
 //   4. gravity, boundary tractions, applied loads    — add_external_forces()
@@ -24,6 +24,7 @@
 #pragma once
 
 #include "contact/contacts.hpp"
+#include "contact/detection.hpp"
 #include "core/model_spec.hpp"
 #include "meshing/blocks.hpp"
 
@@ -94,9 +95,13 @@ public:
     /// Block lists by boundary name.
     const std::vector<std::pair<std::string, std::vector<int>>>& boundary_blocks() const { return boundary_blocks_; }
     std::uint64_t state_hash() const;
+    /// Contacts created, removed and transferred by detection so far.
+    const contact::DetectionResult& detection_totals() const { return detection_totals_; }
+    double detection_tolerance() const { return tolerance_; }
 
 private:
     contact::BlockView view() const;
+    void detect_if_due();
     void update_vertices();
     void update_contact_forces();
     void add_external_forces();
@@ -119,6 +124,13 @@ private:
     std::vector<Relaxing> relaxing_;
     long relax_total_ = 0, relax_left_ = 0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
+    // Detection: tolerance, property of new contacts, motion since the last pass.
+    double tolerance_ = 0.0;
+    int new_contact_property_ = 0;
+    std::vector<double> radius_; ///< largest vertex distance from the centroid
+    std::vector<Vec2> detected_at_;
+    std::vector<double> detected_theta_;
+    contact::DetectionResult detection_totals_;
     long steps_ = 0;
 };
 

@@ -180,3 +180,52 @@ TEST_CASE("verification 7: uniform in-situ stress of a Voronoi assembly is in eq
         CHECK(st[2] == doctest::Approx(-3e6).epsilon(1e-9));
     }
 }
+
+TEST_CASE("verification 6: a block dropped on a bonded base forms contacts and comes to rest") {
+    auto m = load("dropped_block.toml");
+    Solver s(m.blocks, m.file.analysis);
+    Silent quiet;
+    run_stages(s, m.file.analysis.stages, quiet);
+    const auto& b = s.blocks();
+    const int block = b.count() - 1; // the last region's single block
+    CHECK(s.detection_totals().created > 0);
+    CHECK(b.centroid[block].y - b.centroid0[block].y == doctest::Approx(-0.5).epsilon(1e-3));
+    CHECK(s.unbalanced_ratio() < 1e-6);
+    CHECK(s.kinetic_energy() < 1e-6);
+    // No overlap beyond the tolerance, measured geometrically: no vertex of the block
+    // inside a base block, nor a base vertex inside the block, deeper than it.
+    auto depth_inside = [&](Vec2 x, int blk) {
+        const std::span<const Vec2> poly(b.vertex.data() + b.first[blk], b.vertex.data() + b.first[blk + 1]);
+        if (!point_in_polygon(x, poly)) return 0.0;
+        double d = INFINITY;
+        for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, distance_to_segment(x, poly[i], poly[(i + 1) % poly.size()]));
+        return d;
+    };
+    double deepest = 0.0;
+    for (int o = 0; o < block; ++o) {
+        for (auto v = b.first[block]; v < b.first[block + 1]; ++v) deepest = std::max(deepest, depth_inside(b.vertex[v], o));
+        for (auto v = b.first[o]; v < b.first[o + 1]; ++v) deepest = std::max(deepest, depth_inside(b.vertex[v], block));
+    }
+    INFO("deepest penetration " << deepest << " m, tolerance " << s.detection_tolerance());
+    CHECK(deepest < 0.01 * s.detection_tolerance());
+    // The weight is carried: vertical contact force on the block = m g.
+    double fy = 0.0;
+    const auto& c = s.contacts();
+    for (int i = 0; i < c.size(); ++i) {
+        if (c.vertex_block[i] == block) fy += contact::contact_force(c, i).y;
+        if (c.edge_block[i] == block) fy -= contact::contact_force(c, i).y;
+    }
+    CHECK(fy == doctest::Approx(2700.0 * 9.81).epsilon(1e-6));
+}
+
+TEST_CASE("verification 8: determinism — the state hash after a cracking run is pinned") {
+    auto m = load("determinism.toml");
+    Solver a(m.blocks, m.file.analysis), b(m.blocks, m.file.analysis);
+    Silent quiet;
+    run_stages(a, m.file.analysis.stages, quiet);
+    run_stages(b, m.file.analysis.stages, quiet);
+    CHECK(a.state_hash() == b.state_hash());
+    CHECK(a.cracks(contact::JointState::broken_tension) > 0);
+    // Pinned for this compiler and flags (g++ 12, Release, x86-64); see the model file.
+    CHECK(a.state_hash() == 282820589425937901ull);
+}

@@ -1,0 +1,154 @@
+#include "contact/detection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace bbm::contact {
+namespace {
+
+struct EdgeFrame {
+    double s;   ///< position along the edge, 0 at its start, 1 at its end
+    double gap; ///< signed distance along the outward normal
+};
+
+EdgeFrame frame(Vec2 x, Vec2 p, Vec2 q) {
+    const Vec2 d = q - p;
+    const double l2 = norm2(d), l = std::sqrt(l2);
+    return {dot(x - p, d) / l2, cross(d, x - p) / -l};
+}
+
+std::uint64_t pair_key(int a, int b) {
+    return (std::uint64_t(std::uint32_t(std::min(a, b))) << 32) | std::uint32_t(std::max(a, b));
+}
+
+int prev_vertex(const std::uint32_t* first, int block, int v) {
+    return v == int(first[block]) ? int(first[block + 1]) - 1 : v - 1;
+}
+
+} // namespace
+
+DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
+    const BlockView& b = in.blocks;
+    const double tol = in.tolerance;
+    DetectionResult res;
+
+    // 1–2. Transfer along the edge block's boundary, and removal of separated
+    // unbonded contacts.
+    std::vector<std::uint8_t> drop(c.size(), 0);
+    for (int i = 0; i < c.size(); ++i) {
+        const int A = c.vertex_block[i], B = c.edge_block[i];
+        if ((in.removed && (in.removed[A] || in.removed[B]))) {
+            drop[i] = 1;
+            continue;
+        }
+        const Vec2 x = b.vertex[c.vertex_id[i]];
+        EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
+        if (f.s < 0.0 || f.s > 1.0) {
+            const bool back = f.s < 0.0;
+            const int e0 = back ? prev_vertex(b.first, B, c.edge_id[i]) : c.edge_end[i];
+            const int e1 = back ? c.edge_id[i] : next_vertex(b.first, B, c.edge_end[i]);
+            const EdgeFrame g = frame(x, b.vertex[e0], b.vertex[e1]);
+            if (g.s >= 0.0 && g.s <= 1.0 && g.gap > -tol) {
+                c.edge_id[i] = e0;
+                c.edge_end[i] = e1;
+                f = g;
+                ++res.transferred;
+            }
+        }
+        const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
+        if (!c.history[i].bonded && (f.gap > tol || beyond > tol)) drop[i] = 1;
+    }
+    for (std::uint8_t d : drop) res.removed += d;
+    if (res.removed > 0) c.remove_if_flagged(drop);
+
+    // Existing contact points per block pair (either way round).
+    std::unordered_map<std::uint64_t, std::vector<Vec2>> existing;
+    for (int i = 0; i < c.size(); ++i)
+        existing[pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
+
+    // 3. Broad phase: inflated boxes in a uniform grid.
+    const int nb = in.block_count;
+    std::vector<Box2> box(nb);
+    Box2 all;
+    double mean_size = 0.0;
+    int active = 0;
+    for (int k = 0; k < nb; ++k) {
+        if (in.removed && in.removed[k]) continue;
+        for (std::uint32_t v = b.first[k]; v < b.first[k + 1]; ++v) box[k].add(b.vertex[v]);
+        box[k].lo -= Vec2{tol, tol};
+        box[k].hi += Vec2{tol, tol};
+        all.add(box[k].lo);
+        all.add(box[k].hi);
+        mean_size += box[k].width() + box[k].height();
+        ++active;
+    }
+    if (active < 2) return res;
+    const double cell = mean_size / active;
+    const int nx = std::clamp(int(all.width() / cell) + 1, 1, 1 << 14);
+    const int ny = std::clamp(int(all.height() / cell) + 1, 1, 1 << 14);
+    auto cx = [&](double x) { return std::clamp(int((x - all.lo.x) / cell), 0, nx - 1); };
+    auto cy = [&](double y) { return std::clamp(int((y - all.lo.y) / cell), 0, ny - 1); };
+    std::vector<std::vector<int>> grid(std::size_t(nx) * ny);
+    for (int k = 0; k < nb; ++k) {
+        if (in.removed && in.removed[k]) continue;
+        for (int j = cy(box[k].lo.y); j <= cy(box[k].hi.y); ++j)
+            for (int i = cx(box[k].lo.x); i <= cx(box[k].hi.x); ++i) grid[std::size_t(j) * nx + i].push_back(k);
+    }
+
+    // Narrow phase for one ordered pair: vertices of A against edges of B.
+    auto try_vertices = [&](int A, int B) {
+        for (std::uint32_t v = b.first[A]; v < b.first[A + 1]; ++v) {
+            const Vec2 x = b.vertex[v];
+            if (x.x < box[B].lo.x || x.x > box[B].hi.x || x.y < box[B].lo.y || x.y > box[B].hi.y) continue;
+            int best = -1;
+            double best_gap = INFINITY;
+            for (std::uint32_t e = b.first[B]; e < b.first[B + 1]; ++e) {
+                const int e1 = next_vertex(b.first, B, int(e));
+                const EdgeFrame f = frame(x, b.vertex[e], b.vertex[e1]);
+                const double len = 1.0 / b.inv_edge_length[e];
+                const double beyond = std::max({0.0, -f.s, f.s - 1.0}) * len;
+                if (f.gap > tol || f.gap < -tol || beyond > tol) continue;
+                const double dist = std::abs(f.gap) + beyond;
+                if (dist < best_gap) best_gap = dist, best = int(e);
+            }
+            if (best < 0) continue;
+            auto& points = existing[pair_key(A, B)];
+            bool known = false;
+            for (Vec2 p : points) known = known || norm(p - x) <= tol;
+            if (known) continue;
+            const int e1 = next_vertex(b.first, B, best);
+            const Vec2 tb = b.inv_edge_length[best] * (b.vertex[e1] - b.vertex[best]);
+            // The vertex's share: half of its adjacent edge that lies most along B's edge.
+            const int vp = prev_vertex(b.first, A, int(v)), vn = next_vertex(b.first, A, int(v));
+            const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
+            const double l = 0.5 * (std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? norm(ep) : norm(en));
+            JointHistory h;
+            h.bonded = false;
+            const Vec2 n{tb.y, -tb.x};
+            const Vec2 vr = (b.velocity[A] + b.omega[A] * perp(x - b.centroid[A])) -
+                            (b.velocity[B] + b.omega[B] * perp(x - b.centroid[B]));
+            h.un = frame(x, b.vertex[best], b.vertex[e1]).gap - dot(vr, n) * in.dt;
+            c.add(A, int(v), B, best, e1, l, in.new_contact_property, h);
+            points.push_back(x);
+            ++res.created;
+        }
+    };
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const auto& list = grid[std::size_t(j) * nx + i];
+            for (std::size_t p = 0; p < list.size(); ++p)
+                for (std::size_t q = p + 1; q < list.size(); ++q) {
+                    const int A = std::min(list[p], list[q]), B = std::max(list[p], list[q]);
+                    const Box2 &ba = box[A], &bb = box[B];
+                    if (ba.hi.x < bb.lo.x || bb.hi.x < ba.lo.x || ba.hi.y < bb.lo.y || bb.hi.y < ba.lo.y) continue;
+                    // Handle the pair once: in the cell holding the low corner of the overlap.
+                    if (cx(std::max(ba.lo.x, bb.lo.x)) != i || cy(std::max(ba.lo.y, bb.lo.y)) != j) continue;
+                    try_vertices(A, B);
+                    try_vertices(B, A);
+                }
+        }
+    return res;
+}
+
+} // namespace bbm::contact

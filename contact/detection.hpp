@@ -1,0 +1,44 @@
+// bbm contact: detection of contacts during large displacements (SPEC §3).
+//
+// The initial contacts come from the joint topology; this pass keeps the contact
+// set right as blocks move, and runs only when some block has moved more than a
+// fraction of the tolerance since the previous pass (Solver decides when):
+//   1. a contact whose vertex has left its edge passes, with its history, to the
+//      neighbouring edge of the same block if the vertex now projects onto it;
+//   2. an unbonded (or broken) contact whose vertex is farther than the tolerance
+//      from the edge, or beyond its ends, is removed — bonded ones never are;
+//   3. broad phase: block boxes inflated by the tolerance in a uniform grid
+//      (O(N)); narrow phase: each vertex of one block within the tolerance of an
+//      edge of the other (projecting onto it, or near its end: corner contact)
+//      becomes a new unbonded contact, unless the two blocks already have a
+//      contact at that point (either way round).
+// A new contact gets the unbonded property set, its current gap as un, and as
+// length half of the vertex's adjacent edge that lies most nearly along the
+// other block's edge (that edge's share at this end).
+#pragma once
+
+#include "contact/contacts.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace bbm::contact {
+
+struct DetectionInput {
+    BlockView blocks;
+    int block_count = 0;
+    const std::uint8_t* removed = nullptr; ///< excavated blocks take no part
+    double tolerance = 0.0;
+    int new_contact_property = 0;
+    /// The step about to run: its contact update adds v·Δt, motion already in the
+    /// measured gap, so a new contact's un starts at gap − v_rel·n Δt.
+    double dt = 0.0;
+};
+
+struct DetectionResult {
+    int created = 0, removed = 0, transferred = 0;
+};
+
+DetectionResult update_contacts(Contacts& c, const DetectionInput& in);
+
+} // namespace bbm::contact
