@@ -74,8 +74,9 @@ double step_batch(const Law& law, const std::vector<int>& ids, Contacts& c, cons
         const double inv_len = inv_edge[e0[i]];
         Vec2 t = inv_len * (q - p);
         Vec2 n{t.y, -t.x};
-        const double s = dot(x - p, t) * inv_len, margin = 1e-6 * corner_radius * inv_len;
-        if (s < -margin || s > 1.0 + margin) [[unlikely]] {
+        JointHistory& h = hist[i];
+        const double s = dot(x - p, t) * inv_len;
+        if (!h.bonded && (s < 0.0 || s > 1.0)) [[unlikely]] {
             const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * n);
             const double rl = norm(r);
             if (rl > 0.0) n = r / rl, t = Vec2{-n.y, n.x};
@@ -84,7 +85,6 @@ double step_batch(const Law& law, const std::vector<int>& ids, Contacts& c, cons
         const Vec2 vr = (velocity[A] + omega[A] * perp(ra)) - (velocity[B] + omega[B] * perp(rb));
         const double du_n = dot(vr, n) * dt, du_s = dot(vr, t) * dt;
         normal[i] = n;
-        JointHistory& h = hist[i];
         law.update(h, du_n, du_s);
         const Vec2 f = len[i] * (h.sn * n - h.tau * t);
         force[A] += f;

@@ -10,11 +10,16 @@
 // F = L (σn n − τ t), on B its opposite, both applied at the vertex; L is the
 // contact's share of the joint (half of each joint record at each of its ends).
 //
-// Corners: while a vertex lies beyond the end of its edge (a convex corner of B)
-// the normal is taken from B's rounded corner — the direction from a centre set
-// back by r = `corner_radius` behind the corner to the vertex — which turns
-// continuously from one edge's normal to the next's; the contact passes to the
-// neighbouring edge, with its history, once the vertex projects onto that edge.
+// Corners: while the vertex of an unbonded (or broken) contact lies beyond the end
+// of its edge (a convex corner of B) the normal is taken from B's rounded corner —
+// the direction from a centre set back by r = `corner_radius` behind the corner to
+// the vertex — which turns continuously from one edge's normal to the next's; the
+// contact passes to the neighbouring edge, with its history, once the vertex is
+// past the corner by more than the detection tolerance and projects onto that
+// edge. A bonded contact keeps its edge and the edge's normal: an intact joint
+// moves by elastic amounts only, and its contacts sit exactly on edge ends, where
+// rounding noise must not turn the normal of a loaded bond (that would add a
+// spurious geometric stiffness F/r).
 //
 // Storage is flat (structure of arrays) and indexed by contact id; histories are
 // one fixed record per contact (contact/joint_law.hpp). Contacts are grouped in
@@ -74,10 +79,9 @@ inline void contact_kinematics(Contacts& c, int i, const BlockView& b, double co
     const double inv_len = b.inv_edge_length[c.edge_id[i]];
     Vec2 t = inv_len * (q - p);
     Vec2 nrm{t.y, -t.x}; // outward normal of a counter-clockwise polygon's edge
-    // Beyond an end of the edge (past a rounding-level margin, since bonded
-    // contacts sit exactly on edge ends): normal of the rounded corner.
-    const double s = dot(x - p, t) * inv_len, margin = 1e-6 * corner_radius * inv_len;
-    if (s < -margin || s > 1.0 + margin) [[unlikely]] {
+    // An unbonded contact beyond an end of its edge: normal of the rounded corner.
+    const double s = dot(x - p, t) * inv_len;
+    if (!c.history[i].bonded && (s < 0.0 || s > 1.0)) [[unlikely]] {
         const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * nrm);
         const double rl = norm(r);
         if (rl > 0.0) {

@@ -44,7 +44,9 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
         }
         const Vec2 x = b.vertex[c.vertex_id[i]];
         EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
-        if (f.s < 0.0 || f.s > 1.0) {
+        if (c.history[i].bonded) continue; // intact joints keep their edges (contacts.hpp)
+        const double len = 1.0 / b.inv_edge_length[c.edge_id[i]];
+        if (std::max(-f.s, f.s - 1.0) * len > tol) {
             const bool back = f.s < 0.0;
             const int e0 = back ? prev_vertex(b.first, B, c.edge_id[i]) : c.edge_end[i];
             const int e1 = back ? c.edge_id[i] : next_vertex(b.first, B, c.edge_end[i]);
@@ -57,7 +59,7 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
             }
         }
         const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
-        if (!c.history[i].bonded && (f.gap > tol || beyond > tol)) drop[i] = 1;
+        if (f.gap > tol || beyond > 2.0 * tol) drop[i] = 1;
     }
     for (std::uint8_t d : drop) res.removed += d;
     if (res.removed > 0) c.remove_if_flagged(drop);
