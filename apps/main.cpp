@@ -1,12 +1,14 @@
 // bbm: the command-line program. Subcommands:
 //   bbm mesh MODEL.toml --out DIR   generate the block model, write VTK and a summary
 //   bbm run MODEL.toml --out DIR    generate it and run the model file's stages
+//   bbm ucs | tension | biaxial | brazilian [flags]   numerical lab tests (SPEC §8)
 // Exit status: 0 success, 2 bad input (the message names file, line and key),
 // 1 any other failure. Earlier output in DIR is only replaced by complete files.
 #include "apps/model_input.hpp"
 #include "apps/picture.hpp"
 #include "apps/vtk_output.hpp"
 #include "core/analysis.hpp"
+#include "core/labtest.hpp"
 #include "core/error.hpp"
 #include "meshing/blocks.hpp"
 
@@ -18,6 +20,8 @@
 #include <csignal>
 #include <fstream>
 #include <sstream>
+#include <mutex>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -251,6 +255,181 @@ int run_model(const std::string& model_path, const fs::path& out, bool quiet) {
                      solver->cracks(contact::JointState::broken_shear), out.string().c_str());
     return interrupted ? 130 : 0;
 }
+
+/// Command-line values of the lab tests, defaults = the paper's calibration run.
+struct LabTestCli {
+    LabTestOptions o = LabTestOptions::paper_ucs();
+    std::string pattern = "voronoi";
+    std::vector<double> tension_softening{0.5, 1.7, 4.0}, shear_softening{0.5, 1.3, 2.1};
+    std::string platens = "rough";
+    double deformable_fraction = 0.0;
+    int realizations = 1;
+    int threads = 0;
+    std::string out = "out";
+};
+
+void add_labtest_options(CLI::App* sub, LabTestCli& c, bool quiet_flag, bool& quiet) {
+    (void)quiet_flag;
+    auto& o = c.o;
+    sub->add_option("--pattern", c.pattern, "Inner-block pattern")
+        ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
+        ->capture_default_str();
+    sub->add_option("--size", o.size, "Mean block size d (m)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--width", o.width, "Specimen width (m); brazilian: disc diameter")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--height", o.height, "Specimen height (m)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--seed", o.seed, "Random seed of the block pattern")->capture_default_str();
+    sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations")->check(CLI::NonNegativeNumber)->capture_default_str();
+    sub->add_option("--kn", o.joint.kn, "Joint normal stiffness (Pa/m)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--ks", o.joint.ks, "Joint shear stiffness (Pa/m)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--tensile", o.joint.tensile, "Joint tensile strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--cohesion", o.joint.cohesion, "Joint cohesion (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(CLI::Range(0.0, 89.9))->capture_default_str();
+    sub->add_option("--residual-friction", o.joint.residual_friction, "Friction after failure (degrees; default: --friction)")
+        ->check(CLI::Range(0.0, 89.9));
+    sub->add_option("--tension-softening", c.tension_softening, "Tension softening b1,a1,a2 (SPEC §4)")
+        ->delimiter(',')->expected(3)->capture_default_str();
+    sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
+        ->delimiter(',')->expected(3)->capture_default_str();
+    sub->add_option("--density", o.density, "Block density (kg/m³)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--deformable-fraction", c.deformable_fraction,
+                    "Fraction f of the deformation given to deformable blocks (needs deformable blocks: not yet available)")
+        ->check(CLI::Range(0.0, 0.99));
+    sub->add_option("--strain-rate", o.strain_per_step, "Platen velocity over specimen height, per step")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--platens", c.platens, "rough: platen rows held horizontally; smooth: free to slide")
+        ->check(CLI::IsMember({"rough", "smooth"}))->capture_default_str();
+    sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
+        ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--threads", c.threads, "Threads for realizations (0 = all cores)")->check(CLI::NonNegativeNumber);
+    sub->add_option("-o,--out", c.out, "Output directory")->capture_default_str();
+    sub->add_flag("-q,--quiet", quiet, "No progress, only errors");
+}
+
+nlohmann::json labtest_json(const LabTestResult& r) {
+    return {{"E", r.E}, {"nu", r.nu}, {"peak_stress", r.peak_stress}, {"strain_at_peak", r.strain_at_peak},
+            {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
+            {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
+            {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
+            {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
+                                   {"within_30_of_vertical", r.cracks_near_vertical},
+                                   {"within_30_of_horizontal", r.cracks_near_horizontal}}}};
+}
+
+void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path& dir, const std::string& title) {
+    fs::create_directories(dir / "vtk");
+    std::ostringstream csv;
+    csv << "step,axial_strain,axial_stress_Pa,lateral_strain,cracks_tensile,cracks_shear\n";
+    csv.precision(10);
+    io::Series curve{"stress", {}, {}};
+    for (const auto& p : r.curve) {
+        csv << p.step << ',' << p.axial_strain << ',' << p.axial_stress << ',' << p.lateral_strain << ','
+            << p.cracks_tensile << ',' << p.cracks_shear << '\n';
+        curve.x.push_back(1e3 * p.axial_strain);
+        curve.y.push_back(1e-6 * p.axial_stress);
+    }
+    io::write_text_atomically(dir / "stress_strain.csv", csv.str());
+    char label[200];
+    std::snprintf(label, sizeof label, "%s: E = %.2f GPa, peak = %.2f MPa", title.c_str(), r.E / 1e9, r.peak_stress / 1e6);
+    io::draw_curves({curve}, "axial strain (1e-3)", "axial stress (MPa)", dir / "stress_strain.png", label);
+    io::FailurePlotOptions fo;
+    fo.title = title;
+    io::draw_failure(s, dir / "failure.png", fo);
+    io::draw_failure(s, dir / "failure.svg", fo);
+    io::write_state_blocks_vtu(s, dir / "vtk/blocks_final.vtu");
+    io::write_state_contacts_vtu(s, dir / "vtk/contacts_final.vtu");
+    io::write_pvd(dir / "result.pvd", {{double(r.steps), "vtk/blocks_final.vtu"}, {double(r.steps), "vtk/contacts_final.vtu"}});
+    io::write_text_atomically(dir / "summary.json", labtest_json(r).dump(2) + "\n");
+}
+
+int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* name, bool quiet) {
+    auto& o = c.o;
+    o.kind = kind;
+    if (c.deformable_fraction > 0)
+        throw InputError("--deformable-fraction", 0, "", "deformable inner blocks are not available yet (issue 4); use rigid blocks");
+    const std::map<std::string, meshing::PatternSpec::Kind> kinds{
+        {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
+        {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
+        {"brick", meshing::PatternSpec::Kind::brick}};
+    o.pattern = kinds.at(c.pattern);
+    auto curve = [](const std::vector<double>& v, const char* flag) {
+        const double b1 = v[0], a1 = v[1], a2 = v[2];
+        if (!(b1 > 0 && b1 < 1 && a1 > 1 && a2 > a1 && a2 > 0 && a1 - b1 < a2))
+            throw InputError(flag, 0, "", "needs 0 < b1 < 1, 1 < a1 < a2 (points (a1, b1), (a2, 0) after the peak)");
+        return std::vector<std::pair<double, double>>{{a1, b1}, {a2, 0.0}};
+    };
+    o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
+    o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
+    o.rough_platens = c.platens == "rough";
+    const fs::path out = c.out;
+    fs::create_directories(out);
+    const int n = c.realizations;
+    const int threads = std::max(1, std::min(n, c.threads > 0 ? c.threads : int(std::thread::hardware_concurrency())));
+    std::vector<LabTestResult> results(n);
+    std::mutex print;
+    if (!quiet)
+        std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s\n", name,
+                     c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
+                     n > 1 ? "s" : "", threads, threads > 1 ? "s" : "");
+    std::atomic<int> next{0};
+    auto worker = [&] {
+        for (int k = next++; k < n; k = next++) {
+            LabTestOptions ok = o;
+            ok.seed = o.seed + k;
+            const fs::path dir = n > 1 ? out / ("realization_" + std::to_string(k + 1)) : out;
+            auto last = std::chrono::steady_clock::now();
+            auto progress = [&](const StressStrainPoint& p) {
+                if (quiet || n > 1) return;
+                const auto now = std::chrono::steady_clock::now();
+                if (std::chrono::duration<double>(now - last).count() < 1.0) return;
+                last = now;
+                std::fprintf(stderr, "\r  step %8ld  strain %.3e  stress %7.2f MPa  cracks %5d T %5d S   ", p.step,
+                             p.axial_strain, p.axial_stress / 1e6, p.cracks_tensile, p.cracks_shear);
+            };
+            const LabTestResult r = run_labtest(ok, progress, [&](const Solver& s, const LabTestResult& res) {
+                char title[64];
+                std::snprintf(title, sizeof title, "%s, seed %llu", name, static_cast<unsigned long long>(ok.seed));
+                write_labtest_files(res, s, dir, title);
+            });
+            results[k] = r;
+            if (!quiet) {
+                std::lock_guard lock(print);
+                std::fprintf(stderr, "\r  seed %llu: E %.2f GPa  nu %.3f  peak %.2f MPa at strain %.3e  cracks %d T %d S  %ld steps  %.1f s\n",
+                             static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.nu, r.peak_stress / 1e6,
+                             r.strain_at_peak, r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+    if (n > 1) {
+        auto stats = [&](auto get) {
+            double m = 0, v = 0;
+            for (const auto& r : results) m += get(r);
+            m /= n;
+            for (const auto& r : results) v += (get(r) - m) * (get(r) - m);
+            return nlohmann::json{{"mean", m}, {"std", n > 1 ? std::sqrt(v / (n - 1)) : 0.0}};
+        };
+        nlohmann::json per = nlohmann::json::array();
+        for (const auto& r : results) per.push_back(labtest_json(r));
+        const nlohmann::json summary{{"test", name},
+                                     {"realizations", n},
+                                     {"E", stats([](const LabTestResult& r) { return r.E; })},
+                                     {"nu", stats([](const LabTestResult& r) { return r.nu; })},
+                                     {"peak_stress", stats([](const LabTestResult& r) { return r.peak_stress; })},
+                                     {"strain_at_peak", stats([](const LabTestResult& r) { return r.strain_at_peak; })},
+                                     {"per_realization", per}};
+        io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
+        if (!quiet)
+            std::fprintf(stderr, "mean of %d: E %.2f GPa, nu %.3f, peak %.2f MPa; wrote %s/summary.json\n", n,
+                         summary["E"]["mean"].get<double>() / 1e9, summary["nu"]["mean"].get<double>(),
+                         summary["peak_stress"]["mean"].get<double>() / 1e6, out.string().c_str());
+    }
+    return 0;
+}
 } // namespace
 
 int main(int argc, char** argv) {
@@ -289,6 +468,25 @@ int main(int argc, char** argv) {
     run->add_option("-o,--out", run_out, "Output directory (created if missing)")->capture_default_str();
     run->add_flag("-q,--quiet", quiet, "No progress, only errors");
 
+    // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
+    LabTestCli ucs_cli, tension_cli, biaxial_cli, brazilian_cli;
+    auto* ucs = app.add_subcommand("ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, "
+                                          "the paper's calibration run (Voronoi 0.3 m, 8 m x 16 m, SPEC §8). Writes "
+                                          "summary.json (E, nu, peak_stress, ...), stress_strain.csv/.png, failure.png/.svg "
+                                          "and result.pvd in --out.");
+    add_labtest_options(ucs, ucs_cli, true, quiet);
+    auto* tension = app.add_subcommand("tension", "Direct uniaxial tension test (same options as ucs).");
+    add_labtest_options(tension, tension_cli, true, quiet);
+    auto* biaxial = app.add_subcommand("biaxial", "Compression with a constant lateral stress (same options as ucs).");
+    add_labtest_options(biaxial, biaxial_cli, true, quiet);
+    biaxial->add_option("--confinement", biaxial_cli.o.confinement, "Lateral stress (Pa, compression positive)")
+        ->required()
+        ->check(CLI::NonNegativeNumber);
+    auto* brazilian = app.add_subcommand("brazilian", "Brazilian test: a disc of diameter --width loaded across a "
+                                                      "diameter; reports the indirect tensile strength 2P/(pi D).");
+    brazilian_cli.o.width = 4.0;
+    add_labtest_options(brazilian, brazilian_cli, true, quiet);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -297,6 +495,10 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) return run_model(run_model_path, run_out, quiet);
+        if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);
+        if (*tension) return run_labtest_command(tension_cli, LabTestOptions::Kind::tension, "tension", quiet);
+        if (*biaxial) return run_labtest_command(biaxial_cli, LabTestOptions::Kind::biaxial, "biaxial", quiet);
+        if (*brazilian) return run_labtest_command(brazilian_cli, LabTestOptions::Kind::brazilian, "brazilian", quiet);
         if (*mesh) {
             io::PictureOptions picture;
             if (window.size() == 4) {

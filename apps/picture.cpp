@@ -1,9 +1,14 @@
 #include "apps/picture.hpp"
 
+#include "core/solver.hpp"
+
 #include <cairo-svg.h>
 #include <cairo.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace bbm::io {
@@ -13,6 +18,7 @@ struct Rgb { double r, g, b; };
 
 constexpr std::array<Rgb, 6> region_fill{{{0.93, 0.90, 0.82}, {0.80, 0.87, 0.93}, {0.85, 0.93, 0.82},
                                           {0.95, 0.85, 0.85}, {0.88, 0.85, 0.95}, {0.95, 0.93, 0.80}}};
+constexpr Rgb tensile_red{0.85, 0.10, 0.10}, shear_blue{0.10, 0.30, 0.90};
 
 Rgb joint_colour(meshing::JointTag t) {
     using T = meshing::JointTag;
@@ -26,34 +32,101 @@ Rgb joint_colour(meshing::JointTag t) {
     return {0, 0, 0};
 }
 
+/// A cairo surface writing to `file` + ".tmp", renamed over `file` by finish().
+class Canvas {
+public:
+    Canvas(const std::filesystem::path& file, int w, int h)
+        : file_(file), tmp_(file.string() + ".tmp"), svg_(file.extension() == ".svg") {
+        surface_ = svg_ ? cairo_svg_surface_create(tmp_.c_str(), w, h)
+                        : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h);
+        cr = cairo_create(surface_);
+        cairo_set_source_rgb(cr, 1, 1, 1);
+        cairo_paint(cr);
+    }
+    ~Canvas() {
+        if (cr) cairo_destroy(cr);
+        if (surface_) cairo_surface_destroy(surface_);
+        if (!done_) {
+            std::error_code ec;
+            std::filesystem::remove(tmp_, ec);
+        }
+    }
+    Canvas(const Canvas&) = delete;
+    Canvas& operator=(const Canvas&) = delete;
+
+    void finish() {
+        cairo_destroy(cr);
+        cr = nullptr;
+        cairo_status_t status;
+        if (svg_) {
+            cairo_surface_finish(surface_);
+            status = cairo_surface_status(surface_);
+        } else {
+            status = cairo_surface_write_to_png(surface_, tmp_.c_str());
+        }
+        cairo_surface_destroy(surface_);
+        surface_ = nullptr;
+        if (status != CAIRO_STATUS_SUCCESS)
+            throw std::runtime_error("cannot write '" + file_.string() + "': " + cairo_status_to_string(status));
+        std::filesystem::rename(tmp_, file_);
+        done_ = true;
+    }
+
+    cairo_t* cr = nullptr;
+
+private:
+    std::filesystem::path file_, tmp_;
+    bool svg_;
+    bool done_ = false;
+    cairo_surface_t* surface_ = nullptr;
+};
+
+/// Model coordinates (y up) over `box`, fitted to width_px; returns the pixel size.
+struct View {
+    int w, h;
+    double margin, scale;
+    View(const Box2& box, int width_px, double extra_bottom = 0.0)
+        : w(width_px), margin(0.02 * width_px), scale((width_px - 2 * margin) / box.width()) {
+        h = int(box.height() * scale + 2 * margin + extra_bottom);
+    }
+    void apply(cairo_t* cr, const Box2& box, double extra_bottom = 0.0) const {
+        cairo_save(cr);
+        cairo_translate(cr, margin, h - margin - extra_bottom);
+        cairo_scale(cr, scale, -scale);
+        cairo_translate(cr, -box.lo.x, -box.lo.y);
+        cairo_rectangle(cr, box.lo.x, box.lo.y, box.width(), box.height());
+        cairo_clip(cr);
+    }
+};
+
+void polygon_path(cairo_t* cr, std::span<const Vec2> p) {
+    cairo_move_to(cr, p[0].x, p[0].y);
+    for (std::size_t i = 1; i < p.size(); ++i) cairo_line_to(cr, p[i].x, p[i].y);
+    cairo_close_path(cr);
+}
+
+void text(cairo_t* cr, double x, double y, const std::string& s, double size = 14, bool centred = false) {
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, size);
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s.c_str(), &e);
+    cairo_move_to(cr, centred ? x - 0.5 * e.width : x, y);
+    cairo_show_text(cr, s.c_str());
+}
+
 } // namespace
 
 void draw_blocks(const meshing::BlockAssembly& a, const std::filesystem::path& file,
                  const PictureOptions& options) {
     Box2 box = options.window;
     if (box.empty()) box = bounding_box(a.points);
-    const double margin = 0.02 * std::max(box.width(), box.height());
-    const double scale = (options.width_px - 2 * margin) / box.width();
-    const int w = options.width_px, h = int(box.height() * scale + 2 * margin);
-    const auto tmp = std::filesystem::path(file.string() + ".tmp");
-    const bool svg = file.extension() == ".svg";
-    cairo_surface_t* surface = svg ? cairo_svg_surface_create(tmp.c_str(), w, h)
-                                   : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h);
-    cairo_t* cr = cairo_create(surface);
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-    // Model coordinates, y up.
-    cairo_translate(cr, margin, h - margin);
-    cairo_scale(cr, scale, -scale);
-    cairo_translate(cr, -box.lo.x, -box.lo.y);
-    cairo_rectangle(cr, box.lo.x, box.lo.y, box.width(), box.height());
-    cairo_clip(cr);
-    const double px = 1.0 / scale;
+    const View view(box, options.width_px);
+    Canvas canvas(file, view.w, view.h);
+    cairo_t* cr = canvas.cr;
+    view.apply(cr, box);
+    const double px = 1.0 / view.scale;
     for (int b = 0; b < a.block_count(); ++b) {
-        const auto p = a.block(b);
-        cairo_move_to(cr, p[0].x, p[0].y);
-        for (std::size_t i = 1; i < p.size(); ++i) cairo_line_to(cr, p[i].x, p[i].y);
-        cairo_close_path(cr);
+        polygon_path(cr, a.block(b));
         const Rgb c = region_fill[a.region[b] % region_fill.size()];
         cairo_set_source_rgb(cr, c.r, c.g, c.b);
         cairo_fill_preserve(cr);
@@ -72,21 +145,136 @@ void draw_blocks(const meshing::BlockAssembly& a, const std::filesystem::path& f
             cairo_stroke(cr);
         }
     }
-    cairo_destroy(cr);
-    cairo_status_t status = CAIRO_STATUS_SUCCESS;
-    if (svg) {
-        cairo_surface_finish(surface);
-        status = cairo_surface_status(surface);
-    } else {
-        status = cairo_surface_write_to_png(surface, tmp.c_str());
+    cairo_restore(cr);
+    canvas.finish();
+}
+
+void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o) {
+    const auto& b = s.blocks();
+    Box2 box = o.window;
+    if (box.empty())
+        for (int i = 0; i < b.count(); ++i)
+            if (!b.removed[i])
+                for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.vertex[v]);
+    const double legend = 40.0;
+    const View view(box, o.width_px, legend);
+    Canvas canvas(file, view.w, view.h);
+    cairo_t* cr = canvas.cr;
+    double umax = 0.0;
+    for (int i = 0; i < b.count(); ++i)
+        if (!b.removed[i]) umax = std::max(umax, norm(b.centroid[i] - b.centroid0[i]));
+    view.apply(cr, box, legend);
+    const double px = 1.0 / view.scale;
+    for (int i = 0; i < b.count(); ++i) {
+        if (b.removed[i]) continue;
+        polygon_path(cr, {b.vertex.data() + b.first[i], b.vertex.data() + b.first[i + 1]});
+        // Light grey for still blocks to ochre for the most displaced.
+        const double f = umax > 0 ? std::sqrt(norm(b.centroid[i] - b.centroid0[i]) / umax) : 0.0;
+        cairo_set_source_rgb(cr, 0.92 - 0.05 * f, 0.92 - 0.25 * f, 0.92 - 0.6 * f);
+        cairo_fill_preserve(cr);
+        cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 0.7);
+        cairo_set_line_width(cr, 0.4 * px);
+        cairo_stroke(cr);
     }
-    cairo_surface_destroy(surface);
-    if (status != CAIRO_STATUS_SUCCESS) {
-        std::error_code ec;
-        std::filesystem::remove(tmp, ec);
-        throw std::runtime_error("cannot write '" + file.string() + "': " + cairo_status_to_string(status));
+    const auto& c = s.contacts();
+    cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+    for (int i = 0; i < c.size(); ++i) {
+        const auto mode = c.history[i].broken;
+        if (mode == contact::JointState::intact) continue;
+        const Rgb col = mode == contact::JointState::broken_tension ? tensile_red : shear_blue;
+        const Vec2 x = b.vertex[c.vertex_id[i]];
+        const Vec2 mid = 0.5 * (b.vertex[c.edge_id[i]] + b.vertex[c.edge_end[i]]);
+        const Vec2 t = contact::tangent_of(c.normal[i]);
+        const Vec2 y = x + (dot(mid - x, t) >= 0 ? 1.0 : -1.0) * c.length[i] * t;
+        cairo_set_source_rgb(cr, col.r, col.g, col.b);
+        cairo_set_line_width(cr, 2.0 * px);
+        cairo_move_to(cr, x.x, x.y);
+        cairo_line_to(cr, y.x, y.y);
+        cairo_stroke(cr);
     }
-    std::filesystem::rename(tmp, file);
+    cairo_restore(cr);
+    // Legend.
+    const double y0 = view.h - 0.5 * legend + 5;
+    char buf[160];
+    cairo_set_line_width(cr, 3);
+    cairo_set_source_rgb(cr, tensile_red.r, tensile_red.g, tensile_red.b);
+    cairo_move_to(cr, 20, y0 - 5), cairo_line_to(cr, 45, y0 - 5), cairo_stroke(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    std::snprintf(buf, sizeof buf, "tensile cracks (%d)", s.cracks(contact::JointState::broken_tension));
+    text(cr, 52, y0, buf);
+    cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
+    cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement, max %.3g mm%s%s",
+                  s.cracks(contact::JointState::broken_shear), 1e3 * umax, o.title.empty() ? "" : "   ", o.title.c_str());
+    text(cr, 292, y0, buf);
+    canvas.finish();
+}
+
+void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
+                 const std::filesystem::path& file, const std::string& title, bool log_y) {
+    const int w = 900, h = 600;
+    const double left = 90, right = 30, top = 50, bottom = 70;
+    Canvas canvas(file, w, h);
+    cairo_t* cr = canvas.cr;
+    auto ty = [&](double y) { return log_y ? std::log10(std::max(y, 1e-300)) : y; };
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (const auto& s : series)
+        for (std::size_t i = 0; i < s.x.size(); ++i) {
+            if (log_y && !(s.y[i] > 0)) continue;
+            x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
+            y0 = std::min(y0, ty(s.y[i])), y1 = std::max(y1, ty(s.y[i]));
+        }
+    if (!(x1 > x0)) x1 = x0 + 1;
+    if (!(y1 > y0)) y1 = y0 + 1;
+    if (!log_y) y0 = std::min(y0, 0.0);
+    auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * (w - left - right); };
+    auto py = [&](double y) { return h - bottom - (ty(y) - y0) / (y1 - y0) * (h - top - bottom); };
+    auto py_raw = [&](double yt) { return h - bottom - (yt - y0) / (y1 - y0) * (h - top - bottom); };
+    // Axes, ticks and labels.
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 1);
+    cairo_rectangle(cr, left, top, w - left - right, h - top - bottom);
+    cairo_stroke(cr);
+    char buf[64];
+    for (int k = 0; k <= 5; ++k) {
+        const double xv = x0 + k * (x1 - x0) / 5, yv = y0 + k * (y1 - y0) / 5;
+        cairo_move_to(cr, px(xv), h - bottom), cairo_line_to(cr, px(xv), h - bottom + 5), cairo_stroke(cr);
+        std::snprintf(buf, sizeof buf, "%.3g", xv);
+        text(cr, px(xv), h - bottom + 20, buf, 12, true);
+        cairo_move_to(cr, left - 5, py_raw(yv)), cairo_line_to(cr, left, py_raw(yv)), cairo_stroke(cr);
+        std::snprintf(buf, sizeof buf, log_y ? "1e%.1f" : "%.3g", yv);
+        text(cr, 8, py_raw(yv) + 4, buf, 12);
+    }
+    text(cr, 0.5 * (left + w - right), h - 20, x_label, 14, true);
+    cairo_save(cr);
+    cairo_translate(cr, 22, 0.5 * (top + h - bottom));
+    cairo_rotate(cr, -M_PI / 2);
+    text(cr, 0, 0, y_label, 14, true);
+    cairo_restore(cr);
+    if (!title.empty()) text(cr, 0.5 * w, 30, title, 16, true);
+    constexpr std::array<Rgb, 4> colours{{{0.1, 0.2, 0.7}, {0.8, 0.1, 0.1}, {0.1, 0.55, 0.2}, {0.5, 0.3, 0.6}}};
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        const auto& s = series[k];
+        const Rgb col = colours[k % colours.size()];
+        cairo_set_source_rgb(cr, col.r, col.g, col.b);
+        cairo_set_line_width(cr, 1.8);
+        bool pen = false;
+        for (std::size_t i = 0; i < s.x.size(); ++i) {
+            if (log_y && !(s.y[i] > 0)) { pen = false; continue; }
+            if (pen) cairo_line_to(cr, px(s.x[i]), py(s.y[i]));
+            else cairo_move_to(cr, px(s.x[i]), py(s.y[i]));
+            pen = true;
+        }
+        cairo_stroke(cr);
+        if (series.size() > 1) {
+            cairo_move_to(cr, w - right - 200, top + 20 + 18 * k), cairo_line_to(cr, w - right - 175, top + 20 + 18 * k);
+            cairo_stroke(cr);
+            cairo_set_source_rgb(cr, 0, 0, 0);
+            text(cr, w - right - 168, top + 25 + 18 * k, s.label, 12);
+        }
+    }
+    canvas.finish();
 }
 
 } // namespace bbm::io

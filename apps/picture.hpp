@@ -1,12 +1,20 @@
-// bbm apps: pictures drawn with cairo (PNG and SVG), for machines without a
-// display or ParaView: the block model with its joints coloured by tag. Later
-// analyses draw their failure plots (cracks by mode) through the same module.
+// bbm apps: pictures drawn with cairo (PNG or SVG by the file extension, written
+// atomically), for machines without a display or ParaView: the block model with
+// its joints coloured by tag; a failure plot (blocks at their current place,
+// cracks by mode, like the paper's Figures 4b–7); x–y curves (stress–strain,
+// histories).
 #pragma once
 
 #include "core/vec2.hpp"
 #include "meshing/blocks.hpp"
 
 #include <filesystem>
+#include <string>
+#include <vector>
+
+namespace bbm {
+class Solver;
+}
 
 namespace bbm::io {
 
@@ -22,5 +30,24 @@ struct PictureOptions {
 /// the file extension (.png or .svg); written atomically.
 void draw_blocks(const meshing::BlockAssembly& a, const std::filesystem::path& file,
                  const PictureOptions& options = {});
+
+struct FailurePlotOptions {
+    int width_px = 1200;
+    Box2 window; ///< empty = the whole model
+    std::string title;
+};
+
+/// Blocks shaded by displacement magnitude, with broken contacts drawn along their
+/// joints: tensile cracks red, shear cracks blue; a legend.
+void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o = {});
+
+struct Series {
+    std::string label;
+    std::vector<double> x, y;
+};
+
+/// Line plot of one or more series with axes, ticks and labels.
+void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
+                 const std::filesystem::path& file, const std::string& title = {}, bool log_y = false);
 
 } // namespace bbm::io

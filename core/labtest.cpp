@@ -1,0 +1,193 @@
+#include "core/labtest.hpp"
+
+#include "core/solver.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+namespace bbm {
+
+LabTestOptions LabTestOptions::paper_ucs() {
+    LabTestOptions o;
+    o.joint.name = "bond";
+    o.joint.law = JointPropertySpec::Law::softening;
+    o.joint.kn = 96.6e9;
+    o.joint.ks = 40.3e9;
+    o.joint.tensile = 3e6;
+    o.joint.cohesion = 9.5e6;
+    o.joint.friction = 25.0;
+    o.joint.tension_softening = {{1.7, 0.5}, {4.0, 0.0}};
+    o.joint.shear_softening = {{1.3, 0.5}, {2.1, 0.0}};
+    return o;
+}
+
+meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
+    meshing::ModelGeometrySpec g;
+    meshing::RegionSpec r;
+    r.name = "specimen";
+    if (o.kind == LabTestOptions::Kind::brazilian) {
+        r.outline.kind = meshing::OutlineSpec::Kind::circle;
+        r.outline.center = {0.5 * o.width, 0.5 * o.width};
+        r.outline.radius = 0.5 * o.width;
+        r.outline.max_segment = 0.25 * o.size;
+    } else {
+        r.outline.min = {0.0, 0.0};
+        r.outline.max = {o.width, o.height};
+    }
+    r.pattern.kind = o.pattern;
+    r.pattern.size = o.size;
+    r.pattern.lloyd_iterations = o.lloyd;
+    r.pattern.seed = o.seed;
+    g.regions.push_back(r);
+    return g;
+}
+
+namespace {
+double specimen_height(const LabTestOptions& o) {
+    return o.kind == LabTestOptions::Kind::brazilian ? o.width : o.height;
+}
+} // namespace
+
+AnalysisSpec labtest_analysis(const LabTestOptions& o) {
+    AnalysisSpec an;
+    an.materials.push_back({"rock", o.density});
+    an.joint_properties.push_back(o.joint);
+    an.joint_assignments.push_back({o.joint.name, {}, {}});
+    const double h = specimen_height(o), band = 0.5 * o.size, v = o.strain_per_step * h;
+    const double big = 10.0 * (o.width + h);
+    BoundarySpec bottom;
+    bottom.name = "bottom";
+    bottom.select.box = Box2{{-big, -big}, {big, band}};
+    bottom.vy = 0.0;
+    bottom.omega = 0.0;
+    BoundarySpec top = bottom;
+    top.name = "top";
+    top.select.box = Box2{{-big, h - band}, {big, big}};
+    top.vy = o.kind == LabTestOptions::Kind::tension ? v : -v;
+    if (o.rough_platens) {
+        bottom.vx = top.vx = 0.0;
+        an.boundaries = {bottom, top};
+    } else {
+        BoundarySpec anchor;
+        anchor.name = "anchor";
+        anchor.select.box = Box2{{0.5 * o.width - band, -big}, {0.5 * o.width + band, band}};
+        anchor.vx = 0.0;
+        an.boundaries = {bottom, top, anchor};
+    }
+    if (o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0) {
+        BoundarySpec left;
+        left.name = "left";
+        left.kind = BoundarySpec::Kind::stress;
+        left.select.box = Box2{{-big, band}, {1e-6 * o.width, h - band}};
+        left.stress.sxx = -o.confinement;
+        BoundarySpec right = left;
+        right.name = "right";
+        right.select.box = Box2{{o.width * (1 - 1e-6), band}, {big, h - band}};
+        an.boundaries.push_back(left);
+        an.boundaries.push_back(right);
+    }
+    an.solver.mode = SolverSpec::Mode::quasi_static;
+    an.solver.damping = 0.8;
+    return an;
+}
+
+double fit_slope(const std::vector<double>& x, const std::vector<double>& y) {
+    const std::size_t n = x.size();
+    if (n < 2) return 0.0;
+    double mx = 0, my = 0;
+    for (std::size_t i = 0; i < n; ++i) mx += x[i], my += y[i];
+    mx /= n, my /= n;
+    double sxy = 0, sxx = 0;
+    for (std::size_t i = 0; i < n; ++i) sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx);
+    return sxx > 0 ? sxy / sxx : 0.0;
+}
+
+LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(const StressStrainPoint&)>& progress,
+                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto blocks = meshing::generate_blocks(labtest_geometry(o));
+    Solver s(blocks, labtest_analysis(o));
+    LabTestResult r;
+    r.blocks = blocks.block_count();
+    r.contacts = s.contacts().size();
+    const auto& b = s.blocks();
+    const double h = specimen_height(o), band = 0.5 * o.size;
+    const bool brazilian = o.kind == LabTestOptions::Kind::brazilian;
+    const double sign = o.kind == LabTestOptions::Kind::tension ? -1.0 : 1.0;
+    // Side bands for the lateral strain (platen rows excluded).
+    std::vector<int> left, right;
+    for (int i = 0; i < b.count(); ++i) {
+        const Vec2 c = b.centroid0[i];
+        if (c.y < band || c.y > h - band) continue;
+        if (c.x < o.size) left.push_back(i);
+        if (c.x > o.width - o.size) right.push_back(i);
+    }
+    auto mean_ux = [&](const std::vector<int>& ids) {
+        double u = 0;
+        for (int i : ids) u += b.centroid[i].x - b.centroid0[i].x;
+        return ids.empty() ? 0.0 : u / ids.size();
+    };
+    const double v = o.strain_per_step * h;
+    double peak = 0.0;
+    long peak_step = 0;
+    while (s.steps() < o.max_steps) {
+        s.step();
+        if (s.steps() % o.record_every != 0) continue;
+        const double force = sign * s.boundary_force("top").y;
+        StressStrainPoint p;
+        p.step = s.steps();
+        p.axial_strain = v * double(s.steps()) / h;
+        p.axial_stress = brazilian ? 2.0 * force / (std::numbers::pi * o.width) : force / o.width;
+        p.lateral_strain = (mean_ux(right) - mean_ux(left)) / o.width;
+        p.cracks_tensile = s.cracks(contact::JointState::broken_tension);
+        p.cracks_shear = s.cracks(contact::JointState::broken_shear);
+        r.curve.push_back(p);
+        if (progress) progress(p);
+        if (p.axial_stress > peak) peak = p.axial_stress, peak_step = p.step;
+        // Past the peak once the stress is clearly down from it.
+        if (peak > 0 && p.step > peak_step && p.axial_stress < o.stop_fraction * peak) {
+            r.peak_passed = true;
+            break;
+        }
+        if (p.axial_strain >= o.max_strain) break;
+    }
+    r.steps = s.steps();
+    r.peak_stress = peak;
+    r.strain_at_peak = v * double(peak_step) / h;
+    if (brazilian) r.tensile_strength = peak;
+    // E and ν on the initial linear part: pre-peak points between 10% and 50% of the peak.
+    std::vector<double> eps, sig, lat;
+    for (const auto& p : r.curve) {
+        if (p.step > peak_step) break;
+        if (p.axial_stress >= 0.1 * peak && p.axial_stress <= 0.5 * peak) {
+            eps.push_back(p.axial_strain), sig.push_back(p.axial_stress), lat.push_back(p.lateral_strain);
+        }
+    }
+    if (!brazilian) {
+        r.E = fit_slope(eps, sig);
+        // Compression: the sides move out as the specimen shortens (both strains
+        // positive); tension: they move in as it lengthens.
+        r.nu = fit_slope(eps, lat) * (o.kind == LabTestOptions::Kind::tension ? -1.0 : 1.0);
+    }
+    // Crack statistics by joint orientation.
+    const auto& c = s.contacts();
+    for (int i = 0; i < c.size(); ++i) {
+        const auto mode = c.history[i].broken;
+        if (mode == contact::JointState::intact) continue;
+        const Vec2 t = contact::tangent_of(c.normal[i]);
+        double angle = std::atan2(t.y, t.x) * 180.0 / std::numbers::pi;
+        while (angle < 0) angle += 180.0;
+        while (angle >= 180.0) angle -= 180.0;
+        ++r.crack_orientation[std::min(11, int(angle / 15.0))];
+        if (std::abs(angle - 90.0) <= 30.0) ++r.cracks_near_vertical;
+        if (angle <= 30.0 || angle >= 150.0) ++r.cracks_near_horizontal;
+    }
+    r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
+    r.cracks_shear = s.cracks(contact::JointState::broken_shear);
+    r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (on_finish) on_finish(s, r);
+    return r;
+}
+
+} // namespace bbm

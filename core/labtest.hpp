@@ -1,0 +1,93 @@
+// bbm core: numerical laboratory tests for micro-property calibration (paper §4.2,
+// SPEC §8): uniaxial compression, direct tension, biaxial compression and the
+// Brazilian test on a bonded-block specimen.
+//
+// Loading (documented choice): the platens are the rows of specimen blocks whose
+// centroids lie within half a block size of the loaded faces; their velocities are
+// prescribed (the top row moves, the bottom row is held). With `platen_friction`
+// ("rough", the default) their horizontal velocity is held at zero too, like a
+// platen bonded to the specimen; with "smooth" it is free, and only the bottom
+// row's middle block is held horizontally against drift. Confinement (biaxial) is
+// a constant stress on the side faces. Quasi-static mode, Δt = 1, mass scaling
+// and local damping 0.8, so the platen velocity is a displacement per step.
+//
+// Measures, from the platen reaction and displacement:
+//   axial stress  = −(reaction on the top platen) / width (compression positive)
+//   axial strain  = platen displacement / height (compression positive)
+//   lateral strain = mean horizontal displacement of the blocks of the right side
+//                    band minus that of the left band, over the width
+//   E  = least-squares slope of stress against strain over the pre-peak points
+//        with stress between 10% and 50% of the peak (the initial linear part)
+//   ν  = −(least-squares slope of lateral against axial strain) over the same points
+// Brazilian: indirect tensile strength σt = 2P / (π D), P the peak line load.
+// The run stops when the stress has dropped below `stop_fraction` of the peak
+// after it, or at `max_strain`.
+#pragma once
+
+#include "core/model_spec.hpp"
+#include "meshing/spec.hpp"
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace bbm {
+
+struct LabTestOptions {
+    enum class Kind { ucs, tension, biaxial, brazilian };
+    Kind kind = Kind::ucs;
+    meshing::PatternSpec::Kind pattern = meshing::PatternSpec::Kind::voronoi;
+    double size = 0.3, width = 8.0, height = 16.0; ///< m (brazilian: width = diameter)
+    int lloyd = 2;
+    std::uint64_t seed = 1;
+    JointPropertySpec joint;            ///< the bond (law softening by default: paper values)
+    double density = 2700.0;
+    double confinement = 0.0;           ///< biaxial: lateral stress, Pa (positive = compression)
+    double strain_per_step = 5e-8;      ///< platen velocity over height, per step
+    bool rough_platens = true;
+    double stop_fraction = 0.5;         ///< stop after the peak below this fraction of it
+    double max_strain = 0.01;
+    long max_steps = 2000000;
+    int record_every = 20;              ///< steps between stress-strain samples
+
+    /// The paper's Voronoi calibration run (SPEC §8).
+    static LabTestOptions paper_ucs();
+};
+
+struct StressStrainPoint {
+    long step;
+    double axial_strain, axial_stress, lateral_strain;
+    int cracks_tensile, cracks_shear;
+};
+
+struct LabTestResult {
+    double E = 0.0, nu = 0.0, peak_stress = 0.0, strain_at_peak = 0.0;
+    double tensile_strength = 0.0; ///< brazilian: 2P/(πD)
+    int blocks = 0, contacts = 0;
+    long steps = 0;
+    double wall_seconds = 0.0;
+    int cracks_tensile = 0, cracks_shear = 0;
+    /// Broken contacts by joint orientation (angle of the joint from horizontal,
+    /// 0–180°), 12 bins of 15°.
+    std::array<int, 12> crack_orientation{};
+    int cracks_near_vertical = 0, cracks_near_horizontal = 0; ///< within 30° of each
+    bool peak_passed = false;
+    std::vector<StressStrainPoint> curve;
+};
+
+/// Geometry and analysis of a lab test (also what `bbm ucs --write-model` saves).
+meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o);
+AnalysisSpec labtest_analysis(const LabTestOptions& o);
+
+class Solver;
+/// Runs one test. `progress` (optional) is called with every recorded point;
+/// `on_finish` (optional) sees the final solver state and the result (for output).
+LabTestResult run_labtest(const LabTestOptions& o,
+                          const std::function<void(const StressStrainPoint&)>& progress = {},
+                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish = {});
+
+/// Least-squares slope of y on x.
+double fit_slope(const std::vector<double>& x, const std::vector<double>& y);
+
+} // namespace bbm
