@@ -151,11 +151,15 @@ void draw_blocks(const meshing::BlockAssembly& a, const std::filesystem::path& f
 
 void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o) {
     const auto& b = s.blocks();
+    // Frame the model as it was built (blocks thrown far off would shrink the rest).
     Box2 box = o.window;
-    if (box.empty())
+    if (box.empty()) {
         for (int i = 0; i < b.count(); ++i)
-            if (!b.removed[i])
-                for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.vertex[v]);
+            for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.centroid0[i] + b.local[v]);
+        const double m = 0.03 * std::max(box.width(), box.height());
+        box.lo -= Vec2{m, m};
+        box.hi += Vec2{m, m};
+    }
     const double legend = 40.0;
     const View view(box, o.width_px, legend);
     Canvas canvas(file, view.w, view.h);

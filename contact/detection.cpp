@@ -61,7 +61,12 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
         const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
         if (f.gap > tol || beyond > 2.0 * tol) drop[i] = 1;
     }
-    for (std::uint8_t d : drop) res.removed += d;
+    for (int i = 0; i < c.size(); ++i) {
+        if (!drop[i]) continue;
+        ++res.removed;
+        res.removed_tensile += c.history[i].broken == JointState::broken_tension;
+        res.removed_shear += c.history[i].broken == JointState::broken_shear;
+    }
     if (res.removed > 0) c.remove_if_flagged(drop);
 
     // Existing contact points per block pair (either way round).

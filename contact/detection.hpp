@@ -37,6 +37,8 @@ struct DetectionInput {
 
 struct DetectionResult {
     int created = 0, removed = 0, transferred = 0;
+    /// Of the removed: cracks (broken bonds), so that crack counts stay cumulative.
+    int removed_tensile = 0, removed_shear = 0;
 };
 
 DetectionResult update_contacts(Contacts& c, const DetectionInput& in);

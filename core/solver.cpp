@@ -427,6 +427,8 @@ void Solver::detect_if_due() {
     detection_totals_.created += r.created;
     detection_totals_.removed += r.removed;
     detection_totals_.transferred += r.transferred;
+    detection_totals_.removed_tensile += r.removed_tensile;
+    detection_totals_.removed_shear += r.removed_shear;
     if (r.created > 0 || r.removed > 0) {
         c_.rebuild_batches(int(laws_.size()));
         update_timestep();
@@ -469,7 +471,10 @@ double Solver::dissipated_energy() const {
 }
 
 int Solver::cracks(JointState mode) const {
-    int n = 0;
+    // Broken contacts still present plus those detection removed since.
+    int n = mode == JointState::broken_tension ? detection_totals_.removed_tensile
+          : mode == JointState::broken_shear   ? detection_totals_.removed_shear
+                                               : 0;
     for (const auto& h : c_.history) n += h.broken == mode;
     return n;
 }

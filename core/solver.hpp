@@ -61,6 +61,7 @@ public:
     double strain_energy() const;
     double dissipated_energy() const;
     double external_work() const { return work_; }
+    /// Cracks (broken bonds) so far, by mode; cumulative.
     int cracks(contact::JointState mode) const;
     /// Total force the contacts and tractions of a boundary's blocks receive from
     /// their prescribed velocities (reaction) or apply (stress), in N/m.

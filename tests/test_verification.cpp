@@ -2,6 +2,7 @@
 // examples/verification/ run through the solver and compared with analytic answers.
 #include "apps/model_input.hpp"
 #include "core/analysis.hpp"
+#include "core/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <doctest/doctest.h>
@@ -269,4 +270,28 @@ TEST_CASE("excavation stage: support relaxed gradually, walls move in, hoop stre
     CHECK(hoop[1] > hoop[2]);
     CHECK(hoop[3] > p);
     CHECK(hoop[0] < 2.0 * p * (1 + a * a / (1.75 * 1.75)));
+}
+
+TEST_CASE("hexagonal lattice of rigid blocks: E and nu match the closed form") {
+    auto m = load("hexagonal_lattice.toml");
+    Solver s(m.blocks, m.file.analysis);
+    Silent quiet;
+    const auto reports = run_stages(s, m.file.analysis.stages, quiet);
+    REQUIRE(reports[0].converged);
+    const auto& b = s.blocks();
+    // Least-squares strains from interior blocks (1 m away from every edge).
+    std::vector<double> x, ux, y, uy;
+    for (int i = 0; i < b.count(); ++i) {
+        const Vec2 c = b.centroid0[i];
+        if (c.x < 1 || c.x > 5 || c.y < 1 || c.y > 7) continue;
+        x.push_back(c.x), ux.push_back(b.centroid[i].x - c.x);
+        y.push_back(c.y), uy.push_back(b.centroid[i].y - c.y);
+    }
+    REQUIRE(x.size() > 200);
+    const double exx = fit_slope(x, ux), eyy = fit_slope(y, uy);
+    const double kn = 96.6e9, ks = 40.3e9, a = 0.3;
+    const double E = 2 * a * kn * (kn + ks) / (3 * kn + ks), nu = (kn - ks) / (3 * kn + ks);
+    INFO("E " << 1e6 / -eyy << " (closed form " << E << "), nu " << -exx / eyy << " (" << nu << ")");
+    CHECK(1e6 / -eyy == doctest::Approx(E).epsilon(0.01));
+    CHECK(-exx / eyy == doctest::Approx(nu).epsilon(0.02));
 }
