@@ -50,6 +50,7 @@ struct alignas(64) JointHistory {
     bool bonded = true;      ///< false once broken, or for contacts formed unbonded
     bool slipping = false;   ///< plastic shear in the last update
     JointState broken = JointState::intact; ///< broken_tension / broken_shear once broken
+    bool counted = false; ///< its crack has been recorded (statistics at formation)
 };
 static_assert(sizeof(JointHistory) == 64);
 

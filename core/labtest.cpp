@@ -128,12 +128,30 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         for (int i : ids) u += b.centroid[i].x - b.centroid0[i].x;
         return ids.empty() ? 0.0 : u / ids.size();
     };
+    // Crack orientation when each crack forms (later the fragments rotate): the
+    // angle of its joint from horizontal, 0–180°.
+    auto record_new_cracks = [&] {
+        auto& c = s.contacts();
+        for (int i = 0; i < c.size(); ++i) {
+            auto& hist = c.history[i];
+            if (hist.broken == contact::JointState::intact || hist.counted) continue;
+            hist.counted = true;
+            const Vec2 t = contact::tangent_of(c.normal[i]);
+            double angle = std::atan2(t.y, t.x) * 180.0 / std::numbers::pi;
+            while (angle < 0) angle += 180.0;
+            while (angle >= 180.0) angle -= 180.0;
+            ++r.crack_orientation[std::min(11, int(angle / 15.0))];
+            if (std::abs(angle - 90.0) <= 30.0) ++r.cracks_near_vertical;
+            if (angle <= 30.0 || angle >= 150.0) ++r.cracks_near_horizontal;
+        }
+    };
     const double v = o.strain_per_step * h;
     double peak = 0.0;
     long peak_step = 0;
     while (s.steps() < o.max_steps) {
         s.step();
         if (s.steps() % o.record_every != 0) continue;
+        record_new_cracks();
         const double force = sign * s.boundary_force("top").y;
         StressStrainPoint p;
         p.step = s.steps();
@@ -170,19 +188,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         // positive); tension: they move in as it lengthens.
         r.nu = fit_slope(eps, lat) * (o.kind == LabTestOptions::Kind::tension ? -1.0 : 1.0);
     }
-    // Crack statistics by joint orientation.
-    const auto& c = s.contacts();
-    for (int i = 0; i < c.size(); ++i) {
-        const auto mode = c.history[i].broken;
-        if (mode == contact::JointState::intact) continue;
-        const Vec2 t = contact::tangent_of(c.normal[i]);
-        double angle = std::atan2(t.y, t.x) * 180.0 / std::numbers::pi;
-        while (angle < 0) angle += 180.0;
-        while (angle >= 180.0) angle -= 180.0;
-        ++r.crack_orientation[std::min(11, int(angle / 15.0))];
-        if (std::abs(angle - 90.0) <= 30.0) ++r.cracks_near_vertical;
-        if (angle <= 30.0 || angle >= 150.0) ++r.cracks_near_horizontal;
-    }
+    record_new_cracks();
     r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
     r.cracks_shear = s.cracks(contact::JointState::broken_shear);
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -68,8 +68,8 @@ struct LabTestResult {
     long steps = 0;
     double wall_seconds = 0.0;
     int cracks_tensile = 0, cracks_shear = 0;
-    /// Broken contacts by joint orientation (angle of the joint from horizontal,
-    /// 0–180°), 12 bins of 15°.
+    /// Cracks by the orientation of their joint when they formed (angle from
+    /// horizontal, 0–180°), 12 bins of 15°; cracks removed by detection included.
     std::array<int, 12> crack_orientation{};
     int cracks_near_vertical = 0, cracks_near_horizontal = 0; ///< within 30° of each
     bool peak_passed = false;
