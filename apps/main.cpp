@@ -202,9 +202,10 @@ private:
     std::chrono::steady_clock::time_point stage_t0_, last_print_;
 };
 
-int run_model(const std::string& model_path, const fs::path& out, bool quiet) {
+int run_model(const std::string& model_path, const fs::path& out, int threads, bool quiet) {
     const auto t0 = std::chrono::steady_clock::now();
-    const io::ModelFile model = io::read_model(model_path);
+    io::ModelFile model = io::read_model(model_path);
+    model.analysis.solver.threads = threads;
     if (model.analysis.stages.empty())
         throw InputError(model_path, 0, "stage", "the model has no [[stage]] to run (bbm mesh only generates blocks)");
     meshing::BlockAssembly blocks;
@@ -303,7 +304,9 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool quiet_flag, bool& qu
     sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
         ->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--threads", c.threads, "Threads for realizations (0 = all cores)")->check(CLI::NonNegativeNumber);
+    sub->add_option("--threads", c.threads,
+                    "Threads (0 = all cores): realizations run in parallel; a single one uses them in its contact loop")
+        ->check(CLI::NonNegativeNumber);
     sub->add_option("-o,--out", c.out, "Output directory")->capture_default_str();
     sub->add_flag("-q,--quiet", quiet, "No progress, only errors");
 }
@@ -366,18 +369,22 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
     const fs::path out = c.out;
     fs::create_directories(out);
     const int n = c.realizations;
-    const int threads = std::max(1, std::min(n, c.threads > 0 ? c.threads : int(std::thread::hardware_concurrency())));
+    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = std::max(1, std::min(n, available));
+    const int threads_for_loop = available;
     std::vector<LabTestResult> results(n);
     std::mutex print;
     if (!quiet)
         std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s\n", name,
                      c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
-                     n > 1 ? "s" : "", threads, threads > 1 ? "s" : "");
+                     n > 1 ? "s" : "", n > 1 ? threads : threads_for_loop, (n > 1 ? threads : threads_for_loop) > 1 ? "s" : "");
     std::atomic<int> next{0};
     auto worker = [&] {
         for (int k = next++; k < n; k = next++) {
             LabTestOptions ok = o;
             ok.seed = o.seed + k;
+            // One realization: its threads go to the contact loop; several: one each.
+            ok.threads = n == 1 ? threads_for_loop : 1;
             const fs::path dir = n > 1 ? out / ("realization_" + std::to_string(k + 1)) : out;
             auto last = std::chrono::steady_clock::now();
             auto progress = [&](const StressStrainPoint& p) {
@@ -467,6 +474,10 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     run->add_option("-o,--out", run_out, "Output directory (created if missing)")->capture_default_str();
     run->add_flag("-q,--quiet", quiet, "No progress, only errors");
+    int run_threads = 1;
+    run->add_option("--threads", run_threads, "Threads of the contact loop (results are deterministic per thread count)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
 
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     LabTestCli ucs_cli, tension_cli, biaxial_cli, brazilian_cli;
@@ -494,7 +505,7 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : 2;
     }
     try {
-        if (*run) return run_model(run_model_path, run_out, quiet);
+        if (*run) return run_model(run_model_path, run_out, run_threads, quiet);
         if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);
         if (*tension) return run_labtest_command(tension_cli, LabTestOptions::Kind::tension, "tension", quiet);
         if (*biaxial) return run_labtest_command(biaxial_cli, LabTestOptions::Kind::biaxial, "biaxial", quiet);

@@ -1,6 +1,9 @@
 #include "contact/contacts.hpp"
 
 #include <algorithm>
+#include <span>
+
+#include <omp.h>
 #include <cmath>
 
 namespace bbm::contact {
@@ -52,7 +55,7 @@ namespace {
 // Contacts members the compiler must assume the force stores alias them and would
 // reload every base pointer on every contact.
 template <class Law>
-double step_batch(const Law& law, const std::vector<int>& ids, Contacts& c, const BlockView& b, double dt,
+double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const BlockView& b, double dt,
                   double corner_radius, Vec2* __restrict force, double* __restrict moment) {
     const int* __restrict va = c.vertex_block.data();
     const int* __restrict vid = c.vertex_id.data();
@@ -109,11 +112,49 @@ double step_batch(const Law& law, const std::vector<int>& ids, Contacts& c, cons
 } // namespace
 
 double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                     double corner_radius, Vec2* force, double* moment) {
-    double sum = 0.0;
-    for (std::size_t p = 0; p < c.batches.size(); ++p)
-        sum += std::visit([&](const auto& law) { return step_batch(law, c.batches[p], c, b, dt, corner_radius, force, moment); },
+                     double corner_radius, Vec2* force, double* moment, int blocks, int threads,
+                     ThreadForces& scratch) {
+    auto run = [&](std::size_t p, std::size_t begin, std::size_t end, Vec2* f, double* m) {
+        const std::span<const int> ids(c.batches[p].data() + begin, end - begin);
+        return std::visit([&](const auto& law) { return step_batch(law, ids, c, b, dt, corner_radius, f, m); },
                           laws[p]);
+    };
+    if (threads <= 1) {
+        double sum = 0.0;
+        for (std::size_t p = 0; p < c.batches.size(); ++p) sum += run(p, 0, c.batches[p].size(), force, moment);
+        return sum;
+    }
+    const std::size_t nb = std::size_t(blocks);
+    if (scratch.force.size() != nb * threads) {
+        scratch.force.assign(nb * threads, {});
+        scratch.moment.assign(nb * threads, 0.0);
+        scratch.sum.assign(threads, 0.0);
+    }
+#pragma omp parallel num_threads(threads)
+    {
+        const int t = omp_get_thread_num();
+        Vec2* f = scratch.force.data() + nb * t;
+        double* m = scratch.moment.data() + nb * t;
+        std::fill(f, f + nb, Vec2{});
+        std::fill(m, m + nb, 0.0);
+        double sum = 0.0;
+        for (std::size_t p = 0; p < c.batches.size(); ++p) {
+            const std::size_t n = c.batches[p].size();
+            sum += run(p, n * t / threads, n * (t + 1) / threads, f, m);
+        }
+        scratch.sum[t] = sum;
+#pragma omp barrier
+#pragma omp for schedule(static)
+        for (std::size_t k = 0; k < nb; ++k) {
+            Vec2 fs{};
+            double ms = 0.0;
+            for (int u = 0; u < threads; ++u) fs += scratch.force[nb * u + k], ms += scratch.moment[nb * u + k];
+            force[k] += fs;
+            moment[k] += ms;
+        }
+    }
+    double sum = 0.0;
+    for (int u = 0; u < threads; ++u) sum += scratch.sum[u];
     return sum;
 }
 

@@ -102,12 +102,23 @@ inline Vec2 contact_force(const Contacts& c, int i) {
     return c.length[i] * (h.sn * n - h.tau * tangent_of(n));
 }
 
+/// Per-thread force accumulators for step_contacts, kept between steps (sized
+/// once, not allocated per step).
+struct ThreadForces {
+    std::vector<Vec2> force;
+    std::vector<double> moment, sum;
+};
+
 /// Stage 2 of a step, fused per batch so each contact's data is loaded once:
 /// kinematics, the batch's law (one dispatch per batch), and the forces and
-/// moments added to the blocks' accumulators. Returns Σ|F|² over the contacts
-/// (the RMS contact force is the scale of the unbalanced-force ratio; squares
-/// spare a square root per contact).
+/// moments added to the blocks' accumulators (`force`, `moment`, of `blocks`
+/// entries, zeroed by the caller). Returns Σ|F|² over the contacts (the RMS
+/// contact force is the scale of the unbalanced-force ratio; squares spare a
+/// square root per contact). With threads > 1 each thread takes a contiguous part
+/// of every batch into its own accumulators, summed per block afterwards in thread
+/// order: results are deterministic for a given thread count.
 double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                     double corner_radius, Vec2* force, double* moment);
+                     double corner_radius, Vec2* force, double* moment, int blocks, int threads,
+                     ThreadForces& scratch);
 
 } // namespace bbm::contact

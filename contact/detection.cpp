@@ -36,12 +36,14 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
     // 1–2. Transfer along the edge block's boundary, and removal of separated
     // unbonded contacts.
     std::vector<std::uint8_t> drop(c.size(), 0);
+    auto is_active = [&](int k) { return !in.active || in.active[k]; };
     for (int i = 0; i < c.size(); ++i) {
         const int A = c.vertex_block[i], B = c.edge_block[i];
         if ((in.removed && (in.removed[A] || in.removed[B]))) {
             drop[i] = 1;
             continue;
         }
+        if (!is_active(A) && !is_active(B)) continue;
         const Vec2 x = b.vertex[c.vertex_id[i]];
         EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
         if (c.history[i].bonded) continue; // intact joints keep their edges (contacts.hpp)
@@ -72,7 +74,8 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
     // Existing contact points per block pair (either way round).
     std::unordered_map<std::uint64_t, std::vector<Vec2>> existing;
     for (int i = 0; i < c.size(); ++i)
-        existing[pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
+        if (is_active(c.vertex_block[i]) || is_active(c.edge_block[i]))
+            existing[pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
 
     // 3. Broad phase: inflated boxes in a uniform grid.
     const int nb = in.block_count;
@@ -147,6 +150,7 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
             for (std::size_t p = 0; p < list.size(); ++p)
                 for (std::size_t q = p + 1; q < list.size(); ++q) {
                     const int A = std::min(list[p], list[q]), B = std::max(list[p], list[q]);
+                    if (!is_active(A) && !is_active(B)) continue;
                     const Box2 &ba = box[A], &bb = box[B];
                     if (ba.hi.x < bb.lo.x || bb.hi.x < ba.lo.x || ba.hi.y < bb.lo.y || bb.hi.y < ba.lo.y) continue;
                     // Handle the pair once: in the cell holding the low corner of the overlap.

@@ -1,8 +1,11 @@
 // bbm contact: detection of contacts during large displacements (SPEC §3).
 //
 // The initial contacts come from the joint topology; this pass keeps the contact
-// set right as blocks move, and runs only when some block has moved more than a
-// fraction of the tolerance since the previous pass (Solver decides when):
+// set right as blocks move. It runs when some block has moved more than a quarter
+// of the tolerance since its last pass, and then only for such "active" blocks and
+// their neighbours, so a few fast fragments do not cost a pass over all pairs
+// (two blocks each within a quarter tolerance of their references have moved less
+// than the tolerance relative to each other since their pair was last examined):
 //   1. a contact whose vertex has left its edge passes, with its history, to the
 //      neighbouring edge of the same block if the vertex now projects onto it;
 //   2. an unbonded (or broken) contact whose vertex is farther than the tolerance
@@ -28,6 +31,9 @@ struct DetectionInput {
     BlockView blocks;
     int block_count = 0;
     const std::uint8_t* removed = nullptr; ///< excavated blocks take no part
+    /// Blocks that moved enough since their last pass: only pairs with at least
+    /// one active block are examined (null = all).
+    const std::uint8_t* active = nullptr;
     double tolerance = 0.0;
     int new_contact_property = 0;
     /// The step about to run: its contact update adds v·Δt, motion already in the

@@ -50,6 +50,7 @@ struct LabTestOptions {
     double max_strain = 0.01;
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
+    int threads = 1;                    ///< threads of the contact loop
 
     /// The paper's Voronoi calibration run (SPEC §8).
     static LabTestOptions paper_ucs();

@@ -85,6 +85,7 @@ struct SolverSpec {
     std::string new_contact_property; ///< property set of contacts formed during the run
     int output_every = 0;             ///< steps between VTK outputs; 0 = at stage ends only
     int history_every = 10;           ///< steps between history rows
+    int threads = 1;                  ///< threads of the contact loop (from the command line)
 };
 
 struct HistorySpec {

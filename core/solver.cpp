@@ -183,6 +183,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         for (std::uint32_t v = a.first[i]; v < a.first[i + 1]; ++v) radius_[i] = std::max(radius_[i], norm(b_.local[v]));
     detected_at_ = b_.centroid;
     detected_theta_.assign(nb, 0.0);
+    active_.assign(nb, 0);
     c_.rebuild_batches(int(laws_.size()));
 
     apply_boundaries(an, a);
@@ -351,7 +352,8 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps)
 void Solver::update_contact_forces() {
     std::fill(b_.force.begin(), b_.force.end(), Vec2{});
     std::fill(b_.moment.begin(), b_.moment.end(), 0.0);
-    contact_force_sum_ = contact::step_contacts(c_, laws_, view(), dt_, corner_radius_, b_.force.data(), b_.moment.data());
+    contact_force_sum_ = contact::step_contacts(c_, laws_, view(), dt_, corner_radius_, b_.force.data(), b_.moment.data(),
+                                                b_.count(), settings_.threads, thread_forces_);
 }
 
 void Solver::add_external_forces() {
@@ -412,18 +414,23 @@ void Solver::integrate() {
 }
 
 void Solver::detect_if_due() {
-    // Cheap check every few steps: has any block moved a good part of the tolerance?
+    // Every few steps: which blocks have moved a quarter of the tolerance since
+    // their last pass? Only they (and their neighbours) are examined.
     if (steps_ % 4 != 0) return;
-    double moved = 0.0;
-    for (int i = 0; i < b_.count(); ++i)
-        if (!b_.removed[i])
-            moved = std::max(moved, norm(b_.centroid[i] - detected_at_[i]) +
-                                        std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i]);
-    if (moved < 0.25 * tolerance_) return;
-    contact::DetectionInput in{view(), b_.count(), b_.removed.data(), tolerance_, new_contact_property_, dt_};
+    bool any = false;
+    for (int i = 0; i < b_.count(); ++i) {
+        const bool moved = !b_.removed[i] && norm(b_.centroid[i] - detected_at_[i]) +
+                                                     std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i] >=
+                                                 0.25 * tolerance_;
+        active_[i] = moved;
+        any = any || moved;
+    }
+    if (!any) return;
+    contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
+                               new_contact_property_, dt_};
     const auto r = contact::update_contacts(c_, in);
-    detected_at_ = b_.centroid;
-    detected_theta_ = b_.theta;
+    for (int i = 0; i < b_.count(); ++i)
+        if (active_[i]) detected_at_[i] = b_.centroid[i], detected_theta_[i] = b_.theta[i];
     detection_totals_.created += r.created;
     detection_totals_.removed += r.removed;
     detection_totals_.transferred += r.transferred;

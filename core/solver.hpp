@@ -121,6 +121,7 @@ private:
     struct Traction { int block; Vec2 offset; Vec2 force; }; ///< boundary point load, body frame
     std::vector<Traction> tractions_;
     double contact_force_sum_ = 0.0; ///< Σ|F|² of the last step
+    contact::ThreadForces thread_forces_;
     struct Relaxing { int block; Vec2 force; double moment; };
     std::vector<Relaxing> relaxing_;
     long relax_total_ = 0, relax_left_ = 0;
@@ -131,6 +132,7 @@ private:
     std::vector<double> radius_; ///< largest vertex distance from the centroid
     std::vector<Vec2> detected_at_;
     std::vector<double> detected_theta_;
+    std::vector<std::uint8_t> active_; ///< moved enough since its last detection pass
     contact::DetectionResult detection_totals_;
     long steps_ = 0;
 };

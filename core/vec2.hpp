@@ -80,8 +80,8 @@ struct Box2 {
     Vec2 lo{+INFINITY, +INFINITY};
     Vec2 hi{-INFINITY, -INFINITY};
     void add(Vec2 p) {
-        lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y)};
-        hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y)};
+        lo = {p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y};
+        hi = {p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y};
     }
     bool empty() const { return lo.x > hi.x; }
     double width() const { return hi.x - lo.x; }
