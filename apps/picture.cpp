@@ -218,7 +218,7 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
 void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
                  const std::filesystem::path& file, const std::string& title, bool log_y) {
     const int w = 900, h = 600;
-    const double left = 90, right = 30, top = 50, bottom = 70;
+    const double left = 100, right = 30, top = 50, bottom = 70;
     Canvas canvas(file, w, h);
     cairo_t* cr = canvas.cr;
     auto ty = [&](double y) { return log_y ? std::log10(std::max(y, 1e-300)) : y; };
@@ -241,18 +241,29 @@ void draw_curves(const std::vector<Series>& series, const std::string& x_label, 
     cairo_rectangle(cr, left, top, w - left - right, h - top - bottom);
     cairo_stroke(cr);
     char buf[64];
-    for (int k = 0; k <= 5; ++k) {
-        const double xv = x0 + k * (x1 - x0) / 5, yv = y0 + k * (y1 - y0) / 5;
+    // Ticks at 1, 2 or 5 times a power of ten, about five per axis.
+    auto nice_step = [](double range) {
+        const double raw = range / 5.0, p = std::pow(10.0, std::floor(std::log10(raw)));
+        const double f = raw / p;
+        return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
+    };
+    const double xs = nice_step(x1 - x0), ys = log_y ? 1.0 : nice_step(y1 - y0);
+    for (double xv = std::ceil(x0 / xs) * xs; xv <= x1 + 1e-9 * xs; xv += xs) {
         cairo_move_to(cr, px(xv), h - bottom), cairo_line_to(cr, px(xv), h - bottom + 5), cairo_stroke(cr);
-        std::snprintf(buf, sizeof buf, "%.3g", xv);
+        std::snprintf(buf, sizeof buf, "%g", std::abs(xv) < 1e-12 * xs ? 0.0 : xv);
         text(cr, px(xv), h - bottom + 20, buf, 12, true);
+    }
+    for (double yv = std::ceil(y0 / ys) * ys; yv <= y1 + 1e-9 * ys; yv += ys) {
         cairo_move_to(cr, left - 5, py_raw(yv)), cairo_line_to(cr, left, py_raw(yv)), cairo_stroke(cr);
-        std::snprintf(buf, sizeof buf, log_y ? "1e%.1f" : "%.3g", yv);
-        text(cr, 8, py_raw(yv) + 4, buf, 12);
+        std::snprintf(buf, sizeof buf, log_y ? "1e%g" : "%g", std::abs(yv) < 1e-12 * ys ? 0.0 : yv);
+        cairo_text_extents_t e;
+        cairo_set_font_size(cr, 12);
+        cairo_text_extents(cr, buf, &e);
+        text(cr, left - 9 - e.width, py_raw(yv) + 4, buf, 12);
     }
     text(cr, 0.5 * (left + w - right), h - 20, x_label, 14, true);
     cairo_save(cr);
-    cairo_translate(cr, 22, 0.5 * (top + h - bottom));
+    cairo_translate(cr, 18, 0.5 * (top + h - bottom));
     cairo_rotate(cr, -M_PI / 2);
     text(cr, 0, 0, y_label, 14, true);
     cairo_restore(cr);
