@@ -1,7 +1,7 @@
-// Numerical lab tests (core/labtest.hpp) with the paper's Voronoi blocks and joint
-// properties (SPEC §8): direct tension on a 4 m × 8 m specimen, compression on the
-// paper's 8 m × 16 m one (a smaller specimen is several per cent softer: its free
-// sides are a boundary layer of clipped cells of relative width ~ d/W).
+// Numerical lab tests (core/labtest.hpp) on the paper's 8 m × 16 m specimen of
+// Voronoi blocks with its joint properties (SPEC §8). (A smaller specimen is
+// several per cent softer: its free sides are a boundary layer of clipped cells of
+// relative width ~ d/W.)
 #include "core/labtest.hpp"
 
 #include <doctest/doctest.h>
@@ -11,24 +11,25 @@
 
 using namespace bbm;
 
-namespace {
-LabTestOptions small(LabTestOptions::Kind kind) {
-    auto o = LabTestOptions::paper_ucs();
-    o.kind = kind;
-    o.width = 4.0;
-    o.height = 8.0;
-    o.seed = 3;
-    return o;
-}
-} // namespace
-
-TEST_CASE("direct tension: strength between 0.5 and 1.1 times the joint tensile strength") {
-    const auto r = run_labtest(small(LabTestOptions::Kind::tension));
-    INFO("tensile strength " << r.peak_stress / 1e6 << " MPa, E " << r.E / 1e9 << " GPa");
-    CHECK(r.peak_passed);
-    CHECK(r.peak_stress > 0.5 * 3e6);
-    CHECK(r.peak_stress < 1.1 * 3e6);
-    CHECK(r.cracks_tensile > r.cracks_shear);
+TEST_CASE("direct tension, paper specimen: mean strength of 3 realizations within 0.5 to 1.1 sigma_t") {
+    // Tension peaks at a strain of ~1e-4, so it is loaded ten times slower than
+    // compression to stay quasi-static (halving this rate changes it by < 1%; at
+    // the compression rate the peak overshoots by ~15%).
+    double mean = 0.0;
+    for (std::uint64_t seed : {1, 2, 3}) {
+        auto o = LabTestOptions::paper_ucs();
+        o.kind = LabTestOptions::Kind::tension;
+        o.strain_per_step = 5e-9;
+        o.seed = seed;
+        const auto r = run_labtest(o);
+        INFO("seed " << seed << ": tensile strength " << r.peak_stress / 1e6 << " MPa");
+        CHECK(r.peak_passed);
+        CHECK(r.cracks_tensile > r.cracks_shear);
+        mean += r.peak_stress / 3;
+    }
+    INFO("mean tensile strength " << mean / 1e6 << " MPa");
+    CHECK(mean > 0.5 * 3e6);
+    CHECK(mean < 1.1 * 3e6);
 }
 
 TEST_CASE("uniaxial compression, paper specimen: elastic modulus of the lattice theory, axial splitting") {
