@@ -7,6 +7,7 @@
 // large); best and median are reported.
 // Each size runs with 1 and 2 threads of the contact loop.
 // Usage: bench_solver [out.json] [steps]
+#include "core/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <nlohmann/json.hpp>
@@ -27,17 +28,7 @@ namespace {
 
 AnalysisSpec paper_analysis(double width, double height, double rows) {
     AnalysisSpec an;
-    JointPropertySpec p;
-    p.name = "bond";
-    p.law = JointPropertySpec::Law::softening;
-    p.kn = 96.6e9;
-    p.ks = 40.3e9;
-    p.tensile = 3e6;
-    p.cohesion = 9.5e6;
-    p.friction = 25;
-    p.tension_softening = {{1.7, 0.5}, {4.0, 0.0}};
-    p.shear_softening = {{1.3, 0.5}, {2.1, 0.0}};
-    an.joint_properties.push_back(p);
+    an.joint_properties.push_back(LabTestOptions::paper_ucs().joint);
     an.joint_assignments.push_back({"bond", {}, {}});
     BoundarySpec bottom;
     bottom.name = "bottom";

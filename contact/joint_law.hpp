@@ -76,6 +76,17 @@ private:
     std::vector<double> s_{1.0};  ///< normalised strength at them
 };
 
+/// The elastic step of an intact bond below both peaks, shared by the bonded laws:
+/// true (and the stresses committed) if neither the tension cut-off nor the
+/// Coulomb cap is reached; un, us already incremented.
+inline bool intact_elastic_update(JointHistory& h, double kn, double ks, double tensile, double cohesion,
+                                  double tan_phi, double dus) {
+    const double sn = -kn * h.un, tau = h.tau + ks * dus;
+    if (-sn > tensile || std::abs(tau) > cohesion + std::max(sn, 0.0) * tan_phi) return false;
+    h.sn = sn, h.tau = tau, h.slipping = false;
+    return true;
+}
+
 // Each law's update() is inline for the elastic path every contact takes most of
 // the time; plastic returns and failures go out of line.
 struct ElasticLaw {
@@ -97,13 +108,7 @@ struct CoulombLaw {
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
-        if (h.bonded) {
-            const double sn = -kn * h.un, tau = h.tau + ks * dus;
-            if (-sn <= tensile && std::abs(tau) <= cohesion + std::max(sn, 0.0) * tan_phi) {
-                h.sn = sn, h.tau = tau, h.slipping = false;
-                return;
-            }
-        }
+        if (h.bonded && intact_elastic_update(h, kn, ks, tensile, cohesion, tan_phi, dus)) return;
         update_inelastic(h, dus);
     }
     /// Bond failure or frictional contact; un, us already incremented.
@@ -117,13 +122,9 @@ struct SofteningLaw {
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
-        if (h.bonded && h.upn == 0.0 && h.ups == 0.0) { // intact: below both peaks?
-            const double sn = -kn * h.un, tau = h.tau + ks * dus;
-            if (-sn <= tensile && std::abs(tau) <= cohesion + std::max(sn, 0.0) * tan_phi) {
-                h.sn = sn, h.tau = tau, h.slipping = false;
-                return;
-            }
-        }
+        if (h.bonded && h.upn == 0.0 && h.ups == 0.0 && // never softened
+            intact_elastic_update(h, kn, ks, tensile, cohesion, tan_phi, dus))
+            return;
         update_inelastic(h, dus);
     }
     /// Softening, failure or friction; un, us already incremented.

@@ -2,6 +2,7 @@
 #include "meshing/cgal_ops.hpp"
 
 #include "core/error.hpp"
+#include "meshing/detail.hpp"
 
 #include <CGAL/Arr_segment_traits_2.h>
 #include <CGAL/Arrangement_2.h>
@@ -181,15 +182,7 @@ struct Clipper::Impl {
         return false;
     }
 
-    bool inside(Vec2 q) const {
-        for (const auto& p : domain) {
-            if (!point_in_polygon(q, p.outer)) continue;
-            bool in_hole = false;
-            for (const auto& h : p.holes) in_hole = in_hole || point_in_polygon(q, h);
-            if (!in_hole) return true;
-        }
-        return false;
-    }
+    bool inside(Vec2 q) const { return detail::domain_contains(domain, q); }
 };
 
 Clipper::Clipper(const Domain& d) : impl_(new Impl) {
@@ -323,16 +316,6 @@ Vec2 interior_point(const std::vector<Vec2>& ring, const std::vector<Vec2>& obst
     return 0.5 * (v + far);
 }
 
-bool domain_contains(const Domain& d, Vec2 q) {
-    for (const auto& p : d) {
-        if (!point_in_polygon(q, p.outer)) continue;
-        bool in_hole = false;
-        for (const auto& h : p.holes) in_hole = in_hole || point_in_polygon(q, h);
-        if (!in_hole) return true;
-    }
-    return false;
-}
-
 template <class Circ>
 std::vector<Vec2> ring_without_antennas(Circ first) {
     std::vector<Vec2> r;
@@ -376,7 +359,7 @@ CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments
         }
         std::vector<Vec2> obstacles;
         for (const auto& h : face.holes) obstacles.insert(obstacles.end(), h.begin(), h.end());
-        if (!domain_contains(d, interior_point(face.outer, obstacles))) continue;
+        if (!detail::domain_contains(d, interior_point(face.outer, obstacles))) continue;
         if (signed_area(face.outer) < 0) std::reverse(face.outer.begin(), face.outer.end());
         for (auto& h : face.holes)
             if (signed_area(h) > 0) std::reverse(h.begin(), h.end());

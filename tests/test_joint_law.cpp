@@ -2,6 +2,7 @@
 // through their points, fracture energies equal the areas under the curves,
 // unloading is elastic with the initial stiffness, damage persists.
 #include "contact/joint_law.hpp"
+#include "core/labtest.hpp"
 
 #include <doctest/doctest.h>
 
@@ -14,19 +15,7 @@ using namespace bbm::contact;
 namespace {
 
 /// The paper's Voronoi calibration (SPEC §8).
-JointPropertySpec paper_bond() {
-    JointPropertySpec p;
-    p.name = "bond";
-    p.law = JointPropertySpec::Law::softening;
-    p.kn = 96.6e9;
-    p.ks = 40.3e9;
-    p.tensile = 3e6;
-    p.cohesion = 9.5e6;
-    p.friction = 25;
-    p.tension_softening = {{1.7, 0.5}, {4.0, 0.0}};
-    p.shear_softening = {{1.3, 0.5}, {2.1, 0.0}};
-    return p;
-}
+JointPropertySpec paper_bond() { return LabTestOptions::paper_ucs().joint; }
 
 double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
 
