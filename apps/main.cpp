@@ -269,8 +269,7 @@ struct LabTestCli {
     std::string out = "out";
 };
 
-void add_labtest_options(CLI::App* sub, LabTestCli& c, bool quiet_flag, bool& quiet) {
-    (void)quiet_flag;
+void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     auto& o = c.o;
     sub->add_option("--pattern", c.pattern, "Inner-block pattern")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
@@ -485,13 +484,13 @@ int main(int argc, char** argv) {
                                           "the paper's calibration run (Voronoi 0.3 m, 8 m x 16 m, SPEC §8). Writes "
                                           "summary.json (E, nu, peak_stress, ...), stress_strain.csv/.png, failure.png/.svg "
                                           "and result.pvd in --out.");
-    add_labtest_options(ucs, ucs_cli, true, quiet);
+    add_labtest_options(ucs, ucs_cli, quiet);
     auto* tension = app.add_subcommand("tension", "Direct uniaxial tension test (same options as ucs; loaded ten times "
                                                   "slower by default: its peak comes at a tenth of the strain).");
     tension_cli.o.strain_per_step = 5e-9;
-    add_labtest_options(tension, tension_cli, true, quiet);
+    add_labtest_options(tension, tension_cli, quiet);
     auto* biaxial = app.add_subcommand("biaxial", "Compression with a constant lateral stress (same options as ucs).");
-    add_labtest_options(biaxial, biaxial_cli, true, quiet);
+    add_labtest_options(biaxial, biaxial_cli, quiet);
     biaxial->add_option("--confinement", biaxial_cli.o.confinement, "Lateral stress (Pa, compression positive)")
         ->required()
         ->check(CLI::NonNegativeNumber);
@@ -499,7 +498,7 @@ int main(int argc, char** argv) {
                                                       "diameter; reports the indirect tensile strength 2P/(pi D).");
     brazilian_cli.o.width = 4.0;
     brazilian_cli.o.strain_per_step = 1e-8;
-    add_labtest_options(brazilian, brazilian_cli, true, quiet);
+    add_labtest_options(brazilian, brazilian_cli, quiet);
 
     try {
         app.parse(argc, argv);

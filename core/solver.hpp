@@ -63,8 +63,8 @@ public:
     double external_work() const { return work_; }
     /// Cracks (broken bonds) so far, by mode; cumulative.
     int cracks(contact::JointState mode) const;
-    /// Total force the contacts and tractions of a boundary's blocks receive from
-    /// their prescribed velocities (reaction) or apply (stress), in N/m.
+    /// Total contact force on a boundary's blocks in the last step, N/m (for a
+    /// prescribed-velocity boundary: minus the reaction its supports provide).
     Vec2 boundary_force(const std::string& boundary) const;
     /// Block-averaged stress of every block (SPEC §7): σ = (1/A) Σ x ⊗ f over its
     /// contacts and boundary tractions, symmetrised; tension positive. {sxx, syy, sxy}.
