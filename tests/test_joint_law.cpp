@@ -4,6 +4,8 @@
 #include "contact/joint_law.hpp"
 #include "core/labtest.hpp"
 
+#include "tests/softening_reference.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -19,13 +21,6 @@ JointPropertySpec paper_bond() { return LabTestOptions::paper_ucs().joint; }
 
 double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
 
-/// Piecewise-linear reference curve (total displacement ratio -> stress ratio).
-double reference(double x, double a1, double b1, double a2) {
-    if (x <= 1) return x;
-    if (x <= a1) return 1 + (b1 - 1) * (x - 1) / (a1 - 1);
-    if (x <= a2) return b1 * (a2 - x) / (a2 - a1);
-    return 0;
-}
 
 } // namespace
 
@@ -45,7 +40,7 @@ TEST_CASE("softening law, monotonic opening: SPEC §4 curve points and G_I") {
             work += 0.5 * (prev + tension) * du;
             prev = tension;
             const double x = h.un / u0;
-            max_err = std::max(max_err, std::abs(tension / p.tensile - reference(x, 1.7, 0.5, 4.0)));
+            max_err = std::max(max_err, std::abs(tension / p.tensile - softening_reference(x, 1.7, 0.5, 4.0)));
         }
         // Exact return on the piecewise-linear curve: every sample is on it.
         CHECK(max_err < 1e-6);
@@ -72,7 +67,7 @@ TEST_CASE("softening law, shear at sigma_n = 0: curve points and G_II") {
         law.update(h, 0.0, du);
         work += 0.5 * (prev + h.tau) * du;
         prev = h.tau;
-        max_err = std::max(max_err, std::abs(h.tau / p.cohesion - reference(h.us / u0, 1.3, 0.5, 2.1)));
+        max_err = std::max(max_err, std::abs(h.tau / p.cohesion - softening_reference(h.us / u0, 1.3, 0.5, 2.1)));
     }
     CHECK(max_err < 1e-6);
     CHECK(h.broken == JointState::broken_shear);

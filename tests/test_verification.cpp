@@ -5,6 +5,8 @@
 #include "core/labtest.hpp"
 #include "core/solver.hpp"
 
+#include "tests/softening_reference.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -28,12 +30,6 @@ Loaded load(const std::string& name) {
 
 double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
 
-double reference(double x, double a1, double b1, double a2) {
-    if (x <= 1) return x;
-    if (x <= a1) return 1 + (b1 - 1) * (x - 1) / (a1 - 1);
-    if (x <= a2) return b1 * (a2 - x) / (a2 - a1);
-    return 0;
-}
 
 struct Silent : StageObserver {};
 
@@ -51,7 +47,7 @@ TEST_CASE("verification 1: a bonded joint opened monotonically follows the tensi
         const double stress = -s.boundary_force("pull").x;
         const double u = s.blocks().centroid[1].x - s.blocks().centroid0[1].x;
         // Stresses at step k come from the displacement reached at its start.
-        max_err = std::max(max_err, std::abs(stress / st - reference(prev_u / u0, 1.7, 0.5, 4.0)));
+        max_err = std::max(max_err, std::abs(stress / st - softening_reference(prev_u / u0, 1.7, 0.5, 4.0)));
         work += stress * (u - prev_u);
         prev_u = u;
     }
@@ -75,7 +71,7 @@ TEST_CASE("verification 2: a bonded joint in shear at sn = 0 and sn = 5 MPa") {
             s.step();
             const double tau = -s.boundary_force("shear").y, u = s.blocks().centroid[1].y - s.blocks().centroid0[1].y;
             peak = std::max(peak, tau);
-            if (sn == 0.0) max_err = std::max(max_err, std::abs(tau / c - reference(prev_u / u0, 1.3, 0.5, 2.1)));
+            if (sn == 0.0) max_err = std::max(max_err, std::abs(tau / c - softening_reference(prev_u / u0, 1.3, 0.5, 2.1)));
             work += tau * (u - prev_u);
             prev_u = u;
         }
