@@ -168,6 +168,12 @@ vtkNew<vtkStringArray> string_array(const char* name, const Range& values, Name&
     return a;
 }
 
+/// Adds cell-data arrays to a grid, in the order given.
+template <class... Arrays>
+void add_cell_arrays(vtkUnstructuredGrid* grid, Arrays&... arrays) {
+    (grid->GetCellData()->AddArray(arrays), ...);
+}
+
 void require(bool cond, const fs::path& file, const std::string& what) {
     if (!cond) throw std::invalid_argument("cannot write " + in_quotes(file) + ": " + what);
 }
@@ -240,12 +246,7 @@ void write_blocks_vtu(const BlockAssembly& a, const fs::path& file) {
         pattern->SetValue(b, static_cast<int>(a.pattern[b]));
         parent->SetValue(b, a.parent[b]);
     }
-    vtkCellData* cd = grid->GetCellData();
-    cd->AddArray(block_id);
-    cd->AddArray(region);
-    cd->AddArray(area);
-    cd->AddArray(pattern);
-    cd->AddArray(parent);
+    add_cell_arrays(grid, block_id, region, area, pattern, parent);
 
     vtkFieldData* fd = grid->GetFieldData();
     fd->AddArray(string_array("pattern_names", all_pattern_kinds,
@@ -288,11 +289,7 @@ void write_joints_vtu(const BlockAssembly& a, const fs::path& file) {
     vtkNew<vtkUnstructuredGrid> grid;
     grid->SetPoints(points);
     grid->SetCells(VTK_LINE, cells);
-    vtkCellData* cd = grid->GetCellData();
-    cd->AddArray(tag);
-    cd->AddArray(block_a);
-    cd->AddArray(block_b);
-    cd->AddArray(length);
+    add_cell_arrays(grid, tag, block_a, block_b, length);
     grid->GetFieldData()->AddArray(
         string_array("tag_names", all_joint_tags, [](JointTag t) { return meshing::to_string(t); }));
 
@@ -371,12 +368,7 @@ void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
         const double t[6] = {stress[i][0], stress[i][1], 0.0, stress[i][2], 0.0, 0.0};
         sig->SetTuple(k, t);
     }
-    vtkCellData* cd = grid->GetCellData();
-    for (vtkAbstractArray* a : {static_cast<vtkAbstractArray*>(id), static_cast<vtkAbstractArray*>(region),
-                                static_cast<vtkAbstractArray*>(material), static_cast<vtkAbstractArray*>(disp),
-                                static_cast<vtkAbstractArray*>(vel), static_cast<vtkAbstractArray*>(rotation),
-                                static_cast<vtkAbstractArray*>(sig)})
-        cd->AddArray(a);
+    add_cell_arrays(grid, id, region, material, disp, vel, rotation, sig);
     grid->GetFieldData()->AddArray(string_array("region_names", s.region_names(), [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }
@@ -422,12 +414,7 @@ void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
     vtkNew<vtkUnstructuredGrid> grid;
     grid->SetPoints(points);
     grid->SetCells(VTK_LINE, cells);
-    vtkCellData* cd = grid->GetCellData();
-    for (vtkAbstractArray* a : {static_cast<vtkAbstractArray*>(sn), static_cast<vtkAbstractArray*>(tau),
-                                static_cast<vtkAbstractArray*>(un), static_cast<vtkAbstractArray*>(us),
-                                static_cast<vtkAbstractArray*>(damage), static_cast<vtkAbstractArray*>(state),
-                                static_cast<vtkAbstractArray*>(property), static_cast<vtkAbstractArray*>(length)})
-        cd->AddArray(a);
+    add_cell_arrays(grid, sn, tau, un, us, damage, state, property, length);
     const std::vector<std::string> states{"intact", "softening", "broken_tension", "broken_shear", "sliding"};
     grid->GetFieldData()->AddArray(string_array("state_names", states, [](const std::string& x) { return x; }));
     grid->GetFieldData()->AddArray(string_array("property_names", s.property_names(), [](const std::string& x) { return x; }));
