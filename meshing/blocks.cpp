@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <sstream>
 
@@ -45,6 +46,31 @@ void BlockAssembly::add_block(std::span<const Vec2> poly, int region_id, Pattern
     pattern.push_back(kind);
     parent.push_back(parent_id);
     area.push_back(std::abs(signed_area(poly)));
+    deformable.push_back(0);
+    vertex_node.insert(vertex_node.end(), poly.size(), -1);
+}
+
+void BlockAssembly::add_deformable_block(const TriangleMesh& mesh, int region_id,
+                                         PatternSpec::Kind kind, int parent_id) {
+    const int b = block_count();
+    const int base = int(nodes.size());
+    const std::span<const Vec2> loop(mesh.nodes.data(), std::size_t(mesh.boundary_nodes));
+    BBM_ASSERT(loop.size() >= 3 && signed_area(loop) > 0, "a mesh boundary is counter-clockwise");
+    points.insert(points.end(), loop.begin(), loop.end());
+    first.push_back(std::uint32_t(points.size()));
+    region.push_back(region_id);
+    pattern.push_back(kind);
+    parent.push_back(parent_id);
+    area.push_back(signed_area(loop));
+    deformable.push_back(1);
+    for (int i = 0; i < mesh.boundary_nodes; ++i)
+        vertex_node.push_back(base + i);
+    nodes.insert(nodes.end(), mesh.nodes.begin(), mesh.nodes.end());
+    node_block.insert(node_block.end(), mesh.nodes.size(), b);
+    for (const auto& t : mesh.triangles) {
+        zones.push_back({base + t[0], base + t[1], base + t[2]});
+        zone_block.push_back(b);
+    }
 }
 
 double mean_block_size(const BlockAssembly& a, int region) {
@@ -279,6 +305,77 @@ void order_along_curve(RegionBlocks& rb) {
     rb = std::move(sorted);
 }
 
+/// The target triangle size of region r's mesh (spec.hpp, MeshSpec). Regions do not
+/// overlap, so a point of region r lies outside the union U of the `toward` regions,
+/// and its distance to the boundary of U equals its distance to the nearest edge of
+/// any of their domains (a segment from it to an edge inside U crosses U's boundary
+/// first): the edges of the domains, outer rings and holes, are used as they are.
+SizeFunction mesh_size_function(const ModelGeometrySpec& spec, int r,
+                                const std::vector<Domain>& domain) {
+    const MeshSpec& m = spec.regions[r].mesh;
+    const double size = m.size, far = m.size_far > 0 ? m.size_far : m.size;
+    if (m.toward.empty() || m.grading <= 0 || far <= size) return [size](Vec2) { return size; };
+    std::vector<std::pair<Vec2, Vec2>> edges;
+    auto add_ring = [&](const std::vector<Vec2>& ring) {
+        for (std::size_t i = 0; i < ring.size(); ++i)
+            edges.push_back({ring[i], ring[(i + 1) % ring.size()]});
+    };
+    for (const auto& name : m.toward) {
+        const auto it = std::find_if(spec.regions.begin(), spec.regions.end(),
+                                     [&](const RegionSpec& o) { return o.name == name; });
+        for (const auto& p : domain[std::size_t(it - spec.regions.begin())]) {
+            add_ring(p.outer);
+            for (const auto& h : p.holes)
+                add_ring(h);
+        }
+    }
+    // Beyond this distance the size is size_far whatever the exact distance.
+    const double reach = (far - size) / m.grading;
+    auto grid =
+        std::make_shared<const detail::SegmentGrid>(std::move(edges), std::max(size, 0.25 * reach));
+    return [grid, size, far, reach, grading = m.grading](Vec2 x) {
+        const double d = grid->distance_within(x, reach);
+        return std::isfinite(d) ? std::min(far, size + grading * d) : far;
+    };
+}
+
+/// Step 5: every block of a region with a mesh becomes a deformable block. Block ids
+/// stay the same; the assembly is rebuilt because the polygons gain vertices.
+void mesh_deformable_blocks(BlockAssembly& a, const ModelGeometrySpec& spec,
+                            const std::vector<Domain>& domain, GenerationStats& st) {
+    const int nr = int(spec.regions.size());
+    std::vector<SizeFunction> size(nr);
+    for (int r = 0; r < nr; ++r)
+        if (spec.regions[r].mesh.enabled) size[r] = mesh_size_function(spec, r, domain);
+    BlockAssembly out;
+    out.region_names = std::move(a.region_names);
+    out.region_size = std::move(a.region_size);
+    out.real_segments = std::move(a.real_segments);
+    for (int b = 0; b < a.block_count(); ++b) {
+        const int r = a.region[b];
+        if (!size[r]) {
+            out.add_block(a.block(b), r, a.pattern[b], a.parent[b]);
+            continue;
+        }
+        TriangleMesh mesh;
+        try {
+            // The inserted points lie on the edges (up to rounding): the area is unchanged.
+            const auto boundary = subdivide_boundary(a.block(b), size[r]);
+            BBM_ASSERT(std::abs(signed_area(boundary) - a.area[b]) <= 1e-9 * a.area[b],
+                       "subdividing the edges keeps the area");
+            mesh = mesh_polygon(boundary, size[r]);
+        } catch (const GeometryError& e) {
+            throw GeometryError(r, "mesh",
+                                "meshing a block of region '" + spec.regions[r].name +
+                                    "' (centroid " + fmt(centroid(a.block(b)).x) + ", " +
+                                    fmt(centroid(a.block(b)).y) + ") failed: " + e.what());
+        }
+        st.zones += int(mesh.triangles.size());
+        out.add_deformable_block(mesh, r, a.pattern[b], a.parent[b]);
+    }
+    a = std::move(out);
+}
+
 } // namespace
 
 BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats) {
@@ -324,6 +421,29 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
         }
         if (cgal::area(domain[r]) <= 1e-12 * cgal::area(base[r]))
             throw GeometryError(r, "minus", "nothing is left of region '" + reg.name + "' after subtraction");
+        const MeshSpec& mesh = reg.mesh;
+        if (!mesh.enabled) continue;
+        if (!(mesh.size > 0))
+            throw GeometryError(r, "mesh.size",
+                                "the mesh size of region '" + reg.name + "' must be > 0 m, got " +
+                                    fmt(mesh.size));
+        if (mesh.size_far != 0 && !(mesh.size_far >= mesh.size))
+            throw GeometryError(r, "mesh.size_far",
+                                "the far mesh size of region '" + reg.name +
+                                    "' must be >= its size " + fmt(mesh.size) + " m, got " +
+                                    fmt(mesh.size_far));
+        if (!(mesh.grading >= 0))
+            throw GeometryError(r, "mesh.grading",
+                                "the mesh grading of region '" + reg.name + "' must be >= 0, got " +
+                                    fmt(mesh.grading));
+        for (const auto& name : mesh.toward) {
+            const auto it = std::find_if(spec.regions.begin(), spec.regions.end(),
+                                         [&](const RegionSpec& o) { return o.name == name; });
+            if (it == spec.regions.end() || it - spec.regions.begin() == r)
+                throw GeometryError(r, "mesh.toward",
+                                    "the mesh of region '" + reg.name + "' is refined toward '" +
+                                        name + "', which is not another region");
+        }
     }
     for (int r = 0; r < nr; ++r)
         for (int q = 0; q < r; ++q) {
@@ -387,12 +507,19 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
     }
     const auto t2 = clock::now();
 
-    // 5. Topology.
-    detail::build_joints(a);
+    // 5. Deformable blocks.
+    if (std::any_of(spec.regions.begin(), spec.regions.end(),
+                    [](const RegionSpec& reg) { return reg.mesh.enabled; }))
+        mesh_deformable_blocks(a, spec, domain, st);
     const auto t3 = clock::now();
+
+    // 6. Topology.
+    detail::build_joints(a);
+    const auto t4 = clock::now();
     st.seconds_regions = std::chrono::duration<double>(t1 - t0).count();
     st.seconds_patterns = std::chrono::duration<double>(t2 - t1).count();
-    st.seconds_topology = std::chrono::duration<double>(t3 - t2).count();
+    st.seconds_meshing = std::chrono::duration<double>(t3 - t2).count();
+    st.seconds_topology = std::chrono::duration<double>(t4 - t3).count();
     if (stats) *stats = st;
     return a;
 }

@@ -12,16 +12,25 @@
 //      the trace tip being an ordinary inner joint (a rock bridge that can break);
 //   4. short edges are collapsed (shared vertices move together, so the blocks
 //      still tile the region exactly);
-//   5. topology: every stretch of boundary shared by two blocks — a full shared
-//      edge or the part of an edge against a T-junction — becomes one JointRecord.
+//   5. deformable blocks (regions with a mesh, SPEC §6): each block's edges are
+//      subdivided at the region's target size (fe_mesh.hpp: points on a shared edge
+//      depend only on its endpoints, so neighbours in one region conform) and the
+//      block is meshed into constant-strain triangles; its polygon becomes the
+//      boundary loop of the mesh, so every vertex of it is an FE node;
+//   6. topology: every stretch of boundary shared by two blocks — a full shared
+//      edge or the part of an edge against a T-junction (a rigid block's vertex in
+//      the middle of a deformable block's boundary segment, or the reverse) —
+//      becomes one JointRecord.
 //
 // The assembly is flat (structure of arrays, compressed vertex lists) because the
 // contact code walks it for ~10^5 blocks.
 #pragma once
 
 #include "core/vec2.hpp"
+#include "meshing/fe_mesh.hpp"
 #include "meshing/spec.hpp"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -65,11 +74,27 @@ struct BlockAssembly {
     /// Segments of real discontinuities after cutting (for output and checks).
     std::vector<SegmentSpec> real_segments;
 
+    // Deformable blocks (regions with a mesh): the polygon of such a block is the
+    // boundary loop of its triangle mesh (its vertices are FE nodes). The nodes of a
+    // block are contiguous and never shared with another block; its boundary nodes
+    // come first, in the order of its vertices.
+    std::vector<std::uint8_t> deformable;       ///< per block: 1 if meshed
+    std::vector<Vec2> nodes;                    ///< FE nodes of all deformable blocks
+    std::vector<int> node_block;                ///< per node
+    std::vector<std::array<int, 3>> zones;      ///< constant-strain triangles: node ids, counter-clockwise
+    std::vector<int> zone_block;                ///< per zone
+    std::vector<int> vertex_node;               ///< per polygon vertex (index into points): its node, -1 for rigid blocks
+
     int block_count() const { return static_cast<int>(region.size()); }
     std::span<const Vec2> block(int b) const {
         return {points.data() + first[b], points.data() + first[b + 1]};
     }
+    /// A rigid block; `poly` of either orientation.
     void add_block(std::span<const Vec2> poly, int region_id, PatternSpec::Kind kind, int parent_id);
+    /// A deformable block: its polygon is the mesh's boundary loop (counter-clockwise),
+    /// its nodes and triangles are appended with the ids shifted.
+    void add_deformable_block(const TriangleMesh& mesh, int region_id, PatternSpec::Kind kind,
+                              int parent_id);
 };
 
 struct GenerationStats {
@@ -78,6 +103,9 @@ struct GenerationStats {
     /// Edges still shorter than their region's minimum (e.g. a short edge of the
     /// outline itself); reported, never hidden.
     int short_edges_left = 0;
+    /// Deformable blocks: triangles made, and the time spent subdividing and meshing.
+    int zones = 0;
+    double seconds_meshing = 0;
 };
 
 /// The whole pipeline above. Throws GeometryError for an invalid description.

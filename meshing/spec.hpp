@@ -6,8 +6,9 @@
 // subtracted from it ("outer minus bonded"), the real discontinuities that cut it
 // (explicit segments and statistical joint sets), and the pattern of inner blocks
 // that fills each piece left after cutting (paper §3.1: real joints first, inner
-// blocks second). Curved outlines become polylines whose segments are no longer
-// than `max_segment`. These structs are plain data: the input layer (apps/) fills
+// blocks second), and optionally a triangle mesh that makes its blocks deformable.
+// Curved outlines become polylines whose segments are no longer than
+// `max_segment`. These structs are plain data: the input layer (apps/) fills
 // them, generate_blocks() in blocks.hpp turns them into blocks and joints.
 #pragma once
 
@@ -90,6 +91,21 @@ struct SegmentSpec {
     Vec2 a{}, b{};
 };
 
+/// The triangle mesh of a region's deformable blocks (SPEC §6). A region with a mesh
+/// has deformable blocks: every block of its pattern is meshed into constant-strain
+/// triangles (with pattern `single`, the pieces of the region are the blocks: an
+/// elastic outer region). The target triangle size at a point x is
+///   h(x) = min(size_far, size + grading · d(x)),
+/// d(x) the distance from x to the boundary of the regions named in `toward`; with
+/// no `toward` or grading 0, h = size everywhere.
+struct MeshSpec {
+    bool enabled = false;
+    double size = 0.0;      ///< target triangle size next to the `toward` regions (or everywhere), m
+    double size_far = 0.0;  ///< largest triangle size, m; 0 = size
+    double grading = 0.0;   ///< growth of the size per metre of distance from `toward` (m/m); 0 = uniform
+    std::vector<std::string> toward; ///< names of other regions the mesh is refined toward
+};
+
 struct RegionSpec {
     std::string name;
     OutlineSpec outline;
@@ -99,6 +115,7 @@ struct RegionSpec {
     PatternSpec pattern;
     std::vector<SegmentSpec> joints;
     std::vector<JointSetSpec> joint_sets;
+    MeshSpec mesh;
 };
 
 struct ModelGeometrySpec {

@@ -382,3 +382,285 @@ TEST_CASE("invalid geometry is reported with the region and key") {
         CHECK(a.joints.size() == 2); // a's top-right corner edges against b
     }
 }
+
+// --- deformable blocks: boundary subdivision, gmsh meshes, meshed regions ------------
+
+namespace {
+
+double triangle_area(const std::vector<Vec2>& nodes, const std::array<int, 3>& t) {
+    return 0.5 * cross(nodes[t[1]] - nodes[t[0]], nodes[t[2]] - nodes[t[0]]);
+}
+
+/// The facts every mesh of `boundary` must satisfy: boundary nodes are the given points,
+/// bit for bit; triangles are positive and tile the polygon; every boundary segment is
+/// the edge of one triangle (gmsh added no node on it).
+void check_mesh(const TriangleMesh& m, std::span<const Vec2> boundary) {
+    REQUIRE(m.boundary_nodes == int(boundary.size()));
+    REQUIRE(m.nodes.size() >= boundary.size());
+    for (std::size_t i = 0; i < boundary.size(); ++i)
+        REQUIRE(m.nodes[i] == boundary[i]);
+    double sum = 0;
+    std::map<std::pair<int, int>, int> edges;
+    for (const auto& t : m.triangles) {
+        const double a = triangle_area(m.nodes, t);
+        REQUIRE(a > 0);
+        sum += a;
+        for (int k = 0; k < 3; ++k)
+            ++edges[{t[k], t[(k + 1) % 3]}];
+    }
+    const double area = signed_area(boundary);
+    CHECK(std::abs(sum - area) <= 1e-12 * area);
+    const int n = m.boundary_nodes;
+    for (int i = 0; i < n; ++i)
+        CHECK(edges[{i, (i + 1) % n}] == 1); // counter-clockwise, once
+}
+
+SizeFunction uniform(double h) {
+    return [h](Vec2) { return h; };
+}
+
+RegionSpec meshed(RegionSpec r, double size) {
+    r.mesh.enabled = true;
+    r.mesh.size = size;
+    return r;
+}
+
+/// Each deformable block's vertices map to distinct nodes of its own node range (its
+/// nodes are contiguous), at the same place; rigid blocks map to none; zones belong
+/// to the block of their nodes.
+void check_nodes(const BlockAssembly& a) {
+    REQUIRE(a.deformable.size() == std::size_t(a.block_count()));
+    REQUIRE(a.vertex_node.size() == a.points.size());
+    REQUIRE(a.node_block.size() == a.nodes.size());
+    REQUIRE(a.zone_block.size() == a.zones.size());
+    for (std::size_t n = 1; n < a.nodes.size(); ++n)
+        REQUIRE(a.node_block[n - 1] <= a.node_block[n]);
+    for (int b = 0; b < a.block_count(); ++b) {
+        std::vector<int> seen;
+        for (std::uint32_t v = a.first[b]; v < a.first[b + 1]; ++v) {
+            const int n = a.vertex_node[v];
+            if (!a.deformable[b]) {
+                REQUIRE(n == -1);
+                continue;
+            }
+            REQUIRE(n >= 0);
+            REQUIRE(n < int(a.nodes.size()));
+            REQUIRE(a.node_block[n] == b);
+            REQUIRE(a.nodes[n] == a.points[v]);
+            seen.push_back(n);
+        }
+        std::sort(seen.begin(), seen.end());
+        REQUIRE(std::adjacent_find(seen.begin(), seen.end()) == seen.end());
+    }
+    std::vector<double> zone_area(a.block_count(), 0.0);
+    for (std::size_t z = 0; z < a.zones.size(); ++z) {
+        for (int n : a.zones[z])
+            REQUIRE(a.node_block[n] == a.zone_block[z]);
+        const double za = triangle_area(a.nodes, a.zones[z]);
+        REQUIRE(za > 0);
+        zone_area[a.zone_block[z]] += za;
+    }
+    for (int b = 0; b < a.block_count(); ++b)
+        if (a.deformable[b]) CHECK(std::abs(zone_area[b] - a.area[b]) <= 1e-12 * a.area[b]);
+}
+
+} // namespace
+
+TEST_CASE("mesh_polygon: a square and an L tiled exactly, boundary points kept") {
+    const std::vector<Vec2> square{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const std::vector<Vec2> ell{{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+    for (const auto& [poly, h] : {std::pair{square, 0.1}, std::pair{ell, 0.2}}) {
+        const auto boundary = subdivide_boundary(poly, uniform(h));
+        // Perimeter over size (4 / 0.1, 8 / 0.2): no extra piece from rounding.
+        CHECK(boundary.size() == 40);
+        const auto m = mesh_polygon(boundary, uniform(h));
+        check_mesh(m, boundary);
+        // Equilateral triangles of side h: area √3/4 h², about twice as many as nodes.
+        const double area = signed_area(poly);
+        const double triangles = area / (std::sqrt(3.0) / 4.0 * h * h);
+        INFO("nodes " << m.nodes.size() << ", triangles " << m.triangles.size());
+        CHECK(double(m.triangles.size()) > 0.7 * triangles);
+        CHECK(double(m.triangles.size()) < 1.6 * triangles);
+        CHECK(double(m.nodes.size()) > 0.35 * triangles);
+        CHECK(double(m.nodes.size()) < 1.0 * triangles);
+        // Deterministic.
+        const auto again = mesh_polygon(boundary, uniform(h));
+        CHECK(again.nodes == m.nodes);
+        CHECK(again.triangles == m.triangles);
+    }
+}
+
+TEST_CASE("subdivide_boundary: an edge gets the same points in either direction") {
+    // A size that varies along the edge, so the points are not equally spaced.
+    const SizeFunction size = [](Vec2 x) { return 0.05 + 0.1 * x.x * x.x; };
+    const Vec2 a{0.3, 0.1}, b{2.7, 1.9};
+    const std::vector<Vec2> left{a, b, {0.2, 2.5}};  // a -> b
+    const std::vector<Vec2> right{b, a, {2.9, 0.0}}; // b -> a
+    const auto p = subdivide_boundary(left, size);
+    const auto q = subdivide_boundary(right, size);
+    CHECK(p[0] == a);
+    CHECK(q[0] == b);
+    const auto pb = std::find(p.begin(), p.end(), b), qa = std::find(q.begin(), q.end(), a);
+    REQUIRE(pb != p.end());
+    REQUIRE(qa != q.end());
+    const std::vector<Vec2> forward(p.begin() + 1, pb), backward(q.begin() + 1, qa);
+    REQUIRE(forward.size() > 10);
+    REQUIRE(forward.size() == backward.size());
+    for (std::size_t i = 0; i < forward.size(); ++i) {
+        const Vec2 u = forward[i], v = backward[backward.size() - 1 - i];
+        CHECK(std::memcmp(&u, &v, sizeof(Vec2)) == 0);
+        CHECK(distance_to_segment(u, a, b) < 1e-15);
+    }
+    // Pieces shrink where the size does: the first (small x) is shorter than the last.
+    CHECK(norm(forward.front() - a) < 0.5 * norm(b - forward.back()));
+}
+
+TEST_CASE("two meshed regions side by side share their nodes on the common edge") {
+    ModelGeometrySpec m;
+    m.regions.push_back(
+        meshed(rect_region("left", {0, 0}, {1, 1}, PatternSpec::Kind::single, 0), 0.25));
+    m.regions.push_back(
+        meshed(rect_region("right", {1, 0}, {2, 1}, PatternSpec::Kind::single, 0), 0.25));
+    GenerationStats st;
+    const auto a = generate_blocks(m, &st);
+    REQUIRE(a.block_count() == 2);
+    CHECK(a.deformable[0] == 1);
+    CHECK(a.deformable[1] == 1);
+    check_nodes(a);
+    check_tiling(a, 2.0, 6.0);
+    auto on_edge = [&](int b) {
+        std::vector<Vec2> pts;
+        for (Vec2 p : a.block(b))
+            if (p.x == 1.0) pts.push_back(p);
+        std::sort(pts.begin(), pts.end(), [](Vec2 u, Vec2 v) { return u.y < v.y; });
+        return pts;
+    };
+    const auto l = on_edge(0), r = on_edge(1);
+    CHECK(l.size() == 5); // 4 pieces of 0.25 m
+    CHECK(l == r);
+    double joints = 0;
+    for (const auto& j : a.joints) {
+        CHECK(j.tag == JointTag::interface);
+        CHECK(j.p0.x == 1.0);
+        CHECK(j.p1.x == 1.0);
+        joints += j.length();
+    }
+    CHECK(a.joints.size() == 4);
+    CHECK(std::abs(joints - 1.0) <= 1e-12);
+    double zones = 0;
+    for (const auto& z : a.zones)
+        zones += triangle_area(a.nodes, z);
+    CHECK(std::abs(zones - 2.0) <= 1e-12);
+    CHECK(st.zones == int(a.zones.size()));
+}
+
+TEST_CASE("a meshed region against rigid Voronoi blocks: non-conforming interface") {
+    ModelGeometrySpec m;
+    m.regions.push_back(
+        meshed(rect_region("elastic", {0, 0}, {1, 1}, PatternSpec::Kind::single, 0), 0.13));
+    m.regions.push_back(rect_region("bonded", {1, 0}, {2, 1}, PatternSpec::Kind::voronoi, 0.2, 3));
+    const auto a = generate_blocks(m);
+    check_nodes(a);
+    check_tiling(a, 2.0, 6.0);
+    double interface = 0;
+    int t_junctions = 0;
+    for (const auto& j : a.joints) {
+        if (j.tag != JointTag::interface) continue;
+        CHECK(std::abs(j.p0.x - 1.0) < 1e-15);
+        CHECK(std::abs(j.p1.x - 1.0) < 1e-15);
+        interface += j.length();
+        // The record ends at a vertex of one block that lies inside an edge of the other.
+        const auto pa = a.block(j.block_a), pb = a.block(j.block_b);
+        const bool ends_match = (j.p0 == pa[j.edge_a] || j.p0 == pa[(j.edge_a + 1) % pa.size()]) &&
+                                (j.p0 == pb[j.edge_b] || j.p0 == pb[(j.edge_b + 1) % pb.size()]);
+        t_junctions += !ends_match;
+    }
+    CHECK(std::abs(interface - 1.0) <= 1e-9);
+    CHECK(t_junctions > 0);
+}
+
+TEST_CASE("meshed Voronoi blocks: each block its own mesh, conforming to its neighbours") {
+    auto r = meshed(rect_region("rock", {0, 0}, {2, 1}, PatternSpec::Kind::voronoi, 0.5, 5), 0.1);
+    const auto a = generate_blocks(one(r));
+    check_nodes(a);
+    check_tiling(a, 2.0, 6.0);
+    // Shared edges of one region are subdivided identically: every joint record runs
+    // between vertices of both blocks.
+    for (const auto& j : a.joints) {
+        const auto pa = a.block(j.block_a), pb = a.block(j.block_b);
+        CHECK(j.p0 == pb[(j.edge_b + 1) % pb.size()]);
+        CHECK(j.p1 == pb[j.edge_b]);
+        CHECK(j.p0 == pa[j.edge_a]);
+        CHECK(j.p1 == pa[(j.edge_a + 1) % pa.size()]);
+    }
+}
+
+TEST_CASE("the tunnel's outer region meshed with triangles graded toward the bonded region") {
+    auto spec = tunnel(PatternSpec::Kind::voronoi);
+    spec.regions[0].mesh = {true, 0.3, 3.0, 0.25, {"bonded"}};
+    GenerationStats st;
+    const auto a = generate_blocks(spec, &st);
+    MESSAGE("outer region: " << st.zones << " zones, " << a.nodes.size() << " nodes, meshed in "
+                             << st.seconds_meshing << " s");
+    check_tiling(a, 800.0, 120.0);
+    check_nodes(a);
+    int outer_blocks = 0;
+    for (int b = 0; b < a.block_count(); ++b) {
+        CHECK(bool(a.deformable[b]) == (a.region[b] == 0));
+        outer_blocks += a.region[b] == 0;
+    }
+    CHECK(outer_blocks == 1);
+    CHECK(st.zones == int(a.zones.size()));
+    // Zones touching the bonded region (x = 8, |y| <= 8) against those at the far side.
+    double near = 0, far = 0;
+    int n_near = 0, n_far = 0;
+    for (const auto& z : a.zones) {
+        const Vec2 c = (a.nodes[z[0]] + a.nodes[z[1]] + a.nodes[z[2]]) / 3.0;
+        const double area = triangle_area(a.nodes, z);
+        if (c.x > 8 && c.x < 8.3 && std::abs(c.y) < 7) near += area, ++n_near;
+        if (c.x > 17) far += area, ++n_far;
+    }
+    REQUIRE(n_near > 0);
+    REQUIRE(n_far > 0);
+    const double h_near = std::sqrt(near / n_near / (std::sqrt(3.0) / 4.0));
+    const double h_far = std::sqrt(far / n_far / (std::sqrt(3.0) / 4.0));
+    INFO("equilateral side of the mean zone: near " << h_near << " m, far " << h_far << " m");
+    CHECK(h_near < 0.45);
+    CHECK(h_far > 2.0);
+    CHECK(h_far > 5 * h_near);
+    // The whole interface (x = 8 and y = ±8 up to x = 8) is covered by joint records.
+    double interface = 0;
+    for (const auto& j : a.joints)
+        if (j.tag == JointTag::interface && (a.region[j.block_a] == 0 || a.region[j.block_b] == 0))
+            interface += j.length();
+    CHECK(std::abs(interface - 32.0) <= 1e-9 * 32.0);
+}
+
+TEST_CASE("invalid meshes are reported with the region and key") {
+    ModelGeometrySpec m;
+    m.regions.push_back(
+        meshed(rect_region("a", {0, 0}, {1, 1}, PatternSpec::Kind::single, 0), 0.2));
+    m.regions.push_back(rect_region("b", {1, 0}, {2, 1}, PatternSpec::Kind::single, 0));
+    m.regions[0].mesh.grading = 0.5;
+    m.regions[0].mesh.size_far = 1.0;
+    m.regions[0].mesh.toward = {"c"};
+    try {
+        generate_blocks(m);
+        FAIL("no error");
+    } catch (const GeometryError& e) {
+        CHECK(e.region() == 0);
+        CHECK(e.key() == "mesh.toward");
+        CHECK(std::string(e.what()).find("'c', which is not another region") != std::string::npos);
+    }
+    m.regions[0].mesh.toward = {"b"};
+    const auto a = generate_blocks(m);
+    check_nodes(a);
+    check_tiling(a, 2.0, 6.0);
+    m.regions[0].mesh.size = 0;
+    try {
+        generate_blocks(m);
+        FAIL("no error");
+    } catch (const GeometryError& e) {
+        CHECK(e.key() == "mesh.size");
+    }
+}
