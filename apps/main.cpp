@@ -6,6 +6,7 @@
 // 1 any other failure. Earlier output in DIR is only replaced by complete files.
 #include "apps/model_input.hpp"
 #include "apps/picture.hpp"
+#include "apps/run_model.hpp"
 #include "apps/vtk_output.hpp"
 #include "core/analysis.hpp"
 #include "core/labtest.hpp"
@@ -112,150 +113,6 @@ int run_mesh(const std::string& model_path, const fs::path& out, const io::Pictu
     return 0;
 }
 
-
-std::atomic<bool> interrupted{false};
-
-/// Writes the ParaView series, the history and the progress line of a run.
-class RunOutput : public StageObserver {
-public:
-    RunOutput(const fs::path& out, const AnalysisSpec& an, const Solver& s, bool quiet)
-        : out_(out), settings_(an.solver), recorder_(s, an.histories), quiet_(quiet) {
-        fs::create_directories(out_ / "vtk");
-    }
-
-    void stage_started(const Solver& s, const StageSpec& st) override {
-        stage_t0_ = last_print_ = std::chrono::steady_clock::now();
-        stage_steps_ = st.kind == StageSpec::Kind::cycle ? st.steps
-                     : st.kind == StageSpec::Kind::excavate ? st.relax_steps : st.max_steps;
-        if (s.steps() == 0) {
-            record(s);
-            snapshot(s);
-        }
-    }
-    void step_done(const Solver& s, const StageSpec& st, long k) override {
-        if (s.steps() % settings_.history_every == 0) record(s);
-        if (settings_.output_every > 0 && s.steps() % settings_.output_every == 0) snapshot(s);
-        if (!quiet_) {
-            const auto now = std::chrono::steady_clock::now();
-            if (std::chrono::duration<double>(now - last_print_).count() >= 1.0) {
-                last_print_ = now;
-                const double el = std::chrono::duration<double>(now - stage_t0_).count();
-                const double rate = k / el;
-                std::fprintf(stderr, "\r  %-12s step %9ld  ratio %9.3e  cracks %6d T %6d S  %8.0f steps/s  %s   ",
-                             st.name.c_str(), k, s.unbalanced_ratio(), s.cracks(contact::JointState::broken_tension),
-                             s.cracks(contact::JointState::broken_shear), rate,
-                             st.kind == StageSpec::Kind::solve ? "" : ("ETA " + std::to_string(long((stage_steps_ - k) / rate)) + " s").c_str());
-            }
-        }
-    }
-    void stage_done(const Solver& s, const StageReport& r) override {
-        record(s);
-        snapshot(s);
-        flush_history();
-        if (!quiet_)
-            std::fprintf(stderr, "\r  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s\n", r.name.c_str(), r.kind.c_str(),
-                         r.steps, r.ratio, r.seconds, r.converged ? "" : "  (step limit reached)",
-                         std::string(40, ' ').c_str());
-    }
-    bool stop_requested() override { return interrupted.load(); }
-
-private:
-    void record(const Solver& s) {
-        if (!rows_.empty() && rows_.back().first == s.steps()) return;
-        rows_.push_back({s.steps(), recorder_.sample(s)});
-        times_.push_back(s.time());
-    }
-    void snapshot(const Solver& s) {
-        if (!series_.empty() && last_snapshot_ == s.steps()) return;
-        last_snapshot_ = s.steps();
-        char name[64];
-        std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
-        io::write_state_blocks_vtu(s, out_ / name);
-        series_.push_back({s.time(), name});
-        std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
-        io::write_state_contacts_vtu(s, out_ / name);
-        series_.push_back({s.time(), name});
-        io::write_pvd(out_ / "result.pvd", series_);
-    }
-    void flush_history() {
-        std::ostringstream csv;
-        csv << "step,time";
-        for (const auto& h : recorder_.histories()) csv << ',' << h.name;
-        csv << '\n';
-        csv.precision(10);
-        for (std::size_t r = 0; r < rows_.size(); ++r) {
-            csv << rows_[r].first << ',' << times_[r];
-            for (double v : rows_[r].second) csv << ',' << v;
-            csv << '\n';
-        }
-        io::write_text_atomically(out_ / "history.csv", csv.str());
-    }
-
-    fs::path out_;
-    SolverSpec settings_;
-    HistoryRecorder recorder_;
-    bool quiet_;
-    std::vector<std::pair<long, std::vector<double>>> rows_;
-    std::vector<double> times_;
-    std::vector<std::pair<double, std::string>> series_;
-    long last_snapshot_ = -1, stage_steps_ = 0;
-    std::chrono::steady_clock::time_point stage_t0_, last_print_;
-};
-
-int run_model(const std::string& model_path, const fs::path& out, int threads, bool quiet) {
-    const auto t0 = std::chrono::steady_clock::now();
-    io::ModelFile model = io::read_model(model_path);
-    model.analysis.solver.threads = threads;
-    if (model.analysis.stages.empty())
-        throw InputError(model_path, 0, "stage", "the model has no [[stage]] to run (bbm mesh only generates blocks)");
-    meshing::BlockAssembly blocks;
-    try {
-        blocks = meshing::generate_blocks(model.geometry);
-    } catch (const GeometryError& e) {
-        throw io::to_input_error(model.source, e);
-    }
-    std::unique_ptr<Solver> solver;
-    try {
-        solver = std::make_unique<Solver>(blocks, model.analysis);
-    } catch (const InputError& e) {
-        throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
-    }
-    if (!quiet)
-        std::fprintf(stderr, "%s: %d blocks, %d contacts, time step %.3g s (%s)\n", model_path.c_str(),
-                     blocks.block_count(), solver->contacts().size(), solver->timestep(),
-                     model.analysis.solver.mode == SolverSpec::Mode::quasi_static ? "quasi-static" : "dynamic");
-    std::signal(SIGINT, [](int) { interrupted = true; });
-    std::signal(SIGTERM, [](int) { interrupted = true; });
-    RunOutput output(out, model.analysis, *solver, quiet);
-    const auto reports = run_stages(*solver, model.analysis.stages, output);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    nlohmann::json stages = nlohmann::json::array();
-    for (const auto& r : reports)
-        stages.push_back({{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
-                          {"seconds", r.seconds}, {"converged", r.converged}});
-    const nlohmann::json summary{
-        {"model", model_path},
-        {"blocks", blocks.block_count()},
-        {"contacts", solver->contacts().size()},
-        {"steps", solver->steps()},
-        {"time", solver->time()},
-        {"timestep", solver->timestep()},
-        {"wall_seconds", seconds},
-        {"cracks", {{"tensile", solver->cracks(contact::JointState::broken_tension)},
-                    {"shear", solver->cracks(contact::JointState::broken_shear)}}},
-        {"unbalanced_ratio", solver->unbalanced_ratio()},
-        {"energy", {{"kinetic", solver->kinetic_energy()}, {"strain", solver->strain_energy()},
-                    {"dissipated", solver->dissipated_energy()}, {"external_work", solver->external_work()}}},
-        {"state_hash", std::to_string(solver->state_hash())},
-        {"interrupted", interrupted.load()},
-        {"stages", stages}};
-    io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
-    if (!quiet)
-        std::fprintf(stderr, "%ld steps in %.2f s; cracks %d tensile, %d shear; wrote %s/{result.pvd, history.csv, summary.json}\n",
-                     solver->steps(), seconds, solver->cracks(contact::JointState::broken_tension),
-                     solver->cracks(contact::JointState::broken_shear), out.string().c_str());
-    return interrupted ? 130 : 0;
-}
 
 /// Command-line values of the lab tests, defaults = the paper's calibration run.
 struct LabTestCli {
@@ -462,21 +319,25 @@ int main(int argc, char** argv) {
     mesh->add_option("--window", window, "Part of the model drawn in blocks.png: XMIN YMIN XMAX YMAX (m)")
         ->expected(4);
 
-    std::string run_model_path;
+    io::RunOptions run_options;
     std::string run_out = "out";
     auto* run = app.add_subcommand(
-        "run", "Generate the blocks of a model file and run its stages (initialize, solve, excavate, "
-               "cycle). Writes DIR/result.pvd (ParaView series of blocks and contacts), DIR/history.csv "
-               "and DIR/summary.json. Ctrl-C stops after the current step and writes the output.");
-    run->add_option("model", run_model_path, "Model file (TOML; keys in docs/input.md)")
-        ->required()
-        ->check(CLI::ExistingFile);
+        "run", "Generate the blocks of a model file and run its stages (initialize, elastic, solve, excavate, "
+               "cycle). Writes DIR/result.pvd (ParaView series of blocks, zones and contacts), DIR/history.csv, "
+               "history.png, failure.png/.svg and DIR/summary.json. Ctrl-C stops after the current step, writes a "
+               "checkpoint and the output; `bbm run --resume --out DIR` continues.");
+    run->add_option("model", run_options.model, "Model file (TOML; keys in docs/input.md)")->check(CLI::ExistingFile);
     run->add_option("-o,--out", run_out, "Output directory (created if missing)")->capture_default_str();
     run->add_flag("-q,--quiet", quiet, "No progress, only errors");
-    int run_threads = 1;
-    run->add_option("--threads", run_threads, "Threads of the contact loop (results are deterministic per thread count)")
+    run->add_option("--threads", run_options.threads,
+                    "Threads of the contact loop (results are deterministic per thread count)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    run->add_option("--checkpoint-every", run_options.checkpoint_every,
+                    "Write DIR/checkpoint.bin every N steps (0: only when interrupted)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    run->add_flag("--resume", run_options.resume, "Continue the run whose checkpoint is in --out");
 
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     LabTestCli ucs_cli, tension_cli, biaxial_cli, brazilian_cli;
@@ -507,7 +368,13 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : 2;
     }
     try {
-        if (*run) return run_model(run_model_path, run_out, run_threads, quiet);
+        if (*run) {
+            if (run_options.model.empty() && !run_options.resume)
+                throw InputError("bbm run", 0, "", "give a model file, or --resume with the --out of a run to continue");
+            run_options.out = run_out;
+            run_options.quiet = quiet;
+            return io::run_model(run_options);
+        }
         if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);
         if (*tension) return run_labtest_command(tension_cli, LabTestOptions::Kind::tension, "tension", quiet);
         if (*biaxial) return run_labtest_command(biaxial_cli, LabTestOptions::Kind::biaxial, "biaxial", quiet);

@@ -24,6 +24,7 @@
 namespace bbm::io {
 
 using meshing::JointSetSpec;
+using meshing::MeshSpec;
 using meshing::ModelGeometrySpec;
 using meshing::OutlineSpec;
 using meshing::PatternSpec;
@@ -602,13 +603,38 @@ void read_list(const Ctx& c, const toml::table& t, const Path& p, std::string_vi
     for_each_element(c, to_array(c, *n, kp, expected), kp, f);
 }
 
+/// A region's mesh: its blocks become deformable (SPEC §6). The `toward` names are
+/// checked with the other region names, once all regions are read.
+MeshSpec read_mesh(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a mesh table { size = ..., ... }");
+    static constexpr std::array<std::string_view, 4> keys{"size", "size_far", "grading", "toward"};
+    check_keys(c, t, p, keys);
+    MeshSpec m;
+    m.enabled = true;
+    m.size = required_number(c, t, p, "size", above(0, metres));
+    if (const auto far = number(c, t, p, "size_far", above(0, metres))) {
+        if (!(*far >= m.size))
+            c.fail(*t.get("size_far"), p.key("size_far"),
+                   "must be >= size = " + fmt(m.size) + " m, got " + fmt(*far));
+        m.size_far = *far;
+    }
+    m.grading = number(c, t, p, "grading", at_least(0, " m/m")).value_or(0.0);
+    read_list(c, t, p, "toward", "an array of region names",
+              [&](const toml::node& n, const Path& ep) { m.toward.push_back(to_str(c, n, ep)); });
+    if (m.grading > 0 && m.toward.empty())
+        c.fail(*t.get("grading"), p.key("grading"),
+               "grades the mesh by the distance from the regions listed in 'toward', but none "
+               "are listed");
+    return m;
+}
+
 /// A region; the name in its `material` key (checked once materials are read) goes
 /// to `material`.
 RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
                        std::optional<std::string>& material) {
     const toml::table& t = to_table(c, node, p, "a [[region]] table");
-    static constexpr std::array<std::string_view, 8> keys{
-        "name", "outline", "holes", "minus", "pattern", "joints", "joint_set", "material"};
+    static constexpr std::array<std::string_view, 9> keys{
+        "name", "outline", "holes", "minus", "pattern", "joints", "joint_set", "material", "mesh"};
     check_keys(c, t, p, keys);
     RegionSpec r;
     const Path np = p.key("name");
@@ -633,6 +659,7 @@ RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
               [&](const toml::node& n, const Path& ep) {
                   r.joint_sets.push_back(read_joint_set(c, n, ep));
               });
+    if (const toml::node* m = find(c, t, p, "mesh")) r.mesh = read_mesh(c, *m, p.key("mesh"));
     return r;
 }
 
@@ -651,23 +678,30 @@ void check_names(const Ctx& c, const ModelFile& mf) {
                        "region name " + quoted(rs[i].name) + " is already used by region[" +
                            std::to_string(j) + "] (line " +
                            std::to_string(mf.source.region_line[j]) + ")");
-        for (std::size_t k = 0; k < rs[i].minus.size(); ++k) {
-            const std::string& m_name = rs[i].minus[k];
-            const Path mp = p.key("minus").at(k);
-            const int at = lines.at(mp.rel);
-            if (m_name == rs[i].name)
-                c.fail(at, mp, "region " + quoted(m_name) + " cannot subtract itself");
-            if (std::ranges::find(names, m_name) == names.end())
-                c.fail(at, mp,
-                       "region " + quoted(rs[i].name) + " subtracts " + quoted(m_name) +
-                           ", but there is no region of that name" + did_you_mean(m_name, names) +
-                           "; regions are: " + join(names));
-            for (std::size_t q = 0; q < k; ++q)
-                if (rs[i].minus[q] == m_name)
+        // A list of other regions' names: `key` in the region, `verb` for messages.
+        auto check_list = [&](const std::vector<std::string>& list, const std::string& key,
+                              const std::string& verb, const std::string& itself) {
+            for (std::size_t k = 0; k < list.size(); ++k) {
+                const std::string& m_name = list[k];
+                const Path mp = p.key(key).at(k);
+                const int at = lines.at(mp.rel);
+                if (m_name == rs[i].name)
+                    c.fail(at, mp, "region " + quoted(m_name) + " cannot " + itself);
+                if (std::ranges::find(names, m_name) == names.end())
                     c.fail(at, mp,
-                           quoted(m_name) + " is already listed as minus[" + std::to_string(q) +
-                               "]");
-        }
+                           "region " + quoted(rs[i].name) + " " + verb + " " + quoted(m_name) +
+                               ", but there is no region of that name" +
+                               did_you_mean(m_name, names) + "; regions are: " + join(names));
+                for (std::size_t q = 0; q < k; ++q)
+                    if (list[q] == m_name)
+                        c.fail(at, mp,
+                               quoted(m_name) + " is already listed as " + key + "[" +
+                                   std::to_string(q) + "]");
+            }
+        };
+        check_list(rs[i].minus, "minus", "subtracts", "subtract itself");
+        check_list(rs[i].mesh.toward, "mesh.toward", "refines its mesh toward",
+                   "refine its mesh toward itself");
     }
 }
 
@@ -784,7 +818,8 @@ constexpr std::array<std::string_view, 14> quantities{"unbalanced_ratio",  "disp
                                                       "cracks_tensile",    "cracks_shear",
                                                       "kinetic_energy",    "strain_energy",
                                                       "dissipated_energy", "work"};
-constexpr std::array<std::string_view, 4> stage_types{"initialize", "solve", "excavate", "cycle"};
+constexpr std::array<std::string_view, 5> stage_types{"initialize", "solve", "excavate", "cycle",
+                                                      "elastic"};
 
 SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
                        const Names& properties) {
@@ -824,11 +859,24 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
 }
 
 MaterialSpec read_material(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 2> keys{"name", "density"};
+    static constexpr std::array<std::string_view, 5> keys{"name", "density", "young", "poisson",
+                                                          "deformable_fraction"};
     check_keys(c, t, p, keys);
     MaterialSpec m;
     m.name = read_name(c, t, p, names);
     m.density = number(c, t, p, "density", above(0, " kg/m³")).value_or(m.density);
+    m.young = number(c, t, p, "young", above(0, pascals)).value_or(0.0);
+    m.poisson = number(c, t, p, "poisson", below(0, 0.5, "")).value_or(m.poisson);
+    m.deformable_fraction =
+        number(c, t, p, "deformable_fraction",
+               Range{.lo = 0, .hi = 1, .lo_open = true, .hi_open = true, .unit = ""})
+            .value_or(0.0);
+    // Without E there is no elasticity for them to describe.
+    for (std::string_view key : {"poisson", "deformable_fraction"})
+        if (m.young == 0 && t.contains(key))
+            c.fail(*t.get(key), p.key(key),
+                   c.in_owner() + "applies to deformable blocks and needs 'young', which is not "
+                                  "given");
     return m;
 }
 
@@ -984,14 +1032,14 @@ Box2 read_box(const Ctx& c, const toml::node& node, const Path& p) {
 
 BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& names,
                            const Names& regions) {
-    static constexpr std::array<std::string_view, 7> velocity_keys{"name", "type", "regions", "box",
-                                                                   "vx",   "vy",   "omega"};
+    static constexpr std::array<std::string_view, 8> velocity_keys{"name", "type", "regions", "box",
+                                                                   "touching", "vx", "vy", "omega"};
     static constexpr std::array<std::string_view, 11> stress_boundary_keys{
         "name", "type",  "regions", "box",     "sxx",    "syy",
         "sxy",  "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
-    static constexpr std::array<std::string_view, 14> all_keys{
-        "name", "type", "regions", "box",   "vx",      "vy",      "omega",
-        "sxx",  "syy",  "sxy",     "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
+    static constexpr std::array<std::string_view, 15> all_keys{
+        "name", "type", "regions", "box",   "touching", "vx",      "vy",      "omega",
+        "sxx",  "syy",  "sxy",     "y_ref", "dsxx_dy",  "dsyy_dy", "dsxy_dy"};
     check_keys(c, t, p, all_keys);
     BoundarySpec b;
     using Kind = BoundarySpec::Kind;
@@ -1005,6 +1053,7 @@ BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& n
         b.stress = read_stress(c, t, p);
         return b;
     }
+    b.select.touching = boolean(c, t, p, "touching").value_or(false);
     b.vx = number(c, t, p, "vx", unbounded(" m/s"));
     b.vy = number(c, t, p, "vy", unbounded(" m/s"));
     b.omega = number(c, t, p, "omega", unbounded(" rad/s"));
@@ -1061,6 +1110,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     static constexpr std::array<std::string_view, 4> excavate_keys{"name", "type", "regions",
                                                                    "relax_steps"};
     static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
+    static constexpr std::array<std::string_view, 2> elastic_keys{"name", "type"};
     check_keys(c, t, p, all_keys);
     StageSpec s;
     using Kind = StageSpec::Kind;
@@ -1079,7 +1129,8 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     const Keys keys = s.kind == Kind::initialize ? Keys(initialize_keys)
                       : s.kind == Kind::solve    ? Keys(solve_keys)
                       : s.kind == Kind::excavate ? Keys(excavate_keys)
-                                                 : Keys(cycle_keys);
+                      : s.kind == Kind::cycle    ? Keys(cycle_keys)
+                                                 : Keys(elastic_keys);
     check_keys(c, t, p, keys, all_keys,
                article(stage_types[static_cast<std::size_t>(s.kind)]) + " stage");
     constexpr std::int64_t long_max = std::numeric_limits<long>::max();
@@ -1100,8 +1151,36 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     case Kind::cycle:
         s.steps = required_integer(c, t, p, "steps", 1, long_max);
         break;
+    case Kind::elastic:
+        break;
     }
     return s;
+}
+
+/// A deformable region (one with a mesh) needs the elasticity of its material. A region
+/// takes the material it names; if no region names one, every region takes the first
+/// [[material]] (as core/solver.cpp resolves them); otherwise it has none (rigid).
+void check_deformable_materials(const Ctx& c, const ModelFile& mf) {
+    const AnalysisSpec& an = mf.analysis;
+    const auto& rs = mf.geometry.regions;
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+        if (!rs[i].mesh.enabled) continue;
+        const MaterialSpec* m = nullptr;
+        for (const auto& [region, material] : an.region_material)
+            if (region == rs[i].name)
+                m = &*std::ranges::find(an.materials, material, &MaterialSpec::name);
+        if (an.region_material.empty() && !an.materials.empty()) m = &an.materials.front();
+        const Path p{"region[" + std::to_string(i) + "].mesh", ""};
+        const int at = mf.source.key_line[i].at("mesh");
+        const std::string head =
+            "region " + quoted(rs[i].name) + " is deformable (has a mesh) but ";
+        if (!m)
+            c.fail(at, p,
+                   head + "has no material; name a [[material]] with a young modulus in its "
+                          "'material' key");
+        if (m->young == 0)
+            c.fail(at, p, head + "its material " + quoted(m->name) + " has no young modulus");
+    }
 }
 
 /// Each table of the top-level array `key` ([[key]] sections), read by f(table, path).
@@ -1138,6 +1217,7 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
         check_ref(c, mf.source.key_line[i].at("material"), p, *region_material[i], materials);
         an.region_material.emplace_back(regions.names[i], *region_material[i]);
     }
+    check_deformable_materials(c, mf);
 
     Names properties{"joint property", "joint properties", "joint_property", {}, {}};
     read_tables(c, doc, "joint_property", [&](const toml::table& t, const Path& p, std::size_t) {
@@ -1160,6 +1240,22 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
         an.stages.push_back(read_stage(c, t, p, i, stages, regions));
     });
+    if (const toml::node* n = find(c, doc, Path{}, "report")) {
+        const Path p = Path{}.key("report");
+        const toml::table& t = to_table(c, *n, p, "a [report] table");
+        static constexpr std::array<std::string_view, 4> keys{"center", "springline", "crown", "window"};
+        check_keys(c, t, p, keys);
+        auto& r = an.report;
+        if (find(c, t, p, "center") || find(c, t, p, "springline") || find(c, t, p, "crown")) {
+            r.opening = true;
+            r.center = required_point(c, t, p, "center");
+            r.springline = required_point(c, t, p, "springline");
+            r.crown = required_point(c, t, p, "crown");
+            if (!(norm(r.springline - r.center) > 0) || !(norm(r.crown - r.center) > 0))
+                c.fail(t, p, "springline and crown must differ from center (they are points on the opening's wall)");
+        }
+        if (const toml::node* w = find(c, t, p, "window")) r.window = read_box(c, *w, p.key("window"));
+    }
 }
 
 } // namespace
@@ -1201,9 +1297,9 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     c.file = name;
     c.source = &mf.source;
     const Path root{};
-    static constexpr std::array<std::string_view, 9> top_keys{
+    static constexpr std::array<std::string_view, 10> top_keys{
         "model",    "region", "material", "joint_property", "joint_assignment",
-        "boundary", "solver", "history",  "stage"};
+        "boundary", "solver", "history",  "stage",          "report"};
     check_keys(c, doc, root, top_keys);
 
     if (const toml::node* n = find(c, doc, root, "model")) {

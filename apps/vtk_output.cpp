@@ -19,8 +19,10 @@
 #include <vtkIdTypeArray.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkStringArray.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 #pragma GCC diagnostic pop
@@ -331,44 +333,102 @@ void write_text_atomically(const fs::path& file, std::string_view text) {
 
 void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
     const auto& b = s.blocks();
+    const auto& nodes = s.nodes();
+    const auto& z = s.zones();
     const auto stress = s.block_stresses();
-    std::vector<int> kept;
+    // Cells: rigid blocks (polygons) first, then the zones of deformable blocks
+    // (triangles), so one grid shows the whole model.
+    std::vector<int> kept, zones;
     for (int i = 0; i < b.count(); ++i)
-        if (!b.removed[i]) kept.push_back(i);
+        if (!b.removed[i] && !b.deformable[i]) kept.push_back(i);
+    for (int k = 0; k < z.size(); ++k)
+        if (!b.removed[z.block[k]]) zones.push_back(k);
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
+    auto point_disp = double_array("displacement", 0);
+    point_disp->SetNumberOfComponents(3);
     vtkNew<vtkIdTypeArray> offsets, connectivity;
+    vtkNew<vtkUnsignedCharArray> types;
     offsets->InsertNextValue(0);
     for (int i : kept) {
-        for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v)
+        const Vec2 c0 = b.centroid0[i];
+        for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
             connectivity->InsertNextValue(points->InsertNextPoint(b.vertex[v].x, b.vertex[v].y, 0.0));
+            const Vec2 u = b.vertex[v] - (c0 + b.local[v]);
+            point_disp->InsertNextTuple3(u.x, u.y, 0.0);
+        }
         offsets->InsertNextValue(connectivity->GetNumberOfValues());
+        types->InsertNextValue(VTK_POLYGON);
+    }
+    // Nodes of deformable blocks, written once each (only those of kept zones).
+    std::vector<vtkIdType> node_point(nodes.count(), -1);
+    for (int k : zones) {
+        for (int nd : z.node[k]) {
+            if (node_point[nd] < 0) {
+                node_point[nd] = points->InsertNextPoint(nodes.position[nd].x, nodes.position[nd].y, 0.0);
+                const Vec2 u = nodes.position[nd] - nodes.position0[nd];
+                point_disp->InsertNextTuple3(u.x, u.y, 0.0);
+            }
+            connectivity->InsertNextValue(node_point[nd]);
+        }
+        offsets->InsertNextValue(connectivity->GetNumberOfValues());
+        types->InsertNextValue(VTK_TRIANGLE);
     }
     vtkNew<vtkCellArray> cells;
     cells->SetData(offsets, connectivity);
     vtkNew<vtkUnstructuredGrid> grid;
     grid->SetPoints(points);
-    grid->SetCells(VTK_POLYGON, cells);
-    const auto n = static_cast<vtkIdType>(kept.size());
+    grid->SetCells(types, cells);
+    grid->GetPointData()->AddArray(point_disp);
+    const auto nk = static_cast<vtkIdType>(kept.size());
+    const auto n = nk + static_cast<vtkIdType>(zones.size());
     auto id = int_array("block_id", n), region = int_array("region", n), material = int_array("material", n);
+    auto kind = int_array("zone", n);
     auto rotation = double_array("rotation", n);
-    auto disp = double_array("displacement", 0), vel = double_array("velocity", 0), sig = double_array("stress", 0);
+    auto disp = double_array("cell_displacement", 0), vel = double_array("velocity", 0), sig = double_array("stress", 0);
+    auto eps = double_array("strain", 0);
     disp->SetNumberOfComponents(3), disp->SetNumberOfTuples(n);
     vel->SetNumberOfComponents(3), vel->SetNumberOfTuples(n);
     sig->SetNumberOfComponents(6), sig->SetNumberOfTuples(n);
-    for (vtkIdType k = 0; k < n; ++k) {
+    eps->SetNumberOfComponents(6), eps->SetNumberOfTuples(n);
+    for (vtkIdType k = 0; k < nk; ++k) {
         const int i = kept[k];
         id->SetValue(k, i);
         region->SetValue(k, b.region[i]);
         material->SetValue(k, b.material[i]);
+        kind->SetValue(k, 0);
         rotation->SetValue(k, b.theta[i]);
         const Vec2 u = b.centroid[i] - b.centroid0[i];
         disp->SetTuple3(k, u.x, u.y, 0.0);
         vel->SetTuple3(k, b.velocity[i].x, b.velocity[i].y, 0.0);
         const double t[6] = {stress[i][0], stress[i][1], 0.0, stress[i][2], 0.0, 0.0};
         sig->SetTuple(k, t);
+        const double e[6] = {0, 0, 0, 0, 0, 0}; // rigid: the strain lives in the joints
+        eps->SetTuple(k, e);
     }
-    add_cell_arrays(grid, id, region, material, disp, vel, rotation, sig);
+    for (std::size_t q = 0; q < zones.size(); ++q) {
+        const vtkIdType k = nk + vtkIdType(q);
+        const int zi = zones[q], blk = z.block[zi];
+        id->SetValue(k, blk);
+        region->SetValue(k, b.region[blk]);
+        material->SetValue(k, b.material[blk]);
+        kind->SetValue(k, 1);
+        rotation->SetValue(k, 0.0);
+        Vec2 u{}, v{};
+        for (int nd : z.node[zi]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0, v += nodes.velocity[nd] / 3.0;
+        disp->SetTuple3(k, u.x, u.y, 0.0);
+        vel->SetTuple3(k, v.x, v.y, 0.0);
+        const auto& st = z.stress[zi];
+        // Plane strain: σzz = ν(σxx + σyy) = λ/(2(λ+G)) (σxx + σyy) for a stress from zero.
+        const auto& el = z.elasticity[zi];
+        const double szz = el.lambda / (2.0 * (el.lambda + el.shear)) * (st[0] + st[1]);
+        const double t[6] = {st[0], st[1], szz, st[2], 0.0, 0.0};
+        sig->SetTuple(k, t);
+        const auto& sn = z.strain[zi];
+        const double e[6] = {sn[0], sn[1], 0.0, sn[2], 0.0, 0.0};
+        eps->SetTuple(k, e);
+    }
+    add_cell_arrays(grid, id, region, material, kind, disp, vel, rotation, sig, eps);
     grid->GetFieldData()->AddArray(string_array("region_names", s.region_names(), [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }

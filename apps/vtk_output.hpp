@@ -49,10 +49,12 @@ void write_pvd(const std::filesystem::path& file,
 /// Writes `text` to `file` atomically (summary.json, logs of a finished run).
 void write_text_atomically(const std::filesystem::path& file, std::string_view text);
 
-/// The solver's current state: blocks.vtu-like polygons at their current place
-/// (cell data block_id, region, material, displacement, velocity, rotation, stress
-/// as a symmetric tensor XX YY ZZ XY YZ XZ, tension positive); excavated blocks
-/// are left out.
+/// The solver's current state in one grid: rigid blocks as polygons at their
+/// current place, then the zones (triangles) of deformable blocks. Cell data
+/// block_id, region, material, zone (0 rigid block, 1 zone), cell_displacement,
+/// velocity, rotation, stress and strain as symmetric tensors XX YY ZZ XY YZ XZ
+/// (tension positive; rigid blocks: block-averaged stress, zero strain); point
+/// data displacement (of every vertex and node). Excavated blocks are left out.
 void write_state_blocks_vtu(const Solver& s, const std::filesystem::path& file);
 /// Contacts as line cells along their share of the joint (cell data sn, tau, un,
 /// us, damage, state (0 intact, 1 softening, 2 broken-tension, 3 broken-shear,

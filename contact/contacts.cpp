@@ -41,9 +41,12 @@ void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
     normal.resize(out);
 }
 
-void Contacts::rebuild_batches(int property_sets) {
-    batches.assign(property_sets, {});
-    for (int i = 0; i < size(); ++i) batches[property[i]].push_back(i);
+void Contacts::rebuild_batches(int property_sets, const std::uint8_t* deformable) {
+    batches.assign(2 * property_sets, {});
+    for (int i = 0; i < size(); ++i) {
+        const bool mixed = deformable && (deformable[vertex_block[i]] || deformable[edge_block[i]]);
+        batches[2 * property[i] + (mixed ? 1 : 0)].push_back(i);
+    }
 }
 
 void update_normals(Contacts& c, const BlockView& b, double corner_radius) {
@@ -53,10 +56,14 @@ void update_normals(Contacts& c, const BlockView& b, double corner_radius) {
 namespace {
 // The fused loop reads everything through local restrict pointers: through the
 // Contacts members the compiler must assume the force stores alias them and would
-// reload every base pointer on every contact.
-template <class Law>
+// reload every base pointer on every contact. `Mixed` batches have a deformable
+// side: the vertex velocity comes from its node, the edge velocity is interpolated
+// between the edge's nodes, and the forces go to those nodes with the same weights
+// (so the contact does no work the nodes do not see).
+template <bool Mixed, class Law>
 double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const BlockView& b, double dt,
-                  double corner_radius, Vec2* __restrict force, double* __restrict moment) {
+                  double corner_radius, Vec2* __restrict force, double* __restrict moment,
+                  Vec2* __restrict node_force) {
     const int* __restrict va = c.vertex_block.data();
     const int* __restrict vid = c.vertex_id.data();
     const int* __restrict eb = c.edge_block.data();
@@ -96,15 +103,36 @@ double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const B
             if (rl > 0.0) n = r / rl, t = Vec2{-n.y, n.x};
         }
         const Vec2 ra = x - centroid[A], rb = x - centroid[B];
-        const Vec2 vr = (velocity[A] + omega[A] * perp(ra)) - (velocity[B] + omega[B] * perp(rb));
+        Vec2 vr;
+        if constexpr (Mixed)
+            vr = vertex_velocity(b, A, vid[i], x) - edge_velocity(b, B, e0[i], e1[i], s, x);
+        else
+            vr = (velocity[A] + omega[A] * perp(ra)) - (velocity[B] + omega[B] * perp(rb));
         const double du_n = dot(vr, n) * dt, du_s = dot(vr, t) * dt;
         normal[i] = n;
         law.update(h, du_n, du_s);
         const Vec2 f = len[i] * (h.sn * n - h.tau * t);
-        force[A] += f;
-        moment[A] += cross(ra, f);
-        force[B] -= f;
-        moment[B] -= cross(rb, f);
+        if constexpr (Mixed) {
+            if (b.deformable[A]) {
+                node_force[b.vertex_node[vid[i]]] += f;
+            } else {
+                force[A] += f;
+                moment[A] += cross(ra, f);
+            }
+            if (b.deformable[B]) {
+                const double w = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+                node_force[b.vertex_node[e0[i]]] -= (1.0 - w) * f;
+                node_force[b.vertex_node[e1[i]]] -= w * f;
+            } else {
+                force[B] -= f;
+                moment[B] -= cross(rb, f);
+            }
+        } else {
+            force[A] += f;
+            moment[A] += cross(ra, f);
+            force[B] -= f;
+            moment[B] -= cross(rb, f);
+        }
         sum += norm2(f);
     }
     return sum;
@@ -112,22 +140,27 @@ double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const B
 } // namespace
 
 double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                     double corner_radius, Vec2* force, double* moment, int blocks, int threads,
-                     ThreadForces& scratch) {
-    auto run = [&](std::size_t p, std::size_t begin, std::size_t end, Vec2* f, double* m) {
-        const std::span<const int> ids(c.batches[p].data() + begin, end - begin);
-        return std::visit([&](const auto& law) { return step_batch(law, ids, c, b, dt, corner_radius, f, m); },
-                          laws[p]);
+                     double corner_radius, const ForceTargets& out, int threads, ThreadForces& scratch) {
+    auto run = [&](std::size_t k, std::size_t begin, std::size_t end, Vec2* f, double* m, Vec2* nf) {
+        const std::span<const int> ids(c.batches[k].data() + begin, end - begin);
+        return std::visit(
+            [&](const auto& law) {
+                return k % 2 ? step_batch<true>(law, ids, c, b, dt, corner_radius, f, m, nf)
+                             : step_batch<false>(law, ids, c, b, dt, corner_radius, f, m, nf);
+            },
+            laws[k / 2]);
     };
     if (threads <= 1) {
         double sum = 0.0;
-        for (std::size_t p = 0; p < c.batches.size(); ++p) sum += run(p, 0, c.batches[p].size(), force, moment);
+        for (std::size_t k = 0; k < c.batches.size(); ++k)
+            sum += run(k, 0, c.batches[k].size(), out.force, out.moment, out.node_force);
         return sum;
     }
-    const std::size_t nb = std::size_t(blocks);
-    if (scratch.force.size() != nb * threads) {
+    const std::size_t nb = std::size_t(out.blocks), nn = std::size_t(out.nodes);
+    if (scratch.force.size() != nb * threads || scratch.node_force.size() != nn * threads) {
         scratch.force.assign(nb * threads, {});
         scratch.moment.assign(nb * threads, 0.0);
+        scratch.node_force.assign(nn * threads, {});
         scratch.sum.assign(threads, 0.0);
     }
 #pragma omp parallel num_threads(threads)
@@ -135,12 +168,14 @@ double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const Block
         const int t = omp_get_thread_num();
         Vec2* f = scratch.force.data() + nb * t;
         double* m = scratch.moment.data() + nb * t;
+        Vec2* nf = scratch.node_force.data() + nn * t;
         std::fill(f, f + nb, Vec2{});
         std::fill(m, m + nb, 0.0);
+        std::fill(nf, nf + nn, Vec2{});
         double sum = 0.0;
-        for (std::size_t p = 0; p < c.batches.size(); ++p) {
-            const std::size_t n = c.batches[p].size();
-            sum += run(p, n * t / threads, n * (t + 1) / threads, f, m);
+        for (std::size_t k = 0; k < c.batches.size(); ++k) {
+            const std::size_t n = c.batches[k].size();
+            sum += run(k, n * t / threads, n * (t + 1) / threads, f, m, nf);
         }
         scratch.sum[t] = sum;
 #pragma omp barrier
@@ -149,8 +184,14 @@ double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const Block
             Vec2 fs{};
             double ms = 0.0;
             for (int u = 0; u < threads; ++u) fs += scratch.force[nb * u + k], ms += scratch.moment[nb * u + k];
-            force[k] += fs;
-            moment[k] += ms;
+            out.force[k] += fs;
+            out.moment[k] += ms;
+        }
+#pragma omp for schedule(static)
+        for (std::size_t k = 0; k < nn; ++k) {
+            Vec2 fs{};
+            for (int u = 0; u < threads; ++u) fs += scratch.node_force[nn * u + k];
+            out.node_force[k] += fs;
         }
     }
     double sum = 0.0;

@@ -43,7 +43,25 @@ struct BlockView {
     const Vec2* vertex;       ///< current vertex positions, all blocks, CSR by `first`
     const std::uint32_t* first;
     const double* inv_edge_length; ///< 1 / length of the edge starting at each vertex (rigid: constant)
+    // Deformable blocks (fem/): their vertices are FE nodes.
+    const std::uint8_t* deformable; ///< per block
+    const int* vertex_node;         ///< per vertex: its node, −1 on rigid blocks
+    const Vec2* node_velocity;      ///< per node
 };
+
+/// Velocity of the material point of block `blk` at `x`, which is its vertex `v`
+/// (deformable: that node's velocity; rigid: v + ω × (x − c)).
+inline Vec2 vertex_velocity(const BlockView& b, int blk, int v, Vec2 x) {
+    return b.deformable[blk] ? b.node_velocity[b.vertex_node[v]] : b.velocity[blk] + b.omega[blk] * perp(x - b.centroid[blk]);
+}
+
+/// Velocity of block `blk` at `x`, near its edge (e0, e1) at parameter s: on a
+/// deformable edge, linear between the two nodes (s clamped to the edge).
+inline Vec2 edge_velocity(const BlockView& b, int blk, int e0, int e1, double s, Vec2 x) {
+    if (!b.deformable[blk]) return b.velocity[blk] + b.omega[blk] * perp(x - b.centroid[blk]);
+    const double w = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    return (1.0 - w) * b.node_velocity[b.vertex_node[e0]] + w * b.node_velocity[b.vertex_node[e1]];
+}
 
 struct Contacts {
     // Topology (cold).
@@ -55,13 +73,16 @@ struct Contacts {
     std::vector<JointHistory> history;
     /// Current normal n (written every step); the tangent is t = (−n.y, n.x).
     std::vector<Vec2> normal;
-    /// Contacts of each property set, rebuilt when contacts are added or removed.
+    /// Contacts by property set and kind, rebuilt when contacts are added or
+    /// removed: batch 2p holds the rigid–rigid contacts of set p (the fast kernel),
+    /// batch 2p+1 those with a deformable side.
     std::vector<std::vector<int>> batches;
 
     int size() const { return static_cast<int>(length.size()); }
     void add(int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h);
     void remove_if_flagged(const std::vector<std::uint8_t>& remove);
-    void rebuild_batches(int property_sets);
+    /// `deformable`: per block, non-zero for deformable blocks (null = all rigid).
+    void rebuild_batches(int property_sets, const std::uint8_t* deformable);
 };
 
 /// Global id of the vertex after `v` around its block.
@@ -105,20 +126,29 @@ inline Vec2 contact_force(const Contacts& c, int i) {
 /// Per-thread force accumulators for step_contacts, kept between steps (sized
 /// once, not allocated per step).
 struct ThreadForces {
-    std::vector<Vec2> force;
+    std::vector<Vec2> force, node_force;
     std::vector<double> moment, sum;
+};
+
+/// Force accumulators of stage 2: per block (force, moment) and per FE node.
+struct ForceTargets {
+    Vec2* force;
+    double* moment;
+    int blocks;
+    Vec2* node_force;
+    int nodes;
 };
 
 /// Stage 2 of a step, fused per batch so each contact's data is loaded once:
 /// kinematics, the batch's law (one dispatch per batch), and the forces and
-/// moments added to the blocks' accumulators (`force`, `moment`, of `blocks`
-/// entries, zeroed by the caller). Returns Σ|F|² over the contacts (the RMS
+/// moments added to the blocks' and nodes' accumulators (zeroed by the caller;
+/// a force on a deformable edge is split to its two nodes with the weights that
+/// interpolate the edge's velocity). Returns Σ|F|² over the contacts (the RMS
 /// contact force is the scale of the unbalanced-force ratio; squares spare a
 /// square root per contact). With threads > 1 each thread takes a contiguous part
 /// of every batch into its own accumulators, summed per block afterwards in thread
 /// order: results are deterministic for a given thread count.
 double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                     double corner_radius, Vec2* force, double* moment, int blocks, int threads,
-                     ThreadForces& scratch);
+                     double corner_radius, const ForceTargets& out, int threads, ThreadForces& scratch);
 
 } // namespace bbm::contact

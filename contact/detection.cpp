@@ -136,8 +136,8 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
             JointHistory h;
             h.bonded = false;
             const Vec2 n{tb.y, -tb.x};
-            const Vec2 vr = (b.velocity[A] + b.omega[A] * perp(x - b.centroid[A])) -
-                            (b.velocity[B] + b.omega[B] * perp(x - b.centroid[B]));
+            const double s_on = dot(x - b.vertex[best], tb) * b.inv_edge_length[best];
+            const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
             h.un = frame(x, b.vertex[best], b.vertex[e1]).gap - dot(vr, n) * in.dt;
             c.add(A, int(v), B, best, e1, l, in.new_contact_property, h);
             points.push_back(x);

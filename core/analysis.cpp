@@ -1,6 +1,7 @@
 #include "core/analysis.hpp"
 
 #include <chrono>
+#include <cmath>
 
 namespace bbm {
 
@@ -10,49 +11,79 @@ const char* to_string(StageSpec::Kind k) {
     case StageSpec::Kind::solve: return "solve";
     case StageSpec::Kind::excavate: return "excavate";
     case StageSpec::Kind::cycle: return "cycle";
+    case StageSpec::Kind::elastic: return "elastic";
     }
     return "?";
 }
 
-std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs) {
+std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs,
+                                    StageCursor start) {
     std::vector<StageReport> reports;
-    for (const auto& st : stages) {
+    for (int index = start.stage; index < int(stages.size()); ++index) {
+        const StageSpec& st = stages[index];
+        const bool resumed = index == start.stage && start.started;
         const auto t0 = std::chrono::steady_clock::now();
-        obs.stage_started(s, st);
-        StageReport r{st.name, to_string(st.kind)};
+        StageReport r;
+        r.name = st.name;
+        r.kind = to_string(st.kind);
+        StageCursor cursor{index, true, resumed ? start.step : 0};
+        r.steps = cursor.step;
         auto run = [&](long max_steps, double target) {
-            for (long k = 1; k <= max_steps; ++k) {
+            for (long k = cursor.step + 1; k <= max_steps; ++k) {
                 s.step();
                 ++r.steps;
+                cursor.step = k;
                 obs.step_done(s, st, k);
+                obs.at(s, cursor);
                 if (obs.stop_requested()) return;
                 // A few steps first: at rest the ratio is 0 before anything moves.
                 if (target > 0 && k >= 10 && s.unbalanced_ratio() <= target) return;
             }
         };
+        if (!resumed) {
+            obs.stage_started(s, st);
+            switch (st.kind) {
+            case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
+            case StageSpec::Kind::excavate: s.excavate(st.regions, st.relax_steps); break;
+            case StageSpec::Kind::elastic: r.method = s.solve_elastic().method; break;
+            case StageSpec::Kind::solve:
+            case StageSpec::Kind::cycle: break;
+            }
+            obs.at(s, cursor);
+        }
         switch (st.kind) {
-        case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
         case StageSpec::Kind::solve:
-            run(st.max_steps, st.ratio);
+            if (!(resumed && cursor.step >= 10 && s.unbalanced_ratio() <= st.ratio)) run(st.max_steps, st.ratio);
             r.converged = s.unbalanced_ratio() <= st.ratio;
             break;
-        case StageSpec::Kind::excavate:
-            s.excavate(st.regions, st.relax_steps);
-            run(st.relax_steps, 0.0);
-            break;
+        case StageSpec::Kind::excavate: run(st.relax_steps, 0.0); break;
         case StageSpec::Kind::cycle: run(st.steps, 0.0); break;
+        case StageSpec::Kind::initialize:
+        case StageSpec::Kind::elastic: break;
         }
         r.ratio = s.unbalanced_ratio();
         r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        obs.stage_done(s, r);
+        const bool stopped = obs.stop_requested();
+        if (!stopped) obs.stage_done(s, r);
         reports.push_back(r);
-        if (obs.stop_requested()) break;
+        if (stopped) break;
     }
     return reports;
 }
 
 HistoryRecorder::HistoryRecorder(const Solver& s, std::vector<HistorySpec> h) : histories_(std::move(h)) {
-    for (const auto& x : histories_) block_.push_back(x.point ? s.block_at(*x.point) : -1);
+    const auto& n = s.nodes();
+    for (const auto& x : histories_) {
+        const int b = x.point ? s.block_at(*x.point) : -1;
+        int node = -1;
+        if (b >= 0 && s.blocks().deformable[b]) {
+            double best = INFINITY;
+            for (int k = 0; k < n.count(); ++k)
+                if (n.block[k] == b && norm(n.position[k] - *x.point) < best) best = norm(n.position[k] - *x.point), node = k;
+        }
+        block_.push_back(b);
+        node_.push_back(node);
+    }
 }
 
 std::vector<double> HistoryRecorder::sample(const Solver& s) const {
@@ -62,8 +93,20 @@ std::vector<double> HistoryRecorder::sample(const Solver& s) const {
     out.reserve(histories_.size());
     for (std::size_t k = 0; k < histories_.size(); ++k) {
         const auto& h = histories_[k];
-        const int i = block_[k];
+        const int i = block_[k], nd = node_[k];
+        const auto& n = s.nodes();
         double v = 0.0;
+        if (nd >= 0) {
+            // A point of a deformable block: its nearest node (no rotation).
+            switch (h.quantity) {
+            case Q::displacement_x: out.push_back(n.position[nd].x - n.position0[nd].x); continue;
+            case Q::displacement_y: out.push_back(n.position[nd].y - n.position0[nd].y); continue;
+            case Q::velocity_x: out.push_back(n.velocity[nd].x); continue;
+            case Q::velocity_y: out.push_back(n.velocity[nd].y); continue;
+            case Q::rotation: out.push_back(0.0); continue;
+            default: break;
+            }
+        }
         switch (h.quantity) {
         case Q::unbalanced_ratio: v = s.unbalanced_ratio(); break;
         case Q::displacement_x: v = b.centroid[i].x - b.centroid0[i].x; break;
@@ -83,6 +126,56 @@ std::vector<double> HistoryRecorder::sample(const Solver& s) const {
         out.push_back(v);
     }
     return out;
+}
+
+OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown) {
+    OpeningMeasures m;
+    const auto& b = s.blocks();
+    const auto& n = s.nodes();
+    // The material point (rigid vertex or node, of a block still there) that started nearest p.
+    auto displacement_at = [&](Vec2 p) {
+        double best = INFINITY;
+        Vec2 u{};
+        for (int i = 0; i < b.count(); ++i) {
+            if (b.removed[i] || b.deformable[i]) continue;
+            const double c = std::cos(b.theta[i]), sn = std::sin(b.theta[i]);
+            for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
+                const Vec2 x0 = b.centroid0[i] + b.local[v];
+                if (norm(x0 - p) >= best) continue;
+                best = norm(x0 - p);
+                const Vec2 r = b.local[v];
+                u = b.centroid[i] + Vec2{c * r.x - sn * r.y, sn * r.x + c * r.y} - x0;
+            }
+        }
+        for (int k = 0; k < n.count(); ++k)
+            if (!b.removed[n.block[k]] && norm(n.position0[k] - p) < best)
+                best = norm(n.position0[k] - p), u = n.position[k] - n.position0[k];
+        return u;
+    };
+    m.springline_displacement = displacement_at(springline);
+    m.crown_displacement = displacement_at(crown);
+    const Vec2 ds = (springline - center) / norm(springline - center), dc = (crown - center) / norm(crown - center);
+    m.springline_convergence = -dot(m.springline_displacement, ds);
+    m.crown_convergence = -dot(m.crown_displacement, dc);
+    const double rs = norm(springline - center), rc = norm(crown - center);
+    const double cos30 = std::cos(30.0 * 3.141592653589793 / 180.0), cos15 = std::cos(15.0 * 3.141592653589793 / 180.0);
+    const auto& c = s.contacts();
+    for (int i = 0; i < c.size(); ++i) {
+        const auto mode = c.history[i].broken;
+        if (mode != contact::JointState::broken_tension && mode != contact::JointState::broken_shear) continue;
+        const Vec2 r = b.vertex[c.vertex_id[i]] - center;
+        const double d = norm(r);
+        if (d <= 0) continue;
+        const double cs = dot(r, ds) / d, cc = dot(r, dc) / d;
+        if (cs >= cos30) {
+            ++m.cracks_springline_sector;
+            (mode == contact::JointState::broken_tension ? m.tensile_springline_sector : m.shear_springline_sector)++;
+        }
+        if (cc >= cos30) ++m.cracks_crown_sector;
+        if (cs >= cos15) m.failed_depth_springline = std::max(m.failed_depth_springline, d - rs);
+        if (cc >= cos15) m.failed_depth_crown = std::max(m.failed_depth_crown, d - rc);
+    }
+    return m;
 }
 
 } // namespace bbm

@@ -1,6 +1,6 @@
 // bbm core: running the stages of a model file, and sampling its histories.
 //
-// run_stages() drives the solver through initialize / solve / excavate / cycle
+// run_stages() drives the solver through initialize / elastic / solve / excavate / cycle
 // stages (core/model_spec.hpp) and tells an observer about every step and every
 // stage end; the program (apps/) writes output and progress from the observer,
 // so the loop knows nothing of files or terminals.
@@ -19,12 +19,26 @@ struct StageReport {
     double ratio = 0.0;
     double seconds = 0.0;
     bool converged = true; ///< solve: reached the ratio within the step limit
+    std::string method;    ///< elastic: the factorisation used
+};
+
+/// Where a run stands: the stage, whether its action (initialise, excavate, the
+/// elastic solve) is done, and the steps taken in it. A checkpoint stores one; a
+/// resumed run starts from it.
+struct StageCursor {
+    int stage = 0;
+    bool started = false;
+    long step = 0;
 };
 
 class StageObserver {
 public:
     virtual ~StageObserver() = default;
+    /// Before a stage's action (not called again for a resumed stage).
     virtual void stage_started(const Solver&, const StageSpec&) {}
+    /// After a stage's action and after every step, with the position reached
+    /// (a checkpoint taken here resumes exactly).
+    virtual void at(const Solver&, const StageCursor&) {}
     /// After every step; `stage_step` counts from 1 within the stage.
     virtual void step_done(const Solver&, const StageSpec&, long stage_step) { (void)stage_step; }
     virtual void stage_done(const Solver&, const StageReport&) {}
@@ -32,8 +46,10 @@ public:
     virtual bool stop_requested() { return false; }
 };
 
+/// Runs stages[start.stage ...]; a started stage skips its action and continues
+/// from start.step.
 std::vector<StageReport> run_stages(Solver& solver, const std::vector<StageSpec>& stages,
-                                    StageObserver& observer);
+                                    StageObserver& observer, StageCursor start = {});
 
 /// Evaluates named history quantities; blocks named by a point are found once.
 class HistoryRecorder {
@@ -45,8 +61,24 @@ public:
 private:
     std::vector<HistorySpec> histories_;
     std::vector<int> block_;
+    std::vector<int> node_; ///< a point in a deformable block: its nearest node (else -1)
 };
 
 const char* to_string(StageSpec::Kind k);
+
+/// Measures of an excavation a tunnel engineer looks at (paper §4.3), about the
+/// opening's centre: the wall points at the springline and the crown (the
+/// material points that started nearest them; convergence = displacement towards
+/// the centre, positive inwards), cracks in the ±30° sectors around both
+/// directions, and the depth of the failed zone (farthest broken contact beyond the
+/// opening's radius in that direction, within ±15°).
+struct OpeningMeasures {
+    Vec2 springline_displacement{}, crown_displacement{};
+    double springline_convergence = 0, crown_convergence = 0;
+    int cracks_springline_sector = 0, cracks_crown_sector = 0;
+    double failed_depth_springline = 0, failed_depth_crown = 0;
+    int tensile_springline_sector = 0, shear_springline_sector = 0;
+};
+OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
 
 } // namespace bbm

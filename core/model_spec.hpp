@@ -21,6 +21,15 @@ namespace bbm {
 struct MaterialSpec {
     std::string name;
     double density = 2700.0; ///< kg/m³
+    /// Elasticity of deformable blocks (SPEC §6; plane strain, isotropic). young = 0:
+    /// none given (the material's regions must then be rigid).
+    double young = 0;        ///< Young's modulus E of the rock, Pa
+    double poisson = 0.2;    ///< Poisson's ratio ν, 0 <= ν < 0.5
+    /// Fraction f of the deformation taken by the blocks (paper §3.2, SPEC §6). With
+    /// 0 < f < 1 the blocks get E / f and the joints of the material's regions have
+    /// their stiffness scaled by 1 / (1 − f); 0 = not split (blocks get E, joints
+    /// keep their stiffness).
+    double deformable_fraction = 0;
 };
 
 /// One joint property set (SPEC §4). Which law is used follows `law`.
@@ -53,6 +62,10 @@ struct JointAssignmentSpec {
 struct SelectionSpec {
     std::vector<std::string> regions;
     std::optional<Box2> box; ///< block centroid (or edge midpoint) inside the box
+    /// Velocity boundaries: select rigid blocks with an edge inside the box (both
+    /// ends) instead of by centroid, e.g. the blocks along a symmetry plane.
+    /// Nodes of deformable blocks are always selected by position.
+    bool touching = false;
 };
 
 /// A stress field σ(y) = σ0 + (y − y_ref)·dσ/dy, tension positive.
@@ -101,7 +114,8 @@ struct HistorySpec {
 };
 
 struct StageSpec {
-    enum class Kind { initialize, solve, excavate, cycle };
+    /// elastic: elastic equilibrium in one implicit sparse solve (SPEC §5), no keys.
+    enum class Kind { initialize, solve, excavate, cycle, elastic };
     std::string name;
     Kind kind = Kind::solve;
     StressFieldSpec stress;            ///< initialize
@@ -110,6 +124,14 @@ struct StageSpec {
     long steps = 0;                    ///< cycle
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
+};
+
+/// [report]: what `bbm run` measures and draws around an opening (optional;
+/// core/analysis.hpp measure_opening()).
+struct ReportSpec {
+    bool opening = false;           ///< measure the opening (center, springline, crown given)
+    Vec2 center{}, springline{}, crown{};
+    std::optional<Box2> window;     ///< part drawn in failure.png; empty = 2 radii around the opening
 };
 
 struct AnalysisSpec {
@@ -122,6 +144,7 @@ struct AnalysisSpec {
     SolverSpec solver;
     std::vector<HistorySpec> histories;
     std::vector<StageSpec> stages;
+    ReportSpec report;
 };
 
 } // namespace bbm

@@ -42,6 +42,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     // Materials per region.
     std::vector<double> density(a.region_names.size(), 2700.0);
     std::vector<int> material(a.region_names.size(), -1);
+    std::vector<const MaterialSpec*> region_spec(a.region_names.size(), nullptr);
     for (const auto& [region, mat] : an.region_material) {
         const auto r = std::find(region_names_.begin(), region_names_.end(), region);
         const auto m = std::find_if(an.materials.begin(), an.materials.end(),
@@ -50,11 +51,18 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
             throw InputError("", 0, "region.material", "region '" + region + "' or material '" + mat + "' unknown");
         density[r - region_names_.begin()] = m->density;
         material[r - region_names_.begin()] = int(m - an.materials.begin());
+        region_spec[r - region_names_.begin()] = &*m;
     }
     if (an.region_material.empty() && !an.materials.empty()) {
         std::fill(density.begin(), density.end(), an.materials[0].density);
         std::fill(material.begin(), material.end(), 0);
+        std::fill(region_spec.begin(), region_spec.end(), &an.materials[0]);
     }
+    // Deformability split (SPEC §6): a fraction f of the deformation in the blocks.
+    auto fraction_of = [&](int block) {
+        const MaterialSpec* m = region_spec[a.region[block]];
+        return m ? m->deformable_fraction : 0.0;
+    };
 
     // Blocks: exact polygon mass properties.
     b_.first.assign(a.first.begin(), a.first.end());
@@ -90,6 +98,38 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     b_.fixed_velocity.assign(nb, {});
     b_.fixed_omega.assign(nb, 0.0);
     b_.removed.assign(nb, 0);
+    b_.deformable = a.deformable.size() == std::size_t(nb) ? a.deformable : std::vector<std::uint8_t>(nb, 0);
+    b_.vertex_node = a.vertex_node.size() == a.points.size() ? a.vertex_node : std::vector<int>(a.points.size(), -1);
+
+    // FE nodes and zones of deformable blocks: lumped mass ρA/3 per zone corner.
+    n_.position = n_.position0 = a.nodes;
+    n_.block = a.node_block;
+    const int nn = n_.count();
+    n_.velocity.assign(nn, {});
+    n_.force.assign(nn, {});
+    n_.applied.assign(nn, {});
+    n_.real_mass.assign(nn, 0.0);
+    n_.fixed.assign(nn, 0);
+    n_.fixed_velocity.assign(nn, {});
+    for (std::size_t k = 0; k < a.zones.size(); ++k) {
+        const int blk = a.zone_block[k], reg = a.region[blk];
+        const MaterialSpec* m = region_spec[reg];
+        if (!m || m->young <= 0.0)
+            throw InputError("", 0, "material.young",
+                             "region '" + region_names_[reg] + "' is deformable but its material has no young modulus");
+        const auto& t = a.zones[k];
+        const auto g = fem::gradients(a.nodes[t[0]], a.nodes[t[1]], a.nodes[t[2]]);
+        BBM_ASSERT(g.area > 0.0, "zones are counter-clockwise");
+        const double f = m->deformable_fraction > 0.0 ? m->deformable_fraction : 1.0;
+        z_.node.push_back(t);
+        z_.elasticity.push_back(fem::Elasticity::from_young(m->young / f, m->poisson));
+        z_.stress.push_back({0.0, 0.0, 0.0});
+        z_.strain.push_back({0.0, 0.0, 0.0});
+        z_.block.push_back(blk);
+        z_.density.push_back(m->density);
+        for (int i : t) n_.real_mass[i] += m->density * g.area / 3.0;
+    }
+    n_.mass = n_.real_mass;
 
     // Property sets; the last, built in, serves contacts formed unbonded if the
     // model names none: Coulomb, φ 30°, stiffness of the stiffest set.
@@ -97,6 +137,20 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         laws_.push_back(contact::make_law(p));
         property_names_.push_back(p.name);
     }
+    // Joints between blocks that take a fraction f of the deformation are stiffer
+    // by 1/(1 − f): one derived set per (set, f).
+    std::map<std::pair<int, double>, int> split_sets;
+    auto split_property = [&](int prop, double f) {
+        if (f <= 0.0) return prop;
+        if (auto it = split_sets.find({prop, f}); it != split_sets.end()) return it->second;
+        JointPropertySpec p = an.joint_properties[prop];
+        p.kn /= 1.0 - f;
+        p.ks /= 1.0 - f;
+        p.name += " (deformable fraction " + std::to_string(f) + ")";
+        laws_.push_back(contact::make_law(p));
+        property_names_.push_back(p.name);
+        return split_sets[{prop, f}] = int(laws_.size()) - 1;
+    };
 
     // Joint records -> point contacts, one at each end with half the joint length.
     double mean_edge = 0.0;
@@ -119,6 +173,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
                              std::string("no joint property is assigned to ") + meshing::to_string(j.tag) +
                                  " joints between regions '" + region_names_[a.region[j.block_a]] + "' and '" +
                                  region_names_[a.region[j.block_b]] + "'");
+        prop = split_property(prop, std::min(fraction_of(j.block_a), fraction_of(j.block_b)));
         const double half = 0.5 * j.length();
         mean_edge += j.length();
         auto vertex_of = [&](int block, Vec2 p) {
@@ -173,9 +228,14 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         laws_.push_back(contact::make_law(unbonded));
         property_names_.push_back(unbonded.name);
     }
+    // Mean size of the rigid blocks (the few large deformable ones would swamp it).
     double mean_area = 0.0;
-    for (double x : b_.area) mean_area += x;
-    mean_area /= std::max(1, nb);
+    int counted = 0;
+    for (int i = 0; i < nb; ++i)
+        if (!b_.deformable[i]) mean_area += b_.area[i], ++counted;
+    if (counted == 0)
+        for (int i = 0; i < nb; ++i) mean_area += b_.area[i], ++counted;
+    mean_area /= std::max(1, counted);
     tolerance_ = settings_.detection_tolerance > 0 ? settings_.detection_tolerance
                                                    : 0.02 * std::sqrt(4.0 * mean_area / 3.141592653589793);
     radius_.assign(nb, 0.0);
@@ -183,8 +243,9 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         for (std::uint32_t v = a.first[i]; v < a.first[i + 1]; ++v) radius_[i] = std::max(radius_[i], norm(b_.local[v]));
     detected_at_ = b_.centroid;
     detected_theta_.assign(nb, 0.0);
+    detected_vertex_ = b_.vertex;
     active_.assign(nb, 0);
-    c_.rebuild_batches(int(laws_.size()));
+    c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
 
     apply_boundaries(an, a);
     update_vertices();
@@ -192,9 +253,17 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
 }
 
 std::vector<int> Solver::select_blocks(const SelectionSpec& s) const {
+    // A block touches the box if one of its edges lies inside it (both ends).
+    auto touches = [&](const std::optional<Box2>& box, int i) {
+        for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v)
+            if (in_box(box, b_.vertex[v]) && in_box(box, b_.vertex[contact::next_vertex(b_.first.data(), i, int(v))]))
+                return true;
+        return false;
+    };
     std::vector<int> out;
     for (int i = 0; i < b_.count(); ++i)
-        if (selected(s.regions, region_names_[b_.region[i]]) && in_box(s.box, b_.centroid[i])) out.push_back(i);
+        if (selected(s.regions, region_names_[b_.region[i]]) && (s.touching ? touches(s.box, i) : in_box(s.box, b_.centroid[i])))
+            out.push_back(i);
     return out;
 }
 
@@ -211,13 +280,23 @@ void Solver::apply_boundaries(const AnalysisSpec& an, const meshing::BlockAssemb
             covered[v0].push_back({s0, s1});
         }
     for (const auto& bc : an.boundaries) {
-        std::vector<int> blocks;
+        std::vector<int> blocks, nodes;
         if (bc.kind == BoundarySpec::Kind::velocity) {
-            blocks = select_blocks(bc.select);
-            for (int i : blocks) {
+            // Rigid blocks by centroid; deformable blocks by node position.
+            for (int i : select_blocks(bc.select)) {
+                if (b_.deformable[i]) continue;
+                blocks.push_back(i);
                 if (bc.vx) b_.fixed[i] |= 1, b_.fixed_velocity[i].x = *bc.vx;
                 if (bc.vy) b_.fixed[i] |= 2, b_.fixed_velocity[i].y = *bc.vy;
                 if (bc.omega) b_.fixed[i] |= 4, b_.fixed_omega[i] = *bc.omega;
+            }
+            for (int k = 0; k < n_.count(); ++k) {
+                if (!selected(bc.select.regions, region_names_[b_.region[n_.block[k]]]) ||
+                    !in_box(bc.select.box, n_.position[k]))
+                    continue;
+                nodes.push_back(k);
+                if (bc.vx) n_.fixed[k] |= 1, n_.fixed_velocity[k].x = *bc.vx;
+                if (bc.vy) n_.fixed[k] |= 2, n_.fixed_velocity[k].y = *bc.vy;
             }
         } else {
             for (int i = 0; i < a.block_count(); ++i) {
@@ -240,31 +319,52 @@ void Solver::apply_boundaries(const AnalysisSpec& an, const meshing::BlockAssemb
                                 const Vec2 t0 = traction(stress_at(bc.stress, x0.y), n);
                                 const Vec2 t1 = traction(stress_at(bc.stress, x1.y), n);
                                 const Vec2 f0 = (l / 6.0) * (2.0 * t0 + t1), f1 = (l / 6.0) * (t0 + 2.0 * t1);
-                                b_.applied[i] += f0 + f1;
-                                b_.applied_moment[i] += cross(x0 - b_.centroid[i], f0) + cross(x1 - b_.centroid[i], f1);
-                                tractions_.push_back({i, x0 - b_.centroid[i], f0});
-                                tractions_.push_back({i, x1 - b_.centroid[i], f1});
+                                if (b_.deformable[i]) {
+                                    // To the edge's two nodes, linearly by position.
+                                    const int n0 = b_.vertex_node[v0], n1 = b_.vertex_node[v1];
+                                    const double w0 = s, w1 = std::min(c0, 1.0);
+                                    n_.applied[n0] += (1.0 - w0) * f0 + (1.0 - w1) * f1;
+                                    n_.applied[n1] += w0 * f0 + w1 * f1;
+                                    for (int k : {n0, n1})
+                                        if (std::find(nodes.begin(), nodes.end(), k) == nodes.end()) nodes.push_back(k);
+                                } else {
+                                    b_.applied[i] += f0 + f1;
+                                    b_.applied_moment[i] +=
+                                        cross(x0 - b_.centroid[i], f0) + cross(x1 - b_.centroid[i], f1);
+                                    tractions_.push_back({i, x0 - b_.centroid[i], f0});
+                                    tractions_.push_back({i, x1 - b_.centroid[i], f1});
+                                }
                                 any = true;
                             }
                         }
                         s = std::max(s, c1);
                     }
                 }
-                if (any) blocks.push_back(i);
+                if (any && !b_.deformable[i]) blocks.push_back(i);
             }
         }
         boundary_blocks_.push_back({bc.name, blocks});
+        boundary_nodes_.push_back(nodes);
     }
     boundary_force_.assign(boundary_blocks_.size(), {});
 }
 
 contact::BlockView Solver::view() const {
-    return {b_.centroid.data(), b_.velocity.data(), b_.omega.data(), b_.vertex.data(), b_.first.data(),
-            b_.inv_edge_length.data()};
+    return {b_.centroid.data(),        b_.velocity.data(),   b_.omega.data(),
+            b_.vertex.data(),          b_.first.data(),      b_.inv_edge_length.data(),
+            b_.deformable.data(),      b_.vertex_node.data(), n_.velocity.data()};
 }
 
 void Solver::update_vertices() {
     for (int i = 0; i < b_.count(); ++i) {
+        if (b_.deformable[i]) {
+            // The polygon follows the boundary nodes; edge lengths change.
+            const std::uint32_t v0 = b_.first[i], v1 = b_.first[i + 1];
+            for (std::uint32_t v = v0; v < v1; ++v) b_.vertex[v] = n_.position[b_.vertex_node[v]];
+            for (std::uint32_t v = v0; v < v1; ++v)
+                b_.inv_edge_length[v] = 1.0 / norm(b_.vertex[v + 1 == v1 ? v0 : v + 1] - b_.vertex[v]);
+            continue;
+        }
         const double cs = std::cos(b_.theta[i]), sn = std::sin(b_.theta[i]);
         const Vec2 c = b_.centroid[i];
         for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) {
@@ -275,35 +375,65 @@ void Solver::update_vertices() {
 }
 
 void Solver::update_timestep() {
-    const int nb = b_.count();
-    std::vector<double> k(nb, 0.0), kr(nb, 0.0);
+    const int nb = b_.count(), nn = n_.count();
+    std::vector<double> k(nb, 0.0), kr(nb, 0.0), kn(nn, 0.0);
     for (int i = 0; i < c_.size(); ++i) {
         const auto& law = laws_[c_.property[i]];
         const double kk = (contact::normal_stiffness(law) + contact::shear_stiffness(law)) * c_.length[i];
         const Vec2 x = b_.vertex[c_.vertex_id[i]];
-        for (int blk : {c_.vertex_block[i], c_.edge_block[i]}) {
-            k[blk] += kk;
-            kr[blk] += kk * norm2(x - b_.centroid[blk]);
+        const int A = c_.vertex_block[i], B = c_.edge_block[i];
+        if (b_.deformable[A]) {
+            kn[b_.vertex_node[c_.vertex_id[i]]] += kk;
+        } else {
+            k[A] += kk;
+            kr[A] += kk * norm2(x - b_.centroid[A]);
+        }
+        if (b_.deformable[B]) {
+            const Vec2 p = b_.vertex[c_.edge_id[i]], q = b_.vertex[c_.edge_end[i]];
+            const double w = std::clamp(dot(x - p, q - p) / norm2(q - p), 0.0, 1.0);
+            kn[b_.vertex_node[c_.edge_id[i]]] += (1.0 - w) * kk;
+            kn[b_.vertex_node[c_.edge_end[i]]] += w * kk;
+        } else {
+            k[B] += kk;
+            kr[B] += kk * norm2(x - b_.centroid[B]);
+        }
+    }
+    // Zones: half the Gershgorin row sum of each node's rows (the larger of x, y).
+    for (int z = 0; z < z_.size(); ++z) {
+        if (b_.removed[z_.block[z]]) continue;
+        const auto& t = z_.node[z];
+        const auto ke =
+            fem::element_stiffness(fem::gradients(n_.position[t[0]], n_.position[t[1]], n_.position[t[2]]), z_.elasticity[z]);
+        for (int a = 0; a < 3; ++a) {
+            double rx = 0.0, ry = 0.0;
+            for (int j = 0; j < 6; ++j) rx += std::abs(ke[(2 * a) * 6 + j]), ry += std::abs(ke[(2 * a + 1) * 6 + j]);
+            kn[t[a]] += 0.5 * std::max(rx, ry);
         }
     }
     const double s = settings_.safety;
     if (settings_.mode == SolverSpec::Mode::quasi_static) {
         dt_ = settings_.timestep > 0 ? settings_.timestep : 1.0;
         const double f = (dt_ / (2.0 * s)) * (dt_ / (2.0 * s));
+        // A block that has lost all its contacts keeps its scaled mass: with the
+        // real mass and Δt = 1 s it would fall metres per step.
         for (int i = 0; i < nb; ++i) {
-            b_.mass[i] = k[i] > 0 ? k[i] * f : b_.real_mass[i];
-            b_.inertia[i] = kr[i] > 0 ? kr[i] * f : b_.real_inertia[i];
+            b_.mass[i] = k[i] > 0 ? k[i] * f : std::max(b_.mass[i], b_.real_mass[i]);
+            b_.inertia[i] = kr[i] > 0 ? kr[i] * f : std::max(b_.inertia[i], b_.real_inertia[i]);
         }
+        for (int i = 0; i < nn; ++i) n_.mass[i] = kn[i] > 0 ? kn[i] * f : std::max(n_.mass[i], n_.real_mass[i]);
     } else {
         double limit = INFINITY;
         for (int i = 0; i < nb; ++i) {
-            if (b_.removed[i]) continue;
+            if (b_.removed[i] || b_.deformable[i]) continue;
             if (k[i] > 0) limit = std::min(limit, 2.0 * std::sqrt(b_.real_mass[i] / k[i]));
             if (kr[i] > 0) limit = std::min(limit, 2.0 * std::sqrt(b_.real_inertia[i] / kr[i]));
         }
+        for (int i = 0; i < nn; ++i)
+            if (!b_.removed[n_.block[i]] && kn[i] > 0) limit = std::min(limit, 2.0 * std::sqrt(n_.real_mass[i] / kn[i]));
         dt_ = settings_.timestep > 0 ? settings_.timestep : (std::isfinite(limit) ? s * limit : 1e-3);
         b_.mass = b_.real_mass;
         b_.inertia = b_.real_inertia;
+        n_.mass = n_.real_mass;
     }
 }
 
@@ -323,6 +453,11 @@ void Solver::initialize_stress(const StressFieldSpec& field) {
         h.us = h.tau / contact::shear_stiffness(law);
         h.upn = 0.0;
     }
+    for (int z = 0; z < z_.size(); ++z) {
+        const auto& t = z_.node[z];
+        const Vec2 c = (n_.position[t[0]] + n_.position[t[1]] + n_.position[t[2]]) / 3.0;
+        z_.stress[z] = stress_at(field, c.y);
+    }
 }
 
 void Solver::excavate(const std::vector<std::string>& regions, long relax_steps) {
@@ -335,16 +470,28 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps)
         if (!b_.removed[A] && !b_.removed[B]) continue;
         drop[i] = 1;
         if (b_.removed[A] && b_.removed[B]) continue;
+        if (relax_steps <= 0) continue;
         const Vec2 x = b_.vertex[c_.vertex_id[i]];
         const Vec2 f = contact::contact_force(c_, i);
         const int kept = b_.removed[A] ? B : A;
         const Vec2 fk = b_.removed[A] ? -1.0 * f : f;
-        if (relax_steps > 0) relaxing_.push_back({kept, fk, cross(x - b_.centroid[kept], fk)});
+        if (!b_.deformable[kept]) {
+            relaxing_.push_back({kept, -1, fk, cross(x - b_.centroid[kept], fk)});
+        } else if (kept == A) {
+            relaxing_.push_back({kept, b_.vertex_node[c_.vertex_id[i]], fk, 0.0});
+        } else {
+            const Vec2 p = b_.vertex[c_.edge_id[i]], q = b_.vertex[c_.edge_end[i]];
+            const double w = std::clamp(dot(x - p, q - p) / norm2(q - p), 0.0, 1.0);
+            relaxing_.push_back({kept, b_.vertex_node[c_.edge_id[i]], (1.0 - w) * fk, 0.0});
+            relaxing_.push_back({kept, b_.vertex_node[c_.edge_end[i]], w * fk, 0.0});
+        }
     }
     c_.remove_if_flagged(drop);
-    c_.rebuild_batches(int(laws_.size()));
+    c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
     for (int i = 0; i < b_.count(); ++i)
         if (b_.removed[i]) b_.velocity[i] = {}, b_.omega[i] = 0.0;
+    for (int k = 0; k < n_.count(); ++k)
+        if (b_.removed[n_.block[k]]) n_.velocity[k] = {};
     relax_total_ = relax_left_ = relax_steps;
     update_timestep();
 }
@@ -352,8 +499,15 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps)
 void Solver::update_contact_forces() {
     std::fill(b_.force.begin(), b_.force.end(), Vec2{});
     std::fill(b_.moment.begin(), b_.moment.end(), 0.0);
-    contact_force_sum_ = contact::step_contacts(c_, laws_, view(), dt_, corner_radius_, b_.force.data(), b_.moment.data(),
-                                                b_.count(), settings_.threads, thread_forces_);
+    std::fill(n_.force.begin(), n_.force.end(), Vec2{});
+    const contact::ForceTargets out{b_.force.data(), b_.moment.data(), b_.count(), n_.force.data(), n_.count()};
+    contact_force_sum_ =
+        contact::step_contacts(c_, laws_, view(), dt_, corner_radius_, out, settings_.threads, thread_forces_);
+}
+
+void Solver::update_zone_forces() {
+    if (z_.size() == 0) return;
+    zone_force_sum_ = fem::step_zones(z_, n_.position.data(), n_.velocity.data(), dt_, b_.removed.data(), n_.force.data());
 }
 
 void Solver::add_external_forces() {
@@ -362,14 +516,22 @@ void Solver::add_external_forces() {
         b_.force[i] += b_.applied[i] + b_.real_mass[i] * g;
         b_.moment[i] += b_.applied_moment[i];
     }
+    for (int k = 0; k < n_.count(); ++k) n_.force[k] += n_.applied[k] + n_.real_mass[k] * g;
     if (relax_left_ > 0) {
         const double f = double(relax_left_) / double(relax_total_ + 1);
         for (const auto& r : relaxing_) {
-            b_.force[r.block] += f * r.force;
-            b_.moment[r.block] += f * r.moment;
+            if (r.node >= 0) {
+                n_.force[r.node] += f * r.force;
+            } else {
+                b_.force[r.block] += f * r.force;
+                b_.moment[r.block] += f * r.moment;
+            }
         }
-        if (--relax_left_ == 0) relaxing_.clear();
     }
+}
+
+void Solver::release_relaxation() {
+    if (relax_left_ > 0 && --relax_left_ == 0) relaxing_.clear();
 }
 
 void Solver::integrate() {
@@ -379,11 +541,12 @@ void Solver::integrate() {
     for (std::size_t k = 0; k < boundary_blocks_.size(); ++k) {
         Vec2 sum{};
         for (int i : boundary_blocks_[k].second) sum += b_.force[i] - b_.applied[i] - b_.real_mass[i] * settings_.gravity;
+        for (int i : boundary_nodes_[k]) sum += n_.force[i] - n_.applied[i] - n_.real_mass[i] * settings_.gravity;
         boundary_force_[k] = sum;
     }
     double work = 0.0;
     for (int i = 0; i < b_.count(); ++i) {
-        if (b_.removed[i]) continue;
+        if (b_.removed[i] || b_.deformable[i]) continue;
         const std::uint8_t fx = b_.fixed[i];
         Vec2& v = b_.velocity[i];
         const Vec2 f = b_.force[i];
@@ -402,26 +565,54 @@ void Solver::integrate() {
         b_.centroid[i] += dt * v;
         b_.theta[i] += dt * b_.omega[i];
     }
+    for (int i = 0; i < n_.count(); ++i) {
+        if (b_.removed[n_.block[i]]) continue;
+        const std::uint8_t fx = n_.fixed[i];
+        Vec2& v = n_.velocity[i];
+        const Vec2 f = n_.force[i];
+        if (!(fx & 1)) max_unbalanced = std::max(max_unbalanced, std::abs(f.x));
+        if (!(fx & 2)) max_unbalanced = std::max(max_unbalanced, std::abs(f.y));
+        v.x = (fx & 1) ? n_.fixed_velocity[i].x : v.x + damped(f.x, v.x) / n_.mass[i] * dt;
+        v.y = (fx & 2) ? n_.fixed_velocity[i].y : v.y + damped(f.y, v.y) / n_.mass[i] * dt;
+        work += dot(n_.applied[i] + n_.real_mass[i] * settings_.gravity, v) * dt;
+        if (fx & 1) work -= f.x * v.x * dt;
+        if (fx & 2) work -= f.y * v.y * dt;
+        n_.position[i] += dt * v;
+    }
     work_ += work;
-    // Scale: the root-mean-square contact force (SPEC §5 says "mean contact force
-    // magnitude"; RMS >= mean, and it needs no square root per contact).
-    double mean_force = c_.size() > 0 ? std::sqrt(contact_force_sum_ / c_.size()) : 0.0;
+    const double scale = force_scale();
+    ratio_ = scale > 0.0 ? max_unbalanced / scale : 0.0;
+}
+
+double Solver::force_scale() const {
+    // The root-mean-square contact (and zone nodal) force. SPEC §5 says "mean
+    // contact force magnitude"; RMS >= mean, and it needs no square root per contact.
+    const double terms = double(c_.size()) + 3.0 * double(z_.size());
+    double mean_force = terms > 0 ? std::sqrt((contact_force_sum_ + zone_force_sum_) / terms) : 0.0;
     if (mean_force <= 0.0) {
         for (int i = 0; i < b_.count(); ++i) mean_force += norm(b_.applied[i] + b_.real_mass[i] * settings_.gravity);
-        mean_force /= std::max(1, b_.count());
+        for (int i = 0; i < n_.count(); ++i) mean_force += norm(n_.applied[i] + n_.real_mass[i] * settings_.gravity);
+        mean_force /= std::max(1, b_.count() + n_.count());
     }
-    ratio_ = mean_force > 0.0 ? max_unbalanced / mean_force : 0.0;
+    return mean_force;
 }
 
 void Solver::detect_if_due() {
     // Every few steps: which blocks have moved a quarter of the tolerance since
-    // their last pass? Only they (and their neighbours) are examined.
+    // their last pass? Only they (and their neighbours) are examined. A deformable
+    // block counts as moved when any of its boundary vertices has.
     if (steps_ % 4 != 0) return;
     bool any = false;
+    const double limit = 0.25 * tolerance_;
     for (int i = 0; i < b_.count(); ++i) {
-        const bool moved = !b_.removed[i] && norm(b_.centroid[i] - detected_at_[i]) +
-                                                     std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i] >=
-                                                 0.25 * tolerance_;
+        bool moved = false;
+        if (b_.removed[i]) {
+        } else if (b_.deformable[i]) {
+            for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1] && !moved; ++v)
+                moved = norm2(b_.vertex[v] - detected_vertex_[v]) >= limit * limit;
+        } else {
+            moved = norm(b_.centroid[i] - detected_at_[i]) + std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i] >= limit;
+        }
         active_[i] = moved;
         any = any || moved;
     }
@@ -429,15 +620,19 @@ void Solver::detect_if_due() {
     contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
                                new_contact_property_, dt_};
     const auto r = contact::update_contacts(c_, in);
-    for (int i = 0; i < b_.count(); ++i)
-        if (active_[i]) detected_at_[i] = b_.centroid[i], detected_theta_[i] = b_.theta[i];
+    for (int i = 0; i < b_.count(); ++i) {
+        if (!active_[i]) continue;
+        detected_at_[i] = b_.centroid[i], detected_theta_[i] = b_.theta[i];
+        if (b_.deformable[i])
+            for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) detected_vertex_[v] = b_.vertex[v];
+    }
     detection_totals_.created += r.created;
     detection_totals_.removed += r.removed;
     detection_totals_.transferred += r.transferred;
     detection_totals_.removed_tensile += r.removed_tensile;
     detection_totals_.removed_shear += r.removed_shear;
     if (r.created > 0 || r.removed > 0) {
-        c_.rebuild_batches(int(laws_.size()));
+        c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
         update_timestep();
     }
 }
@@ -446,7 +641,9 @@ void Solver::step() {
     update_vertices();
     detect_if_due();
     update_contact_forces();
+    update_zone_forces();
     add_external_forces();
+    release_relaxation();
     integrate();
     time_ += dt_;
     ++steps_;
@@ -455,8 +652,10 @@ void Solver::step() {
 double Solver::kinetic_energy() const {
     double e = 0.0;
     for (int i = 0; i < b_.count(); ++i)
-        if (!b_.removed[i])
+        if (!b_.removed[i] && !b_.deformable[i])
             e += 0.5 * b_.real_mass[i] * norm2(b_.velocity[i]) + 0.5 * b_.real_inertia[i] * b_.omega[i] * b_.omega[i];
+    for (int i = 0; i < n_.count(); ++i)
+        if (!b_.removed[n_.block[i]]) e += 0.5 * n_.real_mass[i] * norm2(n_.velocity[i]);
     return e;
 }
 
@@ -467,6 +666,24 @@ double Solver::strain_energy() const {
         const auto& law = laws_[c_.property[i]];
         e += c_.length[i] * (h.sn * h.sn / (2.0 * contact::normal_stiffness(law)) +
                              h.tau * h.tau / (2.0 * contact::shear_stiffness(law)));
+    }
+    return e + zone_strain_energy();
+}
+
+double Solver::zone_strain_energy() const {
+    double e = 0.0;
+    for (int z = 0; z < z_.size(); ++z) {
+        if (b_.removed[z_.block[z]]) continue;
+        const auto& t = z_.node[z];
+        const double area = fem::gradients(n_.position[t[0]], n_.position[t[1]], n_.position[t[2]]).area;
+        // ½ σ·D⁻¹σ, plane strain: D⁻¹ from the Lamé constants (σzz = λ(εxx + εyy)).
+        const auto& s = z_.stress[z];
+        const double l = z_.elasticity[z].lambda, G = z_.elasticity[z].shear;
+        const double tr = s[0] + s[1];
+        const double exx = (s[0] - l / (2.0 * (l + G)) * tr) / (2.0 * G);
+        const double eyy = (s[1] - l / (2.0 * (l + G)) * tr) / (2.0 * G);
+        const double exy = s[2] / (2.0 * G);
+        e += 0.5 * area * (s[0] * exx + s[1] * eyy + 2.0 * s[2] * exy);
     }
     return e;
 }
@@ -495,6 +712,7 @@ Vec2 Solver::boundary_force(const std::string& name) const {
 std::vector<std::array<double, 3>> Solver::block_stresses() const {
     std::vector<std::array<double, 3>> m(b_.count(), {0.0, 0.0, 0.0});
     auto add = [&](int blk, Vec2 r, Vec2 f) {
+        if (b_.deformable[blk]) return;
         m[blk][0] += r.x * f.x;
         m[blk][1] += r.y * f.y;
         m[blk][2] += 0.5 * (r.x * f.y + r.y * f.x);
@@ -510,6 +728,12 @@ std::vector<std::array<double, 3>> Solver::block_stresses() const {
     for (const auto& t : tractions_) {
         const double cs = std::cos(b_.theta[t.block]), sn = std::sin(b_.theta[t.block]);
         add(t.block, {cs * t.offset.x - sn * t.offset.y, sn * t.offset.x + cs * t.offset.y}, t.force);
+    }
+    // Deformable blocks: area-weighted mean of their zone stresses.
+    for (int z = 0; z < z_.size(); ++z) {
+        const auto& t = z_.node[z];
+        const double a = fem::gradients(n_.position[t[0]], n_.position[t[1]], n_.position[t[2]]).area;
+        for (int k = 0; k < 3; ++k) m[z_.block[z]][k] += a * z_.stress[z][k];
     }
     for (int b = 0; b < b_.count(); ++b)
         for (double& v : m[b]) v /= b_.area[b];
@@ -538,6 +762,9 @@ std::uint64_t Solver::state_hash() const {
         mix(b_.velocity[i].x), mix(b_.velocity[i].y), mix(b_.omega[i]);
     }
     for (const auto& c : c_.history) mix(c.sn), mix(c.tau), mix(c.upn), mix(c.ups);
+    for (int i = 0; i < n_.count(); ++i)
+        mix(n_.position[i].x), mix(n_.position[i].y), mix(n_.velocity[i].x), mix(n_.velocity[i].y);
+    for (const auto& s : z_.stress) mix(s[0]), mix(s[1]), mix(s[2]);
     return h;
 }
 

@@ -3,7 +3,7 @@
 // One step is the list of stages of SPEC §5:
 //   1. (when due) contact detection update          — detect_if_due()
 //   2. contact forces from displacement increments   — update_contact_forces()
-//   3. zone stresses of deformable blocks            — fem/ (later issue)
+//   3. zone stresses of deformable blocks            — update_zone_forces() (fem/cst.hpp)
 //   4. gravity, boundary tractions, applied loads    — add_external_forces()
 //   5. damping and integration, prescribed velocities — integrate()
 //   6. convergence measure                           — the unbalanced-force ratio
@@ -21,15 +21,26 @@
 // are set to K (Δt / (2 safety))², so every block converges at the same rate;
 // gravity still acts on the real mass. Local non-viscous damping (Cundall):
 // each force component is reduced by α|F| against the velocity.
+//
+// Deformable blocks (SPEC §6): a block of a meshed region keeps its entry in the
+// block arrays (region, removal, polygon) but moves through its FE nodes: its
+// polygon vertices are its boundary nodes, so contacts treat it like any block
+// (contacts.hpp interpolates velocities and splits forces along its edges). Nodes
+// have their own flat arrays and are damped, scaled and integrated like blocks
+// (two degrees of freedom each). A node's stiffness for mass scaling and the
+// stable step is the Gershgorin row sum of its zone stiffness (halved, to match
+// the diagonal estimate used for blocks) plus its share of contact stiffness.
 #pragma once
 
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
 #include "core/model_spec.hpp"
+#include "fem/cst.hpp"
 #include "meshing/blocks.hpp"
 
 #include <array>
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -51,6 +62,26 @@ public:
     void step();
     /// Recomputes time step and (quasi-static) masses from the current contacts.
     void update_timestep();
+    /// Implicit elastic stage (SPEC §5): assembles the linear stiffness of blocks
+    /// (3 DOF), nodes (2 DOF), contacts (kn, ks) and zones at the current state,
+    /// solves K Δu = unbalanced force with CHOLMOD (prescribed components held),
+    /// and applies Δu through the contact laws and zones. Velocities are zero
+    /// after it. Throws std::runtime_error naming the cause if the system is
+    /// singular (a floating block or a model without supports).
+    struct ElasticSolveReport {
+        int equations = 0, iterations = 0;
+        long nonzeros = 0;
+        std::string method;
+        double relative_residual = 0, seconds = 0, ratio_before = 0, ratio_after = 0;
+    };
+    ElasticSolveReport solve_elastic();
+
+    // --- checkpoints (core/checkpoint.cpp) -----------------------------------
+    /// Writes the evolving state (binary). A solver built from the same model
+    /// file and given this state continues exactly as the saved one would.
+    void save_state(std::ostream& out) const;
+    /// Throws std::runtime_error if the data is truncated, corrupt or of another model.
+    void load_state(std::istream& in);
 
     // --- measures -------------------------------------------------------------
     double unbalanced_ratio() const { return ratio_; }
@@ -69,6 +100,8 @@ public:
     /// Block-averaged stress of every block (SPEC §7): σ = (1/A) Σ x ⊗ f over its
     /// contacts and boundary tractions, symmetrised; tension positive. {sxx, syy, sxy}.
     std::vector<std::array<double, 3>> block_stresses() const;
+    /// Total strain energy of the zones (½ σ·D⁻¹σ A), J/m.
+    double zone_strain_energy() const;
     int block_at(Vec2 p) const;
 
     // --- state (read by output and tests) ------------------------------------
@@ -80,12 +113,26 @@ public:
         std::vector<Vec2> fixed_velocity;
         std::vector<double> fixed_omega;
         std::vector<std::uint8_t> removed;
+        std::vector<std::uint8_t> deformable; ///< moves through FE nodes (see above)
         std::vector<int> region, material;
         std::vector<Vec2> local, vertex; ///< body and world vertex positions (CSR by first)
         std::vector<double> inv_edge_length; ///< per vertex: 1 / length of the edge it starts
         std::vector<std::uint32_t> first;
+        std::vector<int> vertex_node; ///< per vertex: its FE node, −1 on rigid blocks
         int count() const { return static_cast<int>(centroid.size()); }
     };
+    /// FE nodes of deformable blocks.
+    struct Nodes {
+        std::vector<Vec2> position, position0, velocity, force, applied;
+        std::vector<double> mass, real_mass;
+        std::vector<std::uint8_t> fixed; ///< bit 0 vx, bit 1 vy prescribed
+        std::vector<Vec2> fixed_velocity;
+        std::vector<int> block;
+        int count() const { return static_cast<int>(position.size()); }
+    };
+    const Nodes& nodes() const { return n_; }
+    Nodes& nodes() { return n_; }
+    const fem::Zones& zones() const { return z_; }
     const Blocks& blocks() const { return b_; }
     Blocks& blocks() { return b_; }
     const contact::Contacts& contacts() const { return c_; }
@@ -105,12 +152,17 @@ private:
     void detect_if_due();
     void update_vertices();
     void update_contact_forces();
+    void update_zone_forces();
     void add_external_forces();
+    void release_relaxation();
+    double force_scale() const;
     void integrate();
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
 
     Blocks b_;
+    Nodes n_;
+    fem::Zones z_;
     contact::Contacts c_;
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
@@ -118,11 +170,14 @@ private:
     SolverSpec settings_;
     std::vector<std::pair<std::string, std::vector<int>>> boundary_blocks_;
     std::vector<Vec2> boundary_force_; ///< per boundary_blocks_ entry, last step
+    std::vector<std::vector<int>> boundary_nodes_; ///< per boundary_blocks_ entry: its FE nodes
     struct Traction { int block; Vec2 offset; Vec2 force; }; ///< boundary point load, body frame
     std::vector<Traction> tractions_;
     double contact_force_sum_ = 0.0; ///< Σ|F|² of the last step
+    double zone_force_sum_ = 0.0;    ///< Σ|f|² of zone nodal forces, last step
     contact::ThreadForces thread_forces_;
-    struct Relaxing { int block; Vec2 force; double moment; };
+    /// A support force being relaxed: on a block (node < 0) or on a node.
+    struct Relaxing { int block; int node; Vec2 force; double moment; };
     std::vector<Relaxing> relaxing_;
     long relax_total_ = 0, relax_left_ = 0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
@@ -132,6 +187,7 @@ private:
     std::vector<double> radius_; ///< largest vertex distance from the centroid
     std::vector<Vec2> detected_at_;
     std::vector<double> detected_theta_;
+    std::vector<Vec2> detected_vertex_; ///< deformable blocks: vertex positions at their last pass
     std::vector<std::uint8_t> active_; ///< moved enough since its last detection pass
     contact::DetectionResult detection_totals_;
     long steps_ = 0;

@@ -985,7 +985,10 @@ TEST_CASE("history and stage mistakes") {
     check_error(with("[[stage]]\ntype = \"initialize\"\nratio = 1e-5\n"), "ratio", "stage[0].ratio",
                 "does not apply to an initialize stage");
     check_error(with("[[stage]]\ntype = \"run\"\n"), "run", "stage[0].type",
-                "unknown stage type 'run'; expected one of: initialize, solve, excavate, cycle");
+                "unknown stage type 'run'; expected one of: initialize, solve, excavate, cycle, "
+                "elastic");
+    check_error(with("[[stage]]\ntype = \"elastic\"\nsteps = 10\n"), "steps", "stage[0].steps",
+                "key 'steps' does not apply to an elastic stage; its keys are: name, type");
     check_error(with("[[stage]]\ntype = \"solve\"\n\n[[stage]]\nname = \"stage 1\"\n"
                      "type = \"solve\"\n"),
                 "name = \"stage 1\"", "stage[1].name",
@@ -1015,4 +1018,150 @@ regions = ["a"]
     CHECK(an.boundaries.at(0).select.regions == std::vector<std::string>{"a"});
     CHECK(an.stages.at(0).name == "stage 1");
     CHECK(an.region_material.size() == 1);
+}
+
+// --- deformable regions ----------------------------------------------------------------
+
+namespace {
+
+// The tunnel's outer region meshed, graded toward the bonded region.
+constexpr std::string_view deformable = R"([[region]]
+name = "outer"
+outline = { type = "rectangle", min = [0, -20], max = [20, 20] }
+minus = ["bonded"]
+pattern = { type = "single" }
+material = "rock"
+mesh = { size = 0.4, size_far = 3.0, grading = 0.25, toward = ["bonded"] }
+
+[[region]]
+name = "bonded"
+outline = { type = "rectangle", min = [0, -8], max = [8, 8] }
+pattern = { type = "voronoi", size = 0.3 }
+material = "rock"
+mesh = { size = 0.1 }
+
+[[material]]
+name = "rock"
+density = 2650
+young = 20e9
+poisson = 0.25
+deformable_fraction = 0.9
+
+[[stage]]
+name = "equilibrium"
+type = "elastic"
+)";
+
+/// Region "a" of one_region with a mesh, then `extra` (other tables).
+std::string meshed(std::string_view mesh, std::string_view extra) {
+    return std::string(one_region) + "mesh = " + std::string(mesh) + "\n" + std::string(extra);
+}
+
+constexpr std::string_view rock = "\n[[material]]\nname = \"rock\"\nyoung = 1e10\n";
+
+} // namespace
+
+TEST_CASE("a deformable region: its mesh, its material's elasticity, an elastic stage") {
+    const auto mf = parse_model(deformable, "d.toml");
+    const auto& outer = mf.geometry.regions.at(0).mesh;
+    CHECK(outer.enabled);
+    CHECK(outer.size == 0.4);
+    CHECK(outer.size_far == 3.0);
+    CHECK(outer.grading == 0.25);
+    CHECK(outer.toward == std::vector<std::string>{"bonded"});
+    const auto& bonded = mf.geometry.regions.at(1).mesh;
+    CHECK(bonded.enabled);
+    CHECK(bonded.size == 0.1);
+    CHECK(bonded.size_far == 0.0); // = size
+    CHECK(bonded.grading == 0.0);
+    CHECK(bonded.toward.empty());
+    CHECK_FALSE(parse_model(one_region, "t.toml").geometry.regions.at(0).mesh.enabled);
+
+    const auto& m = mf.analysis.materials.at(0);
+    CHECK(m.density == 2650.0);
+    CHECK(m.young == 20e9);
+    CHECK(m.poisson == 0.25);
+    CHECK(m.deformable_fraction == 0.9);
+    const auto plain = parse_model(with("[[material]]\nname = \"rock\"\n"), "t.toml");
+    CHECK(plain.analysis.materials.at(0).young == 0.0);
+    CHECK(plain.analysis.materials.at(0).poisson == 0.2);
+    CHECK(plain.analysis.materials.at(0).deformable_fraction == 0.0);
+
+    REQUIRE(mf.analysis.stages.size() == 1);
+    CHECK(mf.analysis.stages[0].kind == bbm::StageSpec::Kind::elastic);
+    CHECK(mf.analysis.stages[0].name == "equilibrium");
+
+    // Lines for errors found when the blocks are meshed.
+    CHECK(mf.source.line_of(0, "mesh") == line_of(deformable, "mesh = { size = 0.4"));
+    CHECK(mf.source.line_of(0, "mesh.toward") == line_of(deformable, "mesh = { size = 0.4"));
+    CHECK(mf.source.line_of(1, "mesh") == line_of(deformable, "mesh = { size = 0.1"));
+    // Regions that name no material take the file's first one.
+    CHECK(parse_model(meshed("{ size = 0.1 }", rock), "t.toml").geometry.regions[0].mesh.enabled);
+}
+
+TEST_CASE("mesh and elasticity mistakes") {
+    check_error(meshed("{ size = 0 }", rock), "mesh", "region[0].mesh.size",
+                "must be > 0 m, got 0");
+    check_error(meshed("{ size = -0.2 }", rock), "mesh", "region[0].mesh.size",
+                "must be > 0 m, got -0.2");
+    check_error(meshed("{ size_far = 2 }", rock), "mesh", "region[0].mesh.size",
+                "region 'a': missing required key 'size': expected a number > 0 m");
+    check_error(meshed("{ size = 0.4, size_far = 0.3, toward = [\"b\"] }", rock), "mesh",
+                "region[0].mesh.size_far", "must be >= size = 0.4 m, got 0.3");
+    check_error(meshed("{ size = 0.4, grading = -1 }", rock), "mesh", "region[0].mesh.grading",
+                "must be >= 0 m/m, got -1");
+    check_error(meshed("{ size = 0.4, grading = 0.2 }", rock), "mesh", "region[0].mesh.grading",
+                "grades the mesh by the distance from the regions listed in 'toward', but none "
+                "are listed");
+    check_error(meshed("{ sise = 0.4 }", rock), "mesh", "region[0].mesh.sise",
+                "unknown key 'sise' in region[0].mesh (did you mean 'size'?)");
+    check_error(meshed("0.4", rock), "mesh", "region[0].mesh",
+                "expected a mesh table { size = ..., ... }, got float 0.4");
+
+    // `toward` names other regions, like `minus`.
+    const std::string b = "\n[[region]]\nname = \"bonded\"\noutline = { type = \"circle\", "
+                          "center = [5, 0], radius = 1 }\npattern = { type = \"single\" }\n";
+    check_error(
+        meshed("{ size = 0.4, grading = 0.1, toward = [\"bonde\"] }", b + std::string(rock)),
+        "mesh", "region[0].mesh.toward[0]",
+        "region 'a' refines its mesh toward 'bonde', but there is no region of that name "
+        "(did you mean 'bonded'?); regions are: a, bonded");
+    check_error(meshed("{ size = 0.4, toward = [\"a\"] }", b + std::string(rock)), "mesh",
+                "region[0].mesh.toward[0]", "region 'a' cannot refine its mesh toward itself");
+    check_error(meshed("{ size = 0.4, toward = [\"bonded\", \"bonded\"] }", b + std::string(rock)),
+                "mesh", "region[0].mesh.toward[1]", "'bonded' is already listed as mesh.toward[0]");
+
+    // A deformable region needs the elasticity of its material.
+    const std::string no_young = "\n[[material]]\nname = \"rock\"\ndensity = 2600\n";
+    check_error(meshed("{ size = 0.1 }", "material = \"rock\"\n" + no_young), "mesh",
+                "region[0].mesh",
+                "region 'a' is deformable (has a mesh) but its material 'rock' has no young "
+                "modulus");
+    check_error(meshed("{ size = 0.1 }", no_young), "mesh", "region[0].mesh",
+                "region 'a' is deformable (has a mesh) but its material 'rock' has no young "
+                "modulus");
+    check_error(meshed("{ size = 0.1 }", ""), "mesh", "region[0].mesh",
+                "region 'a' is deformable (has a mesh) but has no material");
+    // Another region names a material, this one none: it has the default, rigid material.
+    check_error(meshed("{ size = 0.1 }", b + "material = \"rock\"\n" + std::string(rock)), "mesh",
+                "region[0].mesh", "region 'a' is deformable (has a mesh) but has no material");
+
+    check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\npoisson = 0.5\n"), "poisson",
+                "material[0].poisson", "must be in [0, 0.5), got 0.5");
+    check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\npoisson = -0.1\n"), "poisson",
+                "material[0].poisson", "must be in [0, 0.5), got -0.1");
+    check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\ndeformable_fraction = 1.2\n"),
+                "deformable_fraction", "material[0].deformable_fraction",
+                "must be in (0, 1), got 1.2");
+    check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\ndeformable_fraction = 0\n"),
+                "deformable_fraction", "material[0].deformable_fraction",
+                "must be in (0, 1), got 0");
+    check_error(with("[[material]]\nname = \"rock\"\nyoung = 0\n"), "young", "material[0].young",
+                "must be > 0 Pa, got 0");
+    check_error(with("[[material]]\nname = \"rock\"\npoisson = 0.3\n"), "poisson",
+                "material[0].poisson",
+                "material 'rock': applies to deformable blocks and needs 'young', which is not "
+                "given");
+    check_error(with("[[material]]\nname = \"rock\"\nyung = 1e10\n"), "yung", "material[0].yung",
+                "did you mean 'young'?");
 }

@@ -1,0 +1,417 @@
+#include "apps/run_model.hpp"
+
+#include "apps/model_input.hpp"
+#include "apps/picture.hpp"
+#include "apps/vtk_output.hpp"
+#include "core/analysis.hpp"
+#include "core/error.hpp"
+#include "meshing/blocks.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace bbm::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::atomic<bool> interrupted{false};
+
+/// A run stopped by a health check; the message says why and what to change.
+struct HealthError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, f, a, b, c);
+    return buf;
+}
+
+/// NaN, runaway motion (more than the detection tolerance in one step: contacts
+/// can no longer follow) and overlaps beyond the tolerance (a contact pushed
+/// through). Cheap checks every 100 steps, the overlap scan every 1000.
+void check_health(const Solver& s) {
+    const double tol = s.detection_tolerance(), dt = s.timestep();
+    const std::string advice =
+        " Reduce solver.safety (the time step is safety x the critical step) or, for a load applied by "
+        "velocity, the velocity; check that stiffness and strength values are in SI units (Pa/m, Pa).";
+    if (!std::isfinite(s.unbalanced_ratio()) || !std::isfinite(s.kinetic_energy()))
+        throw HealthError("the solution became NaN or infinite at step " + std::to_string(s.steps()) + "." + advice);
+    const auto& b = s.blocks();
+    for (int i = 0; i < b.count(); ++i) {
+        if (b.removed[i] || b.deformable[i]) continue;
+        if (norm(b.velocity[i]) * dt > tol)
+            throw HealthError(fmt("runaway motion at step %.0f: block %.0f moves %.3g m in one step, more than the "
+                                  "detection tolerance.",
+                                  double(s.steps()), i, norm(b.velocity[i]) * dt) +
+                              advice);
+    }
+    const auto& n = s.nodes();
+    for (int k = 0; k < n.count(); ++k)
+        if (!b.removed[n.block[k]] && norm(n.velocity[k]) * dt > tol)
+            throw HealthError(fmt("runaway motion at step %.0f: node %.0f moves %.3g m in one step.", double(s.steps()),
+                                  k, norm(n.velocity[k]) * dt) +
+                              advice);
+    if (s.steps() % 1000 != 0) return;
+    const auto& c = s.contacts();
+    for (int i = 0; i < c.size(); ++i) {
+        const Vec2 x = b.vertex[c.vertex_id[i]], p = b.vertex[c.edge_id[i]];
+        const double gap = dot(x - p, c.normal[i]);
+        const double elastic = std::max(0.0, -c.history[i].un);
+        if (gap < -(tol + elastic))
+            throw HealthError(fmt("blocks overlap at step %.0f: a contact at (%.3g, %.3g) is pushed through its edge "
+                                  "by more than the detection tolerance.",
+                                  double(s.steps()), x.x, x.y) +
+                              advice);
+    }
+}
+
+// --- binary helpers for the checkpoint's run part ------------------------------
+template <class T>
+void put(std::ostream& o, const T& v) {
+    o.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+void put_string(std::ostream& o, const std::string& s) {
+    put(o, std::uint64_t(s.size()));
+    o.write(s.data(), std::streamsize(s.size()));
+}
+template <class T>
+T get(std::istream& i) {
+    T v{};
+    i.read(reinterpret_cast<char*>(&v), sizeof v);
+    if (!i) throw std::runtime_error("checkpoint is truncated");
+    return v;
+}
+std::string get_string(std::istream& i) {
+    const auto n = get<std::uint64_t>(i);
+    if (n > (1u << 20)) throw std::runtime_error("checkpoint is corrupt");
+    std::string s(n, '\0');
+    i.read(s.data(), std::streamsize(n));
+    if (!i) throw std::runtime_error("checkpoint is truncated");
+    return s;
+}
+const char* checkpoint_magic = "bbm-run-checkpoint-1";
+
+/// Writes the ParaView series, the history, progress and checkpoints of a run.
+class RunOutput : public StageObserver {
+public:
+    RunOutput(const fs::path& out, const AnalysisSpec& an, const Solver& s, const RunOptions& o, std::string model)
+        : out_(out), settings_(an.solver), recorder_(s, an.histories), options_(o), model_(std::move(model)) {
+        fs::create_directories(out_ / "vtk");
+    }
+
+    void stage_started(const Solver& s, const StageSpec& st) override {
+        if (s.steps() == 0 && rows_.empty()) {
+            record(s);
+            snapshot(s);
+        }
+        (void)st;
+    }
+    void step_done(const Solver& s, const StageSpec& st, long k) override {
+        if (s.steps() % settings_.history_every == 0) record(s);
+        if (settings_.output_every > 0 && s.steps() % settings_.output_every == 0) snapshot(s);
+        if (s.steps() % 100 == 0) check_health(s);
+        if (options_.quiet) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (std::chrono::duration<double>(now - last_print_).count() < 1.0) return;
+        if (stage_name_ != st.name) stage_name_ = st.name, stage_t0_ = now, stage_k0_ = k;
+        last_print_ = now;
+        const double el = std::chrono::duration<double>(now - stage_t0_).count();
+        const double rate = el > 0 ? (k - stage_k0_) / el : 0.0;
+        const long total = st.kind == StageSpec::Kind::cycle ? st.steps
+                         : st.kind == StageSpec::Kind::excavate ? st.relax_steps : st.max_steps;
+        std::fprintf(stderr, "\r  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s  ",
+                     st.name.c_str(), k, total, s.unbalanced_ratio(), s.cracks(contact::JointState::broken_tension),
+                     s.cracks(contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
+    }
+    void at(const Solver& s, const StageCursor& c) override {
+        cursor_ = c;
+        if (options_.checkpoint_every > 0 && c.step > 0 && s.steps() % options_.checkpoint_every == 0)
+            write_checkpoint(s);
+    }
+    void stage_done(const Solver& s, const StageReport& r) override {
+        record(s);
+        snapshot(s);
+        flush_history();
+        if (!options_.quiet)
+            std::fprintf(stderr, "\r  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s%s\n", r.name.c_str(),
+                         r.kind.c_str(), r.steps, r.ratio, r.seconds, r.converged ? "" : "  (step limit reached)",
+                         r.method.empty() ? "" : ("  " + r.method).c_str(), std::string(50, ' ').c_str());
+    }
+    bool stop_requested() override { return interrupted.load(); }
+
+    void write_checkpoint(const Solver& s) {
+        std::ostringstream o(std::ios::binary);
+        o.write(checkpoint_magic, std::streamsize(std::char_traits<char>::length(checkpoint_magic)));
+        put_string(o, model_);
+        put(o, options_.threads);
+        put(o, cursor_.stage), put(o, cursor_.started), put(o, cursor_.step);
+        put(o, std::uint64_t(rows_.size()));
+        for (std::size_t r = 0; r < rows_.size(); ++r) {
+            put(o, rows_[r].first), put(o, times_[r]), put(o, std::uint64_t(rows_[r].second.size()));
+            for (double v : rows_[r].second) put(o, v);
+        }
+        put(o, std::uint64_t(series_.size()));
+        for (const auto& [t, name] : series_) put(o, t), put_string(o, name);
+        put(o, last_snapshot_);
+        s.save_state(o);
+        flush_history();
+        write_text_atomically(out_ / "checkpoint.bin", o.str());
+    }
+    /// Reads the run part of a checkpoint; the solver part follows in the stream.
+    static std::string read_model_name(std::istream& i, int& threads) {
+        std::string magic(std::char_traits<char>::length(checkpoint_magic), '\0');
+        i.read(magic.data(), std::streamsize(magic.size()));
+        if (!i || magic != checkpoint_magic) throw std::runtime_error("not a bbm checkpoint");
+        std::string model = get_string(i);
+        threads = get<int>(i);
+        return model;
+    }
+    void restore(std::istream& i) {
+        cursor_.stage = get<int>(i), cursor_.started = get<bool>(i), cursor_.step = get<long>(i);
+        const auto rows = get<std::uint64_t>(i);
+        for (std::uint64_t r = 0; r < rows; ++r) {
+            const long step = get<long>(i);
+            times_.push_back(get<double>(i));
+            std::vector<double> v(get<std::uint64_t>(i));
+            for (double& x : v) x = get<double>(i);
+            rows_.push_back({step, std::move(v)});
+        }
+        const auto n = get<std::uint64_t>(i);
+        for (std::uint64_t k = 0; k < n; ++k) {
+            const double t = get<double>(i);
+            series_.push_back({t, get_string(i)});
+        }
+        last_snapshot_ = get<long>(i);
+    }
+    const StageCursor& cursor() const { return cursor_; }
+    const std::vector<std::pair<long, std::vector<double>>>& rows() const { return rows_; }
+    const std::vector<double>& times() const { return times_; }
+    const HistoryRecorder& recorder() const { return recorder_; }
+    void snapshot(const Solver& s) {
+        if (!series_.empty() && last_snapshot_ == s.steps()) return;
+        last_snapshot_ = s.steps();
+        char name[64];
+        std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
+        write_state_blocks_vtu(s, out_ / name);
+        series_.push_back({s.time(), name});
+        std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
+        write_state_contacts_vtu(s, out_ / name);
+        series_.push_back({s.time(), name});
+        write_pvd(out_ / "result.pvd", series_);
+    }
+    void flush_history() {
+        std::ostringstream csv;
+        csv << "step,time";
+        for (const auto& h : recorder_.histories()) csv << ',' << h.name;
+        csv << '\n';
+        csv.precision(10);
+        for (std::size_t r = 0; r < rows_.size(); ++r) {
+            csv << rows_[r].first << ',' << times_[r];
+            for (double v : rows_[r].second) csv << ',' << v;
+            csv << '\n';
+        }
+        write_text_atomically(out_ / "history.csv", csv.str());
+    }
+    void record(const Solver& s) {
+        if (!rows_.empty() && rows_.back().first == s.steps()) return;
+        rows_.push_back({s.steps(), recorder_.sample(s)});
+        times_.push_back(s.time());
+    }
+
+private:
+    fs::path out_;
+    SolverSpec settings_;
+    HistoryRecorder recorder_;
+    RunOptions options_;
+    std::string model_;
+    std::vector<std::pair<long, std::vector<double>>> rows_;
+    std::vector<double> times_;
+    std::vector<std::pair<double, std::string>> series_;
+    long last_snapshot_ = -1;
+    StageCursor cursor_;
+    std::string stage_name_;
+    long stage_k0_ = 0;
+    std::chrono::steady_clock::time_point stage_t0_ = std::chrono::steady_clock::now(), last_print_ = stage_t0_;
+};
+
+/// history.png: the unbalanced ratio and the crack counts against the step.
+void draw_history(const RunOutput& out, const fs::path& file) {
+    const auto& h = out.recorder().histories();
+    std::vector<Series> ratio, cracks;
+    for (std::size_t k = 0; k < h.size(); ++k) {
+        using Q = HistorySpec::Quantity;
+        const bool is_ratio = h[k].quantity == Q::unbalanced_ratio;
+        const bool is_crack = h[k].quantity == Q::cracks_tensile || h[k].quantity == Q::cracks_shear;
+        if (!is_ratio && !is_crack) continue;
+        Series ser{h[k].name, {}, {}};
+        for (const auto& [step, values] : out.rows())
+            if (!is_ratio || values[k] > 0) ser.x.push_back(double(step)), ser.y.push_back(values[k]);
+        (is_ratio ? ratio : cracks).push_back(std::move(ser));
+    }
+    auto stem = file.stem().string();
+    if (!ratio.empty()) draw_curves(ratio, "step", "unbalanced-force ratio", file, "convergence", true);
+    if (!cracks.empty())
+        draw_curves(cracks, "step", "broken contacts", file.parent_path() / (stem + "_cracks.png"), "cracks");
+}
+
+} // namespace
+
+int run_model(const RunOptions& opt) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::string model_path = opt.model;
+    std::ifstream checkpoint;
+    int saved_threads = opt.threads;
+    if (opt.resume) {
+        checkpoint.open(opt.out / "checkpoint.bin", std::ios::binary);
+        if (!checkpoint)
+            throw InputError((opt.out / "checkpoint.bin").string(), 0, "",
+                             "no checkpoint to resume from (run with --checkpoint-every N, or stop a run with Ctrl-C)");
+        model_path = RunOutput::read_model_name(checkpoint, saved_threads);
+    }
+    io::ModelFile model = io::read_model(model_path);
+    model.analysis.solver.threads = opt.threads;
+    if (model.analysis.stages.empty())
+        throw InputError(model_path, 0, "stage", "the model has no [[stage]] to run (bbm mesh only generates blocks)");
+    meshing::BlockAssembly blocks;
+    meshing::GenerationStats gen;
+    try {
+        blocks = meshing::generate_blocks(model.geometry, &gen);
+    } catch (const GeometryError& e) {
+        throw io::to_input_error(model.source, e);
+    }
+    std::unique_ptr<Solver> solver;
+    try {
+        solver = std::make_unique<Solver>(blocks, model.analysis);
+    } catch (const InputError& e) {
+        throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
+    }
+    int rigid = 0;
+    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver->blocks().deformable[i];
+    if (!opt.quiet)
+        std::fprintf(stderr, "%s: %d rigid blocks, %d deformable blocks with %d zones, %d contacts; time step %.3g s (%s)\n",
+                     model_path.c_str(), rigid, blocks.block_count() - rigid, solver->zones().size(),
+                     solver->contacts().size(), solver->timestep(),
+                     model.analysis.solver.mode == SolverSpec::Mode::quasi_static ? "quasi-static" : "dynamic");
+    RunOutput output(opt.out, model.analysis, *solver, opt, fs::absolute(model_path).string());
+    StageCursor start;
+    if (opt.resume) {
+        if (saved_threads != opt.threads && !opt.quiet)
+            std::fprintf(stderr, "note: the checkpoint was written with --threads %d; continuing with %d gives a "
+                                 "valid but not bit-identical result\n", saved_threads, opt.threads);
+        output.restore(checkpoint);
+        solver->load_state(checkpoint);
+        start = output.cursor();
+        if (!opt.quiet)
+            std::fprintf(stderr, "resuming at step %ld (stage %d, step %ld in it)\n", solver->steps(), start.stage + 1,
+                         start.step);
+    }
+    interrupted = false;
+    std::signal(SIGINT, [](int) { interrupted = true; });
+    std::signal(SIGTERM, [](int) { interrupted = true; });
+    std::vector<StageReport> reports;
+    std::string health;
+    try {
+        reports = run_stages(*solver, model.analysis.stages, output, start);
+    } catch (const HealthError& e) {
+        health = e.what();
+    }
+    if (interrupted) {
+        output.write_checkpoint(*solver);
+        if (!opt.quiet)
+            std::fprintf(stderr, "\ninterrupted at step %ld: wrote %s; continue with: bbm run --resume --out %s\n",
+                         solver->steps(), (opt.out / "checkpoint.bin").string().c_str(), opt.out.string().c_str());
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    nlohmann::json stages = nlohmann::json::array();
+    for (const auto& r : reports) {
+        nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
+                         {"seconds", r.seconds}, {"converged", r.converged}};
+        if (!r.method.empty()) j["method"] = r.method;
+        stages.push_back(j);
+    }
+    nlohmann::json summary{
+        {"model", model_path},
+        {"blocks", rigid},
+        {"deformable_blocks", blocks.block_count() - rigid},
+        {"zones", solver->zones().size()},
+        {"nodes", solver->nodes().count()},
+        {"contacts", solver->contacts().size()},
+        {"steps", solver->steps()},
+        {"time", solver->time()},
+        {"timestep", solver->timestep()},
+        {"wall_seconds", seconds},
+        {"meshing_seconds", gen.seconds_regions + gen.seconds_patterns + gen.seconds_topology},
+        {"cracks", {{"tensile", solver->cracks(contact::JointState::broken_tension)},
+                    {"shear", solver->cracks(contact::JointState::broken_shear)}}},
+        {"unbalanced_ratio", solver->unbalanced_ratio()},
+        {"energy", {{"kinetic", solver->kinetic_energy()}, {"strain", solver->strain_energy()},
+                    {"dissipated", solver->dissipated_energy()}, {"external_work", solver->external_work()}}},
+        {"state_hash", std::to_string(solver->state_hash())},
+        {"interrupted", interrupted.load()},
+        {"stages", stages}};
+    const auto& rep = model.analysis.report;
+    FailurePlotOptions fo;
+    fo.title = model_path;
+    if (rep.opening) {
+        const auto m = measure_opening(*solver, rep.center, rep.springline, rep.crown);
+        summary["opening"] = {
+            {"springline_displacement", {m.springline_displacement.x, m.springline_displacement.y}},
+            {"crown_displacement", {m.crown_displacement.x, m.crown_displacement.y}},
+            {"springline_convergence", m.springline_convergence},
+            {"crown_convergence", m.crown_convergence},
+            {"failed_depth_springline", m.failed_depth_springline},
+            {"failed_depth_crown", m.failed_depth_crown},
+            {"cracks_springline_sector", m.cracks_springline_sector},
+            {"cracks_crown_sector", m.cracks_crown_sector},
+            {"springline_sector_tensile", m.tensile_springline_sector},
+            {"springline_sector_shear", m.shear_springline_sector}};
+        const double r = std::max(norm(rep.springline - rep.center), norm(rep.crown - rep.center));
+        Box2 all;
+        for (Vec2 p : blocks.points) all.add(p);
+        fo.window.add({std::max(all.lo.x, rep.center.x - 2.2 * r), std::max(all.lo.y, rep.center.y - 2.2 * r)});
+        fo.window.add({std::min(all.hi.x, rep.center.x + 2.2 * r), std::min(all.hi.y, rep.center.y + 2.2 * r)});
+    }
+    if (rep.window) fo.window = *rep.window;
+    if (!health.empty()) {
+        summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
+    } else {
+        draw_failure(*solver, opt.out / "failure.png", fo);
+        draw_failure(*solver, opt.out / "failure.svg", fo);
+        draw_history(output, opt.out / "history.png");
+    }
+    write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");
+    if (!health.empty()) {
+        std::fprintf(stderr, "\nbbm: stopped: %s\nThe output of the last good step is kept in %s.\n", health.c_str(),
+                     opt.out.string().c_str());
+        return 3;
+    }
+    if (!opt.quiet) {
+        std::fprintf(stderr, "%ld steps in %.2f s; cracks %d tensile, %d shear\n", solver->steps(), seconds,
+                     solver->cracks(contact::JointState::broken_tension),
+                     solver->cracks(contact::JointState::broken_shear));
+        if (rep.opening)
+            std::fprintf(stderr, "opening: convergence %.2f mm at the springline, %.2f mm at the crown; cracks in the "
+                                 "±30° sectors %d (springline) vs %d (crown)\n",
+                         1e3 * summary["opening"]["springline_convergence"].get<double>(),
+                         1e3 * summary["opening"]["crown_convergence"].get<double>(),
+                         summary["opening"]["cracks_springline_sector"].get<int>(),
+                         summary["opening"]["cracks_crown_sector"].get<int>());
+        std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
+                     opt.out.string().c_str());
+    }
+    return interrupted ? 130 : 0;
+}
+
+} // namespace bbm::io

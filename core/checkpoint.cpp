@@ -1,0 +1,102 @@
+// Checkpoints: the solver's evolving state as a flat binary dump.
+//
+// What is saved is everything a step reads that the model file does not
+// determine: block and node kinematics and (scaled) masses, contacts with their
+// full histories (detection adds and removes them), zone stresses, relaxation and
+// detection bookkeeping, time and counters. Geometry, property sets and boundary
+// conditions are rebuilt from the model file, which generates the same assembly
+// every time; a checkpoint carries the state hash of its source at save time and
+// the number of blocks, nodes and zones, and refuses to load into a solver built
+// from a different model.
+#include "core/solver.hpp"
+
+#include <istream>
+#include <ostream>
+#include <stdexcept>
+#include <type_traits>
+
+namespace bbm {
+
+namespace {
+constexpr std::uint64_t magic = 0x62626d2d63687031ull; // "bbm-chp1"
+
+template <class T>
+void put(std::ostream& o, const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    o.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T>
+void put(std::ostream& o, const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    put(o, std::uint64_t(v.size()));
+    o.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
+}
+template <class T>
+void get(std::istream& i, T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    i.read(reinterpret_cast<char*>(&v), sizeof v);
+    if (!i) throw std::runtime_error("checkpoint is truncated");
+}
+template <class T>
+void get(std::istream& i, std::vector<T>& v) {
+    std::uint64_t n = 0;
+    get(i, n);
+    if (n > (std::uint64_t(1) << 40) / sizeof(T)) throw std::runtime_error("checkpoint is corrupt (array size)");
+    v.resize(n);
+    i.read(reinterpret_cast<char*>(v.data()), std::streamsize(n * sizeof(T)));
+    if (!i) throw std::runtime_error("checkpoint is truncated");
+}
+} // namespace
+
+void Solver::save_state(std::ostream& o) const {
+    put(o, magic);
+    put(o, std::int64_t(b_.count())), put(o, std::int64_t(n_.count())), put(o, std::int64_t(z_.size()));
+    // Blocks.
+    put(o, b_.centroid), put(o, b_.velocity), put(o, b_.theta), put(o, b_.omega);
+    put(o, b_.mass), put(o, b_.inertia), put(o, b_.removed), put(o, b_.inv_edge_length);
+    // Nodes and zones.
+    put(o, n_.position), put(o, n_.velocity), put(o, n_.mass);
+    put(o, z_.stress), put(o, z_.strain);
+    // Contacts.
+    put(o, c_.vertex_block), put(o, c_.vertex_id), put(o, c_.edge_block), put(o, c_.edge_id), put(o, c_.edge_end);
+    put(o, c_.length), put(o, c_.property), put(o, c_.history), put(o, c_.normal);
+    // Loop bookkeeping.
+    put(o, relaxing_), put(o, relax_total_), put(o, relax_left_);
+    put(o, dt_), put(o, time_), put(o, ratio_), put(o, work_), put(o, steps_);
+    put(o, contact_force_sum_), put(o, zone_force_sum_), put(o, boundary_force_);
+    put(o, detected_at_), put(o, detected_theta_), put(o, detected_vertex_), put(o, active_);
+    put(o, detection_totals_);
+    put(o, state_hash());
+    if (!o) throw std::runtime_error("cannot write the checkpoint");
+}
+
+void Solver::load_state(std::istream& i) {
+    std::uint64_t m = 0;
+    get(i, m);
+    if (m != magic) throw std::runtime_error("not a bbm checkpoint");
+    std::int64_t nb = 0, nn = 0, nz = 0;
+    get(i, nb), get(i, nn), get(i, nz);
+    if (nb != b_.count() || nn != n_.count() || nz != z_.size())
+        throw std::runtime_error("checkpoint is of a different model (" + std::to_string(nb) + " blocks, " +
+                                 std::to_string(nn) + " nodes, " + std::to_string(nz) + " zones; this model has " +
+                                 std::to_string(b_.count()) + ", " + std::to_string(n_.count()) + ", " +
+                                 std::to_string(z_.size()) + ")");
+    get(i, b_.centroid), get(i, b_.velocity), get(i, b_.theta), get(i, b_.omega);
+    get(i, b_.mass), get(i, b_.inertia), get(i, b_.removed), get(i, b_.inv_edge_length);
+    get(i, n_.position), get(i, n_.velocity), get(i, n_.mass);
+    get(i, z_.stress), get(i, z_.strain);
+    get(i, c_.vertex_block), get(i, c_.vertex_id), get(i, c_.edge_block), get(i, c_.edge_id), get(i, c_.edge_end);
+    get(i, c_.length), get(i, c_.property), get(i, c_.history), get(i, c_.normal);
+    get(i, relaxing_), get(i, relax_total_), get(i, relax_left_);
+    get(i, dt_), get(i, time_), get(i, ratio_), get(i, work_), get(i, steps_);
+    get(i, contact_force_sum_), get(i, zone_force_sum_), get(i, boundary_force_);
+    get(i, detected_at_), get(i, detected_theta_), get(i, detected_vertex_), get(i, active_);
+    get(i, detection_totals_);
+    std::uint64_t hash = 0;
+    get(i, hash);
+    c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
+    update_vertices();
+    if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
+}
+
+} // namespace bbm

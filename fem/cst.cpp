@@ -1,0 +1,77 @@
+#include "fem/cst.hpp"
+
+#include <cstdint>
+
+namespace bbm::fem {
+
+std::array<double, 36> element_stiffness(const TriangleGradients& g, const Elasticity& e) {
+    // K = A Bᵀ D B with B rows (εxx, εyy, γxy) and ∂N/∂x = b/(2A): the 1/(4A²) of
+    // the two B factors and the area leave 1/(4A).
+    const double l2g = e.p_modulus(), l = e.lambda, G = e.shear, f = 1.0 / (4.0 * g.area);
+    std::array<double, 36> k{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            const double bi = g.b[i], ci = g.c[i], bj = g.b[j], cj = g.c[j];
+            k[(2 * i) * 6 + 2 * j] = f * (l2g * bi * bj + G * ci * cj);
+            k[(2 * i) * 6 + 2 * j + 1] = f * (l * bi * cj + G * ci * bj);
+            k[(2 * i + 1) * 6 + 2 * j] = f * (l * ci * bj + G * bi * cj);
+            k[(2 * i + 1) * 6 + 2 * j + 1] = f * (l2g * ci * cj + G * bi * bj);
+        }
+    return k;
+}
+
+namespace {
+inline double add_forces(const TriangleGradients& g, const std::array<double, 3>& s, const std::array<int, 3>& n,
+                         Vec2* force) {
+    // f_i = −A σ ∇N_i = −½ σ (b_i, c_i).
+    double sum = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec2 f{-0.5 * (s[0] * g.b[i] + s[2] * g.c[i]), -0.5 * (s[2] * g.b[i] + s[1] * g.c[i])};
+        force[n[i]] += f;
+        sum += norm2(f);
+    }
+    return sum;
+}
+} // namespace
+
+double step_zones(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip, Vec2* force) {
+    double sum = 0.0;
+    const int count = z.size();
+    for (int k = 0; k < count; ++k) {
+        if (skip[z.block[k]]) continue;
+        const auto& n = z.node[k];
+        const auto g = gradients(x[n[0]], x[n[1]], x[n[2]]);
+        // Velocity gradient × Δt: the step's displacement gradient.
+        const double f = dt / (2.0 * g.area);
+        double uxx = 0, uxy = 0, uyx = 0, uyy = 0; // ∂u_x/∂x, ∂u_x/∂y, ∂u_y/∂x, ∂u_y/∂y
+        for (int i = 0; i < 3; ++i) {
+            const Vec2 vi = v[n[i]];
+            uxx += vi.x * g.b[i], uxy += vi.x * g.c[i];
+            uyx += vi.y * g.b[i], uyy += vi.y * g.c[i];
+        }
+        uxx *= f, uxy *= f, uyx *= f, uyy *= f;
+        const double exx = uxx, eyy = uyy, exy = 0.5 * (uxy + uyx), w = 0.5 * (uyx - uxy);
+        auto& s = z.stress[k];
+        const Elasticity& e = z.elasticity[k];
+        // Jaumann rotation of the stress by the step's spin w.
+        const double rot_xx = -2.0 * w * s[2], rot_xy = w * (s[0] - s[1]);
+        const double tr = e.lambda * (exx + eyy);
+        s[0] += rot_xx + tr + 2.0 * e.shear * exx;
+        s[1] += -rot_xx + tr + 2.0 * e.shear * eyy;
+        s[2] += rot_xy + 2.0 * e.shear * exy;
+        auto& eps = z.strain[k];
+        eps[0] += exx, eps[1] += eyy, eps[2] += exy;
+        sum += add_forces(g, s, n, force);
+    }
+    return sum;
+}
+
+void zone_forces(const Zones& z, const Vec2* x, const std::uint8_t* skip, Vec2* force) {
+    for (int k = 0; k < z.size(); ++k) {
+        if (skip[z.block[k]]) continue;
+        const auto& n = z.node[k];
+        add_forces(gradients(x[n[0]], x[n[1]], x[n[2]]), z.stress[k], n, force);
+    }
+}
+
+} // namespace bbm::fem

@@ -1,0 +1,77 @@
+// bbm fem: constant-strain triangles for deformable blocks (SPEC §5 stage 3, §6).
+//
+// A zone is a linear triangle with nodes (x0, x1, x2), counter-clockwise. Its shape
+// functions have constant gradients ∇N_i = (b_i, c_i) / (2A) with
+//   b_i = y_j − y_k,  c_i = x_k − x_j   (i, j, k cyclic),
+// so the velocity gradient L = Σ v_i ⊗ ∇N_i is constant over the zone.
+//
+// Explicit update (small strain on the current configuration, as in FLAC/UDEC
+// deformable blocks, so large rigid motions stay stress-free):
+//   Δε  = sym(L) Δt,   ω = ½ (∂v_y/∂x − ∂v_x/∂y) Δt   (the spin of the step)
+//   σ  ← σ + (W σ − σ W) + D Δε      (Jaumann rotation, then plane-strain Hooke)
+// with D plane strain: σxx = (λ+2G) εxx + λ εyy, σyy = λ εxx + (λ+2G) εyy,
+// σxy = 2G εxy (εxy the tensor shear strain). Internal nodal forces from the zone
+// stress on the current geometry: f_i = −A σ ∇N_i.
+//
+// The same gradients give the linear element stiffness K_e = A Bᵀ D B used by the
+// implicit solve and by mass scaling. Stress is tension positive (SPEC §2).
+#pragma once
+
+#include "core/vec2.hpp"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace bbm::fem {
+
+/// Plane-strain isotropic elasticity as Lamé constants.
+struct Elasticity {
+    double lambda = 0.0, shear = 0.0;
+    static Elasticity from_young(double young, double poisson) {
+        return {young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)), young / (2.0 * (1.0 + poisson))};
+    }
+    /// P-wave modulus λ + 2G (plane strain constrained modulus).
+    double p_modulus() const { return lambda + 2.0 * shear; }
+};
+
+/// Area and shape-function gradient numerators of a triangle: ∂N_i/∂x = b[i]/(2A),
+/// ∂N_i/∂y = c[i]/(2A).
+struct TriangleGradients {
+    double area = 0.0;
+    std::array<double, 3> b{}, c{};
+};
+
+inline TriangleGradients gradients(Vec2 x0, Vec2 x1, Vec2 x2) {
+    TriangleGradients g;
+    g.area = 0.5 * cross(x1 - x0, x2 - x0);
+    g.b = {x1.y - x2.y, x2.y - x0.y, x0.y - x1.y};
+    g.c = {x2.x - x1.x, x0.x - x2.x, x1.x - x0.x};
+    return g;
+}
+
+/// 6×6 element stiffness (row-major, DOF order x0 y0 x1 y1 x2 y2).
+std::array<double, 36> element_stiffness(const TriangleGradients& g, const Elasticity& e);
+
+/// Zones of all deformable blocks, flat.
+struct Zones {
+    std::vector<std::array<int, 3>> node;
+    std::vector<Elasticity> elasticity;
+    std::vector<std::array<double, 3>> stress; ///< σxx, σyy, σxy, Pa, tension positive
+    std::vector<std::array<double, 3>> strain; ///< εxx, εyy, εxy (tensor shear), accumulated
+    std::vector<int> block;
+    std::vector<double> density;
+    int size() const { return static_cast<int>(node.size()); }
+};
+
+/// Stage 3 of a step: zone stresses from the node velocities of the step and the
+/// internal forces they put on the nodes (added to `force`). Zones of removed
+/// blocks are skipped (`skip[block]` non-zero). Returns Σ|f|² of the nodal forces
+/// (the force scale of the unbalanced-force ratio).
+double step_zones(Zones& z, const Vec2* position, const Vec2* velocity, double dt, const std::uint8_t* skip,
+                  Vec2* force);
+
+/// Internal nodal forces of the current stresses only (no update).
+void zone_forces(const Zones& z, const Vec2* position, const std::uint8_t* skip, Vec2* force);
+
+} // namespace bbm::fem
