@@ -164,17 +164,47 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     const View view(box, o.width_px, legend);
     Canvas canvas(file, view.w, view.h);
     cairo_t* cr = canvas.cr;
+    // Displacement of rigid blocks (centroid) and of zones (mean of their nodes).
+    const auto& nodes = s.nodes();
+    const auto& z = s.zones();
+    auto zone_displacement = [&](int k) {
+        Vec2 u{};
+        for (int nd : z.node[k]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0;
+        return norm(u);
+    };
     double umax = 0.0;
     for (int i = 0; i < b.count(); ++i)
-        if (!b.removed[i]) umax = std::max(umax, norm(b.centroid[i] - b.centroid0[i]));
+        if (!b.removed[i] && !b.deformable[i]) umax = std::max(umax, norm(b.centroid[i] - b.centroid0[i]));
+    for (int k = 0; k < z.size(); ++k)
+        if (!b.removed[z.block[k]]) umax = std::max(umax, zone_displacement(k));
     view.apply(cr, box, legend);
     const double px = 1.0 / view.scale;
+    // Light grey for still material to ochre for the most displaced.
+    auto shade = [&](double u) {
+        const double f = umax > 0 ? std::sqrt(u / umax) : 0.0;
+        cairo_set_source_rgb(cr, 0.92 - 0.05 * f, 0.92 - 0.25 * f, 0.92 - 0.6 * f);
+    };
+    for (int k = 0; k < z.size(); ++k) {
+        if (b.removed[z.block[k]]) continue;
+        const auto& t = z.node[k];
+        const Vec2 corners[3] = {nodes.position[t[0]], nodes.position[t[1]], nodes.position[t[2]]};
+        polygon_path(cr, corners);
+        shade(zone_displacement(k));
+        cairo_fill_preserve(cr);
+        cairo_set_source_rgba(cr, 0.7, 0.7, 0.7, 0.5);
+        cairo_set_line_width(cr, 0.25 * px);
+        cairo_stroke(cr);
+    }
     for (int i = 0; i < b.count(); ++i) {
         if (b.removed[i]) continue;
         polygon_path(cr, {b.vertex.data() + b.first[i], b.vertex.data() + b.first[i + 1]});
-        // Light grey for still blocks to ochre for the most displaced.
-        const double f = umax > 0 ? std::sqrt(norm(b.centroid[i] - b.centroid0[i]) / umax) : 0.0;
-        cairo_set_source_rgb(cr, 0.92 - 0.05 * f, 0.92 - 0.25 * f, 0.92 - 0.6 * f);
+        if (b.deformable[i]) { // outline only: its zones are drawn above
+            cairo_set_source_rgba(cr, 0.3, 0.3, 0.3, 0.9);
+            cairo_set_line_width(cr, 0.8 * px);
+            cairo_stroke(cr);
+            continue;
+        }
+        shade(norm(b.centroid[i] - b.centroid0[i]));
         cairo_fill_preserve(cr);
         cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 0.7);
         cairo_set_line_width(cr, 0.4 * px);

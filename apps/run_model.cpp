@@ -53,7 +53,9 @@ void check_health(const Solver& s) {
         if (b.removed[i] || b.deformable[i]) continue;
         if (norm(b.velocity[i]) * dt > tol)
             throw HealthError(fmt("runaway motion at step %.0f: block %.0f moves %.3g m in one step, more than the "
-                                  "detection tolerance.",
+                                  "detection tolerance, so contacts can no longer follow it. Either part of the "
+                                  "model is collapsing (a mechanism: look at the last output) or the step is "
+                                  "unstable.",
                                   double(s.steps()), i, norm(b.velocity[i]) * dt) +
                               advice);
     }
@@ -377,6 +379,18 @@ int run_model(const RunOptions& opt) {
             {"cracks_crown_sector", m.cracks_crown_sector},
             {"springline_sector_tensile", m.tensile_springline_sector},
             {"springline_sector_shear", m.shear_springline_sector}};
+        // Hoop stress profiles from the wall outwards (compression positive, MPa).
+        const auto stress = solver->block_stresses();
+        const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
+        nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
+        for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
+            const double hs = hoop_stress_at(*solver, stress, rep.center, rep.springline, f * a_s, 0.3);
+            const double hc = hoop_stress_at(*solver, stress, rep.center, rep.crown, f * a_c, 0.3);
+            spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
+            crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
+        }
+        summary["opening"]["hoop_stress_springline"] = spring;
+        summary["opening"]["hoop_stress_crown"] = crown;
         const double r = std::max(norm(rep.springline - rep.center), norm(rep.crown - rep.center));
         Box2 all;
         for (Vec2 p : blocks.points) all.add(p);

@@ -70,8 +70,9 @@ const char* to_string(StageSpec::Kind k);
 /// opening's centre: the wall points at the springline and the crown (the
 /// material points that started nearest them; convergence = displacement towards
 /// the centre, positive inwards), cracks in the ±30° sectors around both
-/// directions, and the depth of the failed zone (farthest broken contact beyond the
-/// opening's radius in that direction, within ±15°).
+/// directions, and the depth of the failed zone beyond the opening's radius in
+/// each direction (±15°): the depth within which 90% of those cracks lie, zero
+/// with fewer than 3.
 struct OpeningMeasures {
     Vec2 springline_displacement{}, crown_displacement{};
     double springline_convergence = 0, crown_convergence = 0;
@@ -80,5 +81,12 @@ struct OpeningMeasures {
     int tensile_springline_sector = 0, shear_springline_sector = 0;
 };
 OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
+
+/// Hoop stress (tension positive) at distance r from `center` along the direction
+/// `towards`: the area-weighted mean of the block-averaged stress of rigid blocks
+/// and of the zone stresses whose centroids lie within `band` of that point (the
+/// scatter of discrete blocks needs an average; SPEC §7). NaN if none is there.
+double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,
+                      Vec2 towards, double r, double band);
 
 } // namespace bbm

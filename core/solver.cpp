@@ -286,6 +286,17 @@ void Solver::apply_boundaries(const AnalysisSpec& an, const meshing::BlockAssemb
             for (int i : select_blocks(bc.select)) {
                 if (b_.deformable[i]) continue;
                 blocks.push_back(i);
+                if (bc.select.touching) {
+                    Vec2 sum{};
+                    double len = 0.0;
+                    for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) {
+                        const Vec2 p = b_.vertex[v], q = b_.vertex[contact::next_vertex(b_.first.data(), i, int(v))];
+                        if (!in_box(bc.select.box, p) || !in_box(bc.select.box, q)) continue;
+                        sum += norm(q - p) * 0.5 * (p + q);
+                        len += norm(q - p);
+                    }
+                    if (len > 0) supports_.push_back({i, sum / len - b_.centroid[i]});
+                }
                 if (bc.vx) b_.fixed[i] |= 1, b_.fixed_velocity[i].x = *bc.vx;
                 if (bc.vy) b_.fixed[i] |= 2, b_.fixed_velocity[i].y = *bc.vy;
                 if (bc.omega) b_.fixed[i] |= 4, b_.fixed_omega[i] = *bc.omega;
@@ -728,6 +739,15 @@ std::vector<std::array<double, 3>> Solver::block_stresses() const {
     for (const auto& t : tractions_) {
         const double cs = std::cos(b_.theta[t.block]), sn = std::sin(b_.theta[t.block]);
         add(t.block, {cs * t.offset.x - sn * t.offset.y, sn * t.offset.x + cs * t.offset.y}, t.force);
+    }
+    // Supports (reaction = minus the force on the prescribed components), where a
+    // `touching` boundary holds the block: without them a block on a symmetry
+    // plane would show half its stress across the plane.
+    for (const auto& sp : supports_) {
+        const int i = sp.block;
+        const Vec2 reaction{(b_.fixed[i] & 1) ? -b_.force[i].x : 0.0, (b_.fixed[i] & 2) ? -b_.force[i].y : 0.0};
+        const double cs = std::cos(b_.theta[i]), sn = std::sin(b_.theta[i]);
+        add(i, {cs * sp.offset.x - sn * sp.offset.y, sn * sp.offset.x + cs * sp.offset.y}, reaction);
     }
     // Deformable blocks: area-weighted mean of their zone stresses.
     for (int z = 0; z < z_.size(); ++z) {

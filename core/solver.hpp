@@ -173,6 +173,10 @@ private:
     std::vector<std::vector<int>> boundary_nodes_; ///< per boundary_blocks_ entry: its FE nodes
     struct Traction { int block; Vec2 offset; Vec2 force; }; ///< boundary point load, body frame
     std::vector<Traction> tractions_;
+    /// Blocks held by a `touching` velocity boundary: where the support acts (the
+    /// mean midpoint of their edges in the box, body frame), for block stresses.
+    struct Support { int block; Vec2 offset; };
+    std::vector<Support> supports_;
     double contact_force_sum_ = 0.0; ///< Σ|F|² of the last step
     double zone_force_sum_ = 0.0;    ///< Σ|f|² of zone nodal forces, last step
     contact::ThreadForces thread_forces_;

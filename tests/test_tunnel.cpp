@@ -1,0 +1,128 @@
+// The paper's tunnel end to end (issue 6): the elastic reference against Kirsch,
+// the side-wall failure of the trigon model, and exact restart from a checkpoint.
+#include "apps/model_input.hpp"
+#include "core/analysis.hpp"
+#include "core/solver.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <sstream>
+
+using namespace bbm;
+
+namespace {
+
+io::ModelFile read_example(const std::string& name) {
+    return io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/" + name);
+}
+
+struct Quiet : StageObserver {};
+
+/// Stops the run after `stop_at` steps, keeping the cursor reached.
+struct StopAt : StageObserver {
+    long stop_at;
+    StageCursor cursor;
+    bool stop = false;
+    explicit StopAt(long n) : stop_at(n) {}
+    void at(const Solver& s, const StageCursor& c) override {
+        cursor = c;
+        stop = s.steps() >= stop_at;
+    }
+    bool stop_requested() override { return stop; }
+};
+
+// Kirsch, plane strain, infinite plate, vertical p = 15 MPa and horizontal 7.5 MPa
+// (SPEC §8): hoop stress (compression positive, MPa) on the springline and crown lines.
+double kirsch_hoop(double r, bool springline) {
+    const double a = 4.0, pv = 15.0, ph = 7.5, q = (a * a) / (r * r);
+    // θ from the horizontal: σθ = ½(pv+ph)(1 + q) − ½(ph − pv)(1 + 3q²) cos 2θ.
+    const double c2 = springline ? 1.0 : -1.0;
+    return 0.5 * (pv + ph) * (1 + q) - 0.5 * (ph - pv) * (1 + 3 * q * q) * c2;
+}
+
+} // namespace
+
+TEST_CASE("tunnel: Kirsch reference values of SPEC §8") {
+    CHECK(kirsch_hoop(4.0, true) == doctest::Approx(37.5));
+    CHECK(kirsch_hoop(6.0, true) == doctest::Approx(22.2).epsilon(0.005));
+    CHECK(kirsch_hoop(4.0, false) == doctest::Approx(7.5));
+    CHECK(kirsch_hoop(6.0, false) == doctest::Approx(10.3).epsilon(0.005));
+}
+
+TEST_CASE("tunnel: elastic Voronoi model — hoop stress within 15% of Kirsch at 5, 6 and 8 m") {
+    const auto file = read_example("tunnel_elastic.toml");
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    Solver s(blocks, file.analysis);
+    Quiet q;
+    const auto reports = run_stages(s, file.analysis.stages, q);
+    REQUIRE(reports.back().converged);
+    CHECK(s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear) == 0);
+    // The model's vertical stress at the tunnel axis is 15 MPa plus the weight of
+    // 20 m of rock: Kirsch scaled by that ratio.
+    const double scale = (15e6 + 2700 * 9.81 * 20) / 15e6;
+    const auto stress = s.block_stresses();
+    const Vec2 c{0, 0};
+    for (double r : {5.0, 6.0, 8.0}) {
+        const double spring = -hoop_stress_at(s, stress, c, {4, 0}, r, 0.5) / 1e6;
+        const double crown = -hoop_stress_at(s, stress, c, {0, 4}, r, 0.5) / 1e6;
+        const double ks = scale * kirsch_hoop(r, true), kc = scale * kirsch_hoop(r, false);
+        MESSAGE("r = " << r << " m: springline " << spring << " MPa (Kirsch " << ks << ", " << (spring / ks - 1) * 100
+                       << "%), crown " << crown << " MPa (Kirsch " << kc << ", " << (crown / kc - 1) * 100 << "%)");
+        CHECK(spring == doctest::Approx(ks).epsilon(0.15));
+        CHECK(crown == doctest::Approx(kc).epsilon(0.15));
+    }
+}
+
+TEST_CASE("tunnel: a run resumed from a checkpoint ends in the same state as an uninterrupted one") {
+    // The Voronoi tunnel through excavation into the failure stage (detection,
+    // cracking, deformable far field), stopped mid-stage and resumed in a new solver.
+    auto file = read_example("tunnel_voronoi.toml");
+    file.analysis.stages.back().max_steps = 1500;
+    file.analysis.stages.back().ratio = 1e-9;
+    file.analysis.solver.threads = 1;
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    Solver whole(blocks, file.analysis);
+    Quiet q;
+    run_stages(whole, file.analysis.stages, q);
+
+    Solver first(blocks, file.analysis);
+    StopAt stop(3700); // inside the last stage (excavation relaxes over 3000 steps)
+    run_stages(first, file.analysis.stages, stop);
+    REQUIRE(first.steps() == 3700);
+    std::stringstream checkpoint;
+    first.save_state(checkpoint);
+
+    Solver resumed(blocks, file.analysis);
+    resumed.load_state(checkpoint);
+    CHECK(resumed.state_hash() == first.state_hash());
+    run_stages(resumed, file.analysis.stages, q, stop.cursor);
+    CHECK(resumed.steps() == whole.steps());
+    CHECK(resumed.state_hash() == whole.state_hash());
+    CHECK(resumed.cracks(contact::JointState::broken_tension) == whole.cracks(contact::JointState::broken_tension));
+
+    // A checkpoint of another model is refused with a reason.
+    auto other = read_example("verification/stack.toml");
+    Solver wrong(meshing::generate_blocks(other.geometry), other.analysis);
+    std::stringstream again;
+    first.save_state(again);
+    CHECK_THROWS_WITH_AS(wrong.load_state(again), doctest::Contains("different model"), std::runtime_error);
+}
+
+TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown") {
+    auto file = read_example("tunnel_trigon.toml");
+    file.analysis.stages.back().max_steps = 8000; // the failure is well developed by then
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    file.analysis.solver.threads = 2;
+    Solver s(blocks, file.analysis);
+    Quiet q;
+    run_stages(s, file.analysis.stages, q);
+    const auto m = measure_opening(s, {0, 0}, {4, 0}, {0, 4});
+    const int tensile = s.cracks(contact::JointState::broken_tension), shear = s.cracks(contact::JointState::broken_shear);
+    MESSAGE("cracks " << tensile << " tensile, " << shear << " shear; springline sector " << m.cracks_springline_sector
+                      << ", crown sector " << m.cracks_crown_sector << "; failed depth " << m.failed_depth_springline
+                      << " m (springline), " << m.failed_depth_crown << " m (crown)");
+    CHECK(m.cracks_springline_sector >= 20);
+    CHECK(m.cracks_springline_sector >= 3 * m.cracks_crown_sector);
+    CHECK(shear > 0); // trigon: sliding along the triangle edges takes part
+}
