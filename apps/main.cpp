@@ -339,6 +339,20 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     run->add_flag("--resume", run_options.resume, "Continue the run whose checkpoint is in --out");
 
+    std::vector<std::string> compare_models;
+    std::string compare_out = "out/compare";
+    int compare_threads = 1;
+    auto* compare = app.add_subcommand(
+        "compare", "Run several model files (e.g. rigid and deformable blocks, examples/compare_rigid_deformable/) "
+                   "into DIR/<name>/ and write DIR/comparison.csv, comparison.md (wall displacements, cracks by "
+                   "mode, failed-zone depth, run time) and comparison.png (cracks against step).");
+    compare->add_option("models", compare_models, "Model files")->required()->check(CLI::ExistingFile);
+    compare->add_option("-o,--out", compare_out, "Output directory")->capture_default_str();
+    compare->add_option("--threads", compare_threads, "Threads of each run's contact loop")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
+
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     LabTestCli ucs_cli, tension_cli, biaxial_cli, brazilian_cli;
     auto* ucs = app.add_subcommand("ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, "
@@ -375,6 +389,7 @@ int main(int argc, char** argv) {
             run_options.quiet = quiet;
             return io::run_model(run_options);
         }
+        if (*compare) return io::compare_models(compare_models, compare_out, compare_threads, quiet);
         if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);
         if (*tension) return run_labtest_command(tension_cli, LabTestOptions::Kind::tension, "tension", quiet);
         if (*biaxial) return run_labtest_command(biaxial_cli, LabTestOptions::Kind::biaxial, "biaxial", quiet);

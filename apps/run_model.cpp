@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -211,7 +212,13 @@ public:
         std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
         write_state_contacts_vtu(s, out_ / name);
         series_.push_back({s.time(), name});
+        // result.pvd holds both parts; blocks.pvd and contacts.pvd one each (for
+        // scripts that style them apart, examples/paraview_view.py).
         write_pvd(out_ / "result.pvd", series_);
+        std::vector<std::pair<double, std::string>> blocks, contacts;
+        for (std::size_t k = 0; k < series_.size(); ++k) (k % 2 ? contacts : blocks).push_back(series_[k]);
+        write_pvd(out_ / "blocks.pvd", blocks);
+        write_pvd(out_ / "contacts.pvd", contacts);
     }
     void flush_history() {
         std::ostringstream csv;
@@ -426,6 +433,80 @@ int run_model(const RunOptions& opt) {
                      opt.out.string().c_str());
     }
     return interrupted ? 130 : 0;
+}
+
+int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet) {
+    fs::create_directories(out);
+    std::ostringstream csv, md;
+    csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
+           "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
+           "cracks_springline_sector,cracks_crown_sector\n";
+    md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
+          "failed depth springline m | failed depth crown m | sector cracks springline / crown |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    std::vector<Series> curves;
+    int status = 0;
+    for (const auto& model : models) {
+        const std::string name = fs::path(model).stem().string();
+        RunOptions o;
+        o.model = model;
+        o.out = out / name;
+        o.threads = threads;
+        o.quiet = quiet;
+        if (!quiet) std::fprintf(stderr, "== %s\n", name.c_str());
+        const int rc = run_model(o);
+        if (rc != 0 && status == 0) status = rc;
+        std::ifstream f(o.out / "summary.json");
+        const auto j = nlohmann::json::parse(f);
+        const auto op = j.contains("opening") ? j["opening"] : nlohmann::json::object();
+        auto get = [&](const char* k) { return op.contains(k) ? op[k].get<double>() : 0.0; };
+        char row[1024];
+        std::snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d\n", name.c_str(),
+                      j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
+                      j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
+                      j["cracks"]["tensile"].get<int>(), j["cracks"]["shear"].get<int>(),
+                      1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
+                      get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
+                      int(get("cracks_crown_sector")));
+        csv << row;
+        std::snprintf(row, sizeof row, "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d |\n",
+                      name.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
+                      j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
+                      j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
+                      1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
+                      int(get("cracks_springline_sector")), int(get("cracks_crown_sector")));
+        md << row;
+        // Cracks against step from the run's history (columns whose quantity is a crack count).
+        Series ser{name, {}, {}};
+        std::ifstream h(o.out / "history.csv");
+        std::string line;
+        std::getline(h, line);
+        std::vector<int> crack_columns;
+        {
+            std::stringstream head(line);
+            std::string col;
+            for (int k = 0; std::getline(head, col, ','); ++k)
+                if (col.find("crack") != std::string::npos) crack_columns.push_back(k);
+        }
+        while (std::getline(h, line)) {
+            std::stringstream row_in(line);
+            std::string cell;
+            double step = 0, cracks = 0;
+            for (int k = 0; std::getline(row_in, cell, ','); ++k) {
+                if (k == 0) step = std::stod(cell);
+                if (std::find(crack_columns.begin(), crack_columns.end(), k) != crack_columns.end())
+                    cracks += std::stod(cell);
+            }
+            ser.x.push_back(step), ser.y.push_back(cracks);
+        }
+        if (!crack_columns.empty()) curves.push_back(std::move(ser));
+    }
+    write_text_atomically(out / "comparison.csv", csv.str());
+    write_text_atomically(out / "comparison.md", md.str());
+    if (!curves.empty()) draw_curves(curves, "step", "broken contacts", out / "comparison.png", "cracks by model");
+    if (!quiet) std::fprintf(stderr, "%swrote %s/{comparison.csv, comparison.md, comparison.png}\n", md.str().c_str(),
+                             out.string().c_str());
+    return status;
 }
 
 } // namespace bbm::io

@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace bbm::io {
 
@@ -28,5 +29,13 @@ struct RunOptions {
 /// numerical health check (the message names the cause and what to change).
 /// Throws InputError for bad input, std::runtime_error for other failures.
 int run_model(const RunOptions& options);
+
+/// `bbm compare A.toml B.toml ... --out DIR`: runs each model into DIR/<name>/ and
+/// writes DIR/comparison.csv and comparison.md (opening displacements, cracks by
+/// mode, failed-zone depths, counts and run time per model) and comparison.png
+/// (broken contacts against step, one curve per model). Models with a [report]
+/// give the opening columns. Returns the first non-zero exit status of a run, or 0.
+int compare_models(const std::vector<std::string>& models, const std::filesystem::path& out, int threads,
+                   bool quiet);
 
 } // namespace bbm::io

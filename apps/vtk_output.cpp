@@ -391,6 +391,9 @@ void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
     vel->SetNumberOfComponents(3), vel->SetNumberOfTuples(n);
     sig->SetNumberOfComponents(6), sig->SetNumberOfTuples(n);
     eps->SetNumberOfComponents(6), eps->SetNumberOfTuples(n);
+    // Symmetric tensors in VTK's order, named so ParaView offers XX, YY, ... to colour by.
+    static const char* tensor[6] = {"XX", "YY", "ZZ", "XY", "YZ", "XZ"};
+    for (int k = 0; k < 6; ++k) sig->SetComponentName(k, tensor[k]), eps->SetComponentName(k, tensor[k]);
     for (vtkIdType k = 0; k < nk; ++k) {
         const int i = kept[k];
         id->SetValue(k, i);

@@ -77,43 +77,63 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
         if (is_active(c.vertex_block[i]) || is_active(c.edge_block[i]))
             existing[pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
 
-    // 3. Broad phase: inflated boxes in a uniform grid.
+    // 3. Broad phase: inflated boxes in a uniform grid. A block with many vertices
+    // (a deformable block's boundary, hundreds of nodes) enters as chunks of at
+    // most `chunk` consecutive vertices, each with its own box: otherwise its one
+    // box, as large as the model, would pair it with every block and the narrow
+    // phase would test every vertex against all its edges.
+    constexpr std::uint32_t chunk = 16;
+    struct Piece {
+        int block;
+        std::uint32_t v0, v1; ///< vertices [v0, v1) and the edges they start
+        Box2 box;
+    };
     const int nb = in.block_count;
-    std::vector<Box2> box(nb);
+    std::vector<Piece> pieces;
     Box2 all;
     double mean_size = 0.0;
     int active = 0;
     for (int k = 0; k < nb; ++k) {
         if (in.removed && in.removed[k]) continue;
-        for (std::uint32_t v = b.first[k]; v < b.first[k + 1]; ++v) box[k].add(b.vertex[v]);
-        box[k].lo -= Vec2{tol, tol};
-        box[k].hi += Vec2{tol, tol};
-        all.add(box[k].lo);
-        all.add(box[k].hi);
-        mean_size += box[k].width() + box[k].height();
+        const std::uint32_t first = b.first[k], last = b.first[k + 1];
+        for (std::uint32_t v0 = first; v0 < last; v0 += chunk) {
+            Piece pc{k, v0, std::min(last, v0 + chunk), {}};
+            // An edge's box holds both its ends: the next vertex closes it.
+            for (std::uint32_t v = pc.v0; v < pc.v1; ++v) {
+                pc.box.add(b.vertex[v]);
+                pc.box.add(b.vertex[next_vertex(b.first, k, int(v))]);
+            }
+            pc.box.lo -= Vec2{tol, tol};
+            pc.box.hi += Vec2{tol, tol};
+            all.add(pc.box.lo);
+            all.add(pc.box.hi);
+            mean_size += pc.box.width() + pc.box.height();
+            pieces.push_back(pc);
+        }
         ++active;
     }
     if (active < 2) return res;
-    const double cell = mean_size / active;
+    const double cell = mean_size / double(pieces.size());
     const int nx = std::clamp(int(all.width() / cell) + 1, 1, 1 << 14);
     const int ny = std::clamp(int(all.height() / cell) + 1, 1, 1 << 14);
     auto cx = [&](double x) { return std::clamp(int((x - all.lo.x) / cell), 0, nx - 1); };
     auto cy = [&](double y) { return std::clamp(int((y - all.lo.y) / cell), 0, ny - 1); };
     std::vector<std::vector<int>> grid(std::size_t(nx) * ny);
-    for (int k = 0; k < nb; ++k) {
-        if (in.removed && in.removed[k]) continue;
-        for (int j = cy(box[k].lo.y); j <= cy(box[k].hi.y); ++j)
-            for (int i = cx(box[k].lo.x); i <= cx(box[k].hi.x); ++i) grid[std::size_t(j) * nx + i].push_back(k);
+    for (int k = 0; k < int(pieces.size()); ++k) {
+        const Box2& bx = pieces[k].box;
+        for (int j = cy(bx.lo.y); j <= cy(bx.hi.y); ++j)
+            for (int i = cx(bx.lo.x); i <= cx(bx.hi.x); ++i) grid[std::size_t(j) * nx + i].push_back(k);
     }
 
-    // Narrow phase for one ordered pair: vertices of A against edges of B.
-    auto try_vertices = [&](int A, int B) {
-        for (std::uint32_t v = b.first[A]; v < b.first[A + 1]; ++v) {
+    // Narrow phase for one ordered pair of pieces: vertices of P against edges of Q.
+    auto try_vertices = [&](const Piece& P, const Piece& Q) {
+        const int A = P.block, B = Q.block;
+        for (std::uint32_t v = P.v0; v < P.v1; ++v) {
             const Vec2 x = b.vertex[v];
-            if (x.x < box[B].lo.x || x.x > box[B].hi.x || x.y < box[B].lo.y || x.y > box[B].hi.y) continue;
+            if (x.x < Q.box.lo.x || x.x > Q.box.hi.x || x.y < Q.box.lo.y || x.y > Q.box.hi.y) continue;
             int best = -1;
             double best_gap = INFINITY;
-            for (std::uint32_t e = b.first[B]; e < b.first[B + 1]; ++e) {
+            for (std::uint32_t e = Q.v0; e < Q.v1; ++e) {
                 const int e1 = next_vertex(b.first, B, int(e));
                 const EdgeFrame f = frame(x, b.vertex[e], b.vertex[e1]);
                 const double len = 1.0 / b.inv_edge_length[e];
@@ -149,14 +169,16 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
             const auto& list = grid[std::size_t(j) * nx + i];
             for (std::size_t p = 0; p < list.size(); ++p)
                 for (std::size_t q = p + 1; q < list.size(); ++q) {
-                    const int A = std::min(list[p], list[q]), B = std::max(list[p], list[q]);
-                    if (!is_active(A) && !is_active(B)) continue;
-                    const Box2 &ba = box[A], &bb = box[B];
+                    const Piece *P = &pieces[list[p]], *Q = &pieces[list[q]];
+                    if (P->block == Q->block) continue;
+                    if (P->block > Q->block) std::swap(P, Q);
+                    if (!is_active(P->block) && !is_active(Q->block)) continue;
+                    const Box2 &ba = P->box, &bb = Q->box;
                     if (ba.hi.x < bb.lo.x || bb.hi.x < ba.lo.x || ba.hi.y < bb.lo.y || bb.hi.y < ba.lo.y) continue;
                     // Handle the pair once: in the cell holding the low corner of the overlap.
                     if (cx(std::max(ba.lo.x, bb.lo.x)) != i || cy(std::max(ba.lo.y, bb.lo.y)) != j) continue;
-                    try_vertices(A, B);
-                    try_vertices(B, A);
+                    try_vertices(*P, *Q);
+                    try_vertices(*Q, *P);
                 }
         }
     return res;

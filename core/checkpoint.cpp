@@ -48,9 +48,28 @@ void get(std::istream& i, std::vector<T>& v) {
 }
 } // namespace
 
+std::uint64_t Solver::model_fingerprint() const {
+    // What the model file fixes: initial geometry, masses (materials), supports,
+    // loads and property sets.
+    std::uint64_t h = 1469598103934665603ull;
+    auto mix = [&](const void* p, std::size_t n) {
+        const auto* c = static_cast<const unsigned char*>(p);
+        for (std::size_t k = 0; k < n; ++k) h = (h ^ c[k]) * 1099511628211ull;
+    };
+    auto vec = [&](const auto& v) { mix(v.data(), v.size() * sizeof(v[0])); };
+    vec(b_.local), vec(b_.centroid0), vec(b_.real_mass), vec(b_.fixed), vec(b_.fixed_velocity), vec(b_.applied);
+    vec(n_.position0), vec(n_.real_mass), vec(n_.fixed), vec(n_.applied), vec(z_.elasticity);
+    for (const auto& law : laws_) {
+        const double k[2] = {contact::normal_stiffness(law), contact::shear_stiffness(law)};
+        mix(k, sizeof k);
+    }
+    return h;
+}
+
 void Solver::save_state(std::ostream& o) const {
     put(o, magic);
     put(o, std::int64_t(b_.count())), put(o, std::int64_t(n_.count())), put(o, std::int64_t(z_.size()));
+    put(o, model_fingerprint());
     // Blocks.
     put(o, b_.centroid), put(o, b_.velocity), put(o, b_.theta), put(o, b_.omega);
     put(o, b_.mass), put(o, b_.inertia), put(o, b_.removed), put(o, b_.inv_edge_length);
@@ -81,6 +100,11 @@ void Solver::load_state(std::istream& i) {
                                  std::to_string(nn) + " nodes, " + std::to_string(nz) + " zones; this model has " +
                                  std::to_string(b_.count()) + ", " + std::to_string(n_.count()) + ", " +
                                  std::to_string(z_.size()) + ")");
+    std::uint64_t fingerprint = 0;
+    get(i, fingerprint);
+    if (fingerprint != model_fingerprint())
+        throw std::runtime_error("checkpoint is of a different model (same counts, but the geometry, materials, "
+                                 "joint properties or boundaries differ: was the model file edited?)");
     get(i, b_.centroid), get(i, b_.velocity), get(i, b_.theta), get(i, b_.omega);
     get(i, b_.mass), get(i, b_.inertia), get(i, b_.removed), get(i, b_.inv_edge_length);
     get(i, n_.position), get(i, n_.velocity), get(i, n_.mass);

@@ -113,7 +113,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
         };
         for (int i = 0; i < c_.size(); ++i) {
             const auto& h = c_.history[i];
-            if (h.broken != contact::JointState::intact && h.sn <= 0.0) continue; // an open crack carries nothing
+            if (!h.bonded && h.sn <= 0.0) continue; // an open crack or unbonded contact carries nothing
             const int A = c_.vertex_block[i], B = c_.edge_block[i];
             const Vec2 x = b_.vertex[c_.vertex_id[i]], n = c_.normal[i], tg = contact::tangent_of(n);
             Term terms[8];

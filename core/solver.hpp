@@ -82,6 +82,9 @@ public:
     void save_state(std::ostream& out) const;
     /// Throws std::runtime_error if the data is truncated, corrupt or of another model.
     void load_state(std::istream& in);
+    /// Hash of what the model file determines (initial geometry, masses, supports,
+    /// loads, property sets): a checkpoint records it and refuses another model.
+    std::uint64_t model_fingerprint() const;
 
     // --- measures -------------------------------------------------------------
     double unbalanced_ratio() const { return ratio_; }

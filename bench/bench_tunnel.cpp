@@ -1,0 +1,112 @@
+// Benchmark of the hybrid loop and of the paper's tunnel (issues 4 and 6).
+//   1. hybrid_scene.toml (~10k rigid blocks, ~20k zones): steps/s of the whole
+//      explicit loop, contact-updates/s and zone-updates/s over it, and the zone
+//      kernel alone (fem::step_zones) — 1 and 2 threads of the contact loop;
+//   2. examples/tunnel_voronoi.toml end to end (mesh, in-situ, implicit elastic
+//      stage, excavation, failure stage): wall time per stage, on 2 threads.
+// Prints a table and writes JSON. Usage: bench_tunnel [out.json] (run from the
+// repository root, or set BBM_SOURCE_DIR).
+#include "apps/model_input.hpp"
+#include "core/analysis.hpp"
+#include "core/solver.hpp"
+#include "fem/cst.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sys/resource.h>
+
+using namespace bbm;
+using clock_type = std::chrono::steady_clock;
+
+namespace {
+double seconds_since(clock_type::time_point t0) {
+    return std::chrono::duration<double>(clock_type::now() - t0).count();
+}
+double peak_mb() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return u.ru_maxrss / 1024.0;
+}
+struct Quiet : StageObserver {};
+} // namespace
+
+int main(int argc, char** argv) {
+    const char* out = argc > 1 ? argv[1] : "bench_tunnel.json";
+    const char* env = std::getenv("BBM_SOURCE_DIR");
+    const std::string root = env ? env : ".";
+    nlohmann::json result;
+
+    // 1. Hybrid scene.
+    auto scene = io::read_model(root + "/bench/hybrid_scene.toml");
+    auto t0 = clock_type::now();
+    const auto blocks = meshing::generate_blocks(scene.geometry);
+    const double mesh_s = seconds_since(t0);
+    nlohmann::json hybrid = nlohmann::json::array();
+    std::printf("hybrid scene: generated in %.2f s\n", mesh_s);
+    std::printf("%7s %8s %8s %9s %7s %9s %9s %13s %13s %13s\n", "threads", "rigid", "zones", "contacts", "steps",
+                "seconds", "steps/s", "c-upd/s", "z-upd/s", "zone kernel/s");
+    for (int threads : {1, 2}) {
+        scene.analysis.solver.threads = threads;
+        Solver s(blocks, scene.analysis);
+        int rigid = 0;
+        for (int i = 0; i < s.blocks().count(); ++i) rigid += !s.blocks().deformable[i];
+        for (int k = 0; k < 20; ++k) s.step(); // warm up
+        const long steps = scene.analysis.stages[0].steps;
+        double best = 1e30;
+        for (int rep = 0; rep < 3; ++rep) {
+            t0 = clock_type::now();
+            for (long k = 0; k < steps; ++k) s.step();
+            best = std::min(best, seconds_since(t0));
+        }
+        // The zone kernel alone, on a copy of the model's zones and nodes.
+        fem::Zones z = s.zones();
+        std::vector<Vec2> force(s.nodes().count());
+        std::vector<std::uint8_t> keep(s.blocks().count(), 0);
+        const long kernel_steps = 300;
+        t0 = clock_type::now();
+        for (long k = 0; k < kernel_steps; ++k)
+            fem::step_zones(z, s.nodes().position.data(), s.nodes().velocity.data(), 1.0, keep.data(), force.data());
+        const double kernel_s = seconds_since(t0);
+        const double cups = double(s.contacts().size()) * steps / best, zups = double(s.zones().size()) * steps / best;
+        const double kernel = double(z.size()) * kernel_steps / kernel_s;
+        std::printf("%7d %8d %8d %9d %7ld %9.3f %9.0f %13.3g %13.3g %13.3g\n", threads, rigid, s.zones().size(),
+                    s.contacts().size(), steps, best, steps / best, cups, zups, kernel);
+        hybrid.push_back({{"threads", threads}, {"rigid_blocks", rigid}, {"zones", s.zones().size()},
+                          {"nodes", s.nodes().count()}, {"contacts", s.contacts().size()}, {"steps", steps},
+                          {"best_seconds", best}, {"steps_per_second", steps / best},
+                          {"contact_updates_per_second", cups}, {"zone_updates_per_second", zups},
+                          {"zone_kernel_updates_per_second", kernel}});
+    }
+    result["hybrid_scene"] = hybrid;
+    result["hybrid_scene_generation_seconds"] = mesh_s;
+
+    // 2. The paper's tunnel end to end.
+    auto tunnel = io::read_model(root + "/examples/tunnel_voronoi.toml");
+    tunnel.analysis.solver.threads = 2;
+    t0 = clock_type::now();
+    const auto tb = meshing::generate_blocks(tunnel.geometry);
+    Solver s(tb, tunnel.analysis);
+    const double setup = seconds_since(t0);
+    Quiet q;
+    const auto reports = run_stages(s, tunnel.analysis.stages, q);
+    const double total = seconds_since(t0);
+    nlohmann::json stages = nlohmann::json::array();
+    std::printf("\ntunnel_voronoi.toml on 2 threads: setup %.2f s\n", setup);
+    for (const auto& r : reports) {
+        std::printf("  %-12s %-10s %7ld steps %8.2f s  ratio %.2e\n", r.name.c_str(), r.kind.c_str(), r.steps,
+                    r.seconds, r.ratio);
+        stages.push_back({{"name", r.name}, {"steps", r.steps}, {"seconds", r.seconds}, {"ratio", r.ratio}});
+    }
+    std::printf("  total %.2f s, %ld steps, %d contacts, %d zones, peak memory %.0f MB\n", total, s.steps(),
+                s.contacts().size(), s.zones().size(), peak_mb());
+    result["tunnel_voronoi"] = {{"threads", 2}, {"setup_seconds", setup}, {"total_seconds", total},
+                                {"steps", s.steps()}, {"contacts", s.contacts().size()}, {"zones", s.zones().size()},
+                                {"stages", stages}};
+    result["peak_memory_mb"] = peak_mb();
+    std::ofstream(out) << result.dump(2) << "\n";
+    std::printf("wrote %s\n", out);
+}
