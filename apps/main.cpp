@@ -120,7 +120,6 @@ struct LabTestCli {
     std::string pattern = "voronoi";
     std::vector<double> tension_softening{0.5, 1.7, 4.0}, shear_softening{0.5, 1.3, 2.1};
     std::string platens = "rough";
-    double deformable_fraction = 0.0;
     int realizations = 1;
     int threads = 0;
     std::string out = "out";
@@ -148,9 +147,16 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--density", o.density, "Block density (kg/m³)")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--deformable-fraction", c.deformable_fraction,
-                    "Fraction f of the deformation given to deformable blocks (needs deformable blocks: not yet available)")
+    sub->add_option("--deformable-fraction", o.deformable_fraction,
+                    "Deformable blocks (meshed into triangles) taking this fraction f of the deformation: blocks "
+                    "get --young / f, joints --kn, --ks / (1 - f) (SPEC §6); 0 = rigid blocks")
         ->check(CLI::Range(0.0, 0.99));
+    sub->add_option("--young", o.young, "With --deformable-fraction: target modulus E of the rock mass (Pa)")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--poisson", o.poisson, "With --deformable-fraction: Poisson's ratio of the blocks")
+        ->check(CLI::Range(0.0, 0.49))->capture_default_str();
+    sub->add_option("--mesh-size", o.mesh_size, "With --deformable-fraction: triangle size (m; default size / 2)")
+        ->check(CLI::NonNegativeNumber);
     sub->add_option("--strain-rate", o.strain_per_step, "Platen velocity over specimen height, per step")
         ->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--platens", c.platens, "rough: platen rows held horizontally; smooth: free to slide")
@@ -206,8 +212,6 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
 int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* name, bool quiet) {
     auto& o = c.o;
     o.kind = kind;
-    if (c.deformable_fraction > 0)
-        throw InputError("--deformable-fraction", 0, "", "deformable inner blocks are not available yet (issue 4); use rigid blocks");
     const std::map<std::string, meshing::PatternSpec::Kind> kinds{
         {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
         {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},

@@ -39,6 +39,10 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
     r.pattern.size = o.size;
     r.pattern.lloyd_iterations = o.lloyd;
     r.pattern.seed = o.seed;
+    if (o.deformable_fraction > 0.0) {
+        r.mesh.enabled = true;
+        r.mesh.size = o.mesh_size > 0.0 ? o.mesh_size : 0.5 * o.size;
+    }
     g.regions.push_back(r);
     return g;
 }
@@ -51,7 +55,15 @@ double specimen_height(const LabTestOptions& o) {
 
 AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     AnalysisSpec an;
-    an.materials.push_back({"rock", o.density});
+    MaterialSpec rock;
+    rock.name = "rock";
+    rock.density = o.density;
+    if (o.deformable_fraction > 0.0) {
+        rock.young = o.young;
+        rock.poisson = o.poisson;
+        rock.deformable_fraction = o.deformable_fraction;
+    }
+    an.materials.push_back(rock);
     an.joint_properties.push_back(o.joint);
     an.joint_assignments.push_back({o.joint.name, {}, {}});
     const double h = specimen_height(o), band = 0.5 * o.size, v = o.strain_per_step * h;
@@ -124,9 +136,20 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         if (c.x < o.size) left.push_back(i);
         if (c.x > o.width - o.size) right.push_back(i);
     }
+    // A deformable block moves with its nodes: the mean of its boundary nodes.
+    const auto& nodes = s.nodes();
+    auto ux_of = [&](int i) {
+        if (!b.deformable[i]) return b.centroid[i].x - b.centroid0[i].x;
+        double u = 0.0;
+        for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
+            const int nd = b.vertex_node[v];
+            u += nodes.position[nd].x - nodes.position0[nd].x;
+        }
+        return u / double(b.first[i + 1] - b.first[i]);
+    };
     auto mean_ux = [&](const std::vector<int>& ids) {
         double u = 0;
-        for (int i : ids) u += b.centroid[i].x - b.centroid0[i].x;
+        for (int i : ids) u += ux_of(i);
         return ids.empty() ? 0.0 : u / ids.size();
     };
     // Crack orientation when each crack forms (later the fragments rotate): the

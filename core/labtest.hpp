@@ -51,6 +51,13 @@ struct LabTestOptions {
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
     int threads = 1;                    ///< threads of the contact loop
+    /// Deformable blocks (SPEC §6): with 0 < f < 1 every block is meshed (triangles
+    /// of mesh_size, default size / 2) and takes the fraction f of the deformation:
+    /// blocks get young / f, joints kn / (1 − f) and ks / (1 − f). 0 = rigid blocks.
+    double deformable_fraction = 0.0;
+    double young = 20.0e9;              ///< target modulus E of the rock mass, Pa
+    double poisson = 0.2;               ///< Poisson's ratio of the blocks
+    double mesh_size = 0.0;
 
     /// The paper's Voronoi calibration run (SPEC §8).
     static LabTestOptions paper_ucs();
