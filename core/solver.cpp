@@ -555,39 +555,37 @@ void Solver::integrate() {
         for (int i : boundary_nodes_[k]) sum += n_.force[i] - n_.applied[i] - n_.real_mass[i] * settings_.gravity;
         boundary_force_[k] = sum;
     }
+    // Translation of one body (rigid block or node): damped central difference with
+    // its prescribed components held; returns the work of its loads and of the
+    // supports on the prescribed components (reaction −F) over the step.
+    auto translate = [&](std::uint8_t fx, Vec2& v, Vec2 f, Vec2 fixed_v, double mass, Vec2 load) {
+        if (!(fx & 1)) max_unbalanced = std::max(max_unbalanced, std::abs(f.x));
+        if (!(fx & 2)) max_unbalanced = std::max(max_unbalanced, std::abs(f.y));
+        v.x = (fx & 1) ? fixed_v.x : v.x + damped(f.x, v.x) / mass * dt;
+        v.y = (fx & 2) ? fixed_v.y : v.y + damped(f.y, v.y) / mass * dt;
+        double w = dot(load, v) * dt;
+        if (fx & 1) w -= f.x * v.x * dt;
+        if (fx & 2) w -= f.y * v.y * dt;
+        return w;
+    };
     double work = 0.0;
     for (int i = 0; i < b_.count(); ++i) {
         if (b_.removed[i] || b_.deformable[i]) continue;
         const std::uint8_t fx = b_.fixed[i];
         Vec2& v = b_.velocity[i];
-        const Vec2 f = b_.force[i];
-        if (!(fx & 1)) max_unbalanced = std::max(max_unbalanced, std::abs(f.x));
-        if (!(fx & 2)) max_unbalanced = std::max(max_unbalanced, std::abs(f.y));
-        v.x = (fx & 1) ? b_.fixed_velocity[i].x : v.x + damped(f.x, v.x) / b_.mass[i] * dt;
-        v.y = (fx & 2) ? b_.fixed_velocity[i].y : v.y + damped(f.y, v.y) / b_.mass[i] * dt;
+        work += translate(fx, v, b_.force[i], b_.fixed_velocity[i], b_.mass[i],
+                          b_.applied[i] + b_.real_mass[i] * settings_.gravity);
         b_.omega[i] = (fx & 4) ? b_.fixed_omega[i]
                                : b_.omega[i] + damped(b_.moment[i], b_.omega[i]) / b_.inertia[i] * dt;
-        // Work of loads, and of the supports on prescribed components (reaction −F).
-        const Vec2 load = b_.applied[i] + b_.real_mass[i] * settings_.gravity;
-        work += (dot(load, v) + b_.applied_moment[i] * b_.omega[i]) * dt;
-        if (fx & 1) work -= f.x * v.x * dt;
-        if (fx & 2) work -= f.y * v.y * dt;
-        if (fx & 4) work -= b_.moment[i] * b_.omega[i] * dt;
+        work += (b_.applied_moment[i] - ((fx & 4) ? b_.moment[i] : 0.0)) * b_.omega[i] * dt;
         b_.centroid[i] += dt * v;
         b_.theta[i] += dt * b_.omega[i];
     }
     for (int i = 0; i < n_.count(); ++i) {
         if (b_.removed[n_.block[i]]) continue;
-        const std::uint8_t fx = n_.fixed[i];
         Vec2& v = n_.velocity[i];
-        const Vec2 f = n_.force[i];
-        if (!(fx & 1)) max_unbalanced = std::max(max_unbalanced, std::abs(f.x));
-        if (!(fx & 2)) max_unbalanced = std::max(max_unbalanced, std::abs(f.y));
-        v.x = (fx & 1) ? n_.fixed_velocity[i].x : v.x + damped(f.x, v.x) / n_.mass[i] * dt;
-        v.y = (fx & 2) ? n_.fixed_velocity[i].y : v.y + damped(f.y, v.y) / n_.mass[i] * dt;
-        work += dot(n_.applied[i] + n_.real_mass[i] * settings_.gravity, v) * dt;
-        if (fx & 1) work -= f.x * v.x * dt;
-        if (fx & 2) work -= f.y * v.y * dt;
+        work += translate(n_.fixed[i], v, n_.force[i], n_.fixed_velocity[i], n_.mass[i],
+                          n_.applied[i] + n_.real_mass[i] * settings_.gravity);
         n_.position[i] += dt * v;
     }
     work_ += work;
