@@ -45,8 +45,9 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
 void check_health(const Solver& s) {
     const double tol = s.detection_tolerance(), dt = s.timestep();
     const std::string advice =
-        " Reduce solver.safety (the time step is safety x the critical step) or, for a load applied by "
-        "velocity, the velocity; check that stiffness and strength values are in SI units (Pa/m, Pa).";
+        " Reduce solver.safety (the automatic time step is safety x the critical step) or a solver.timestep "
+        "given explicitly, or, for a load applied by velocity, the velocity; check that stiffness and strength "
+        "values are in SI units (Pa/m, Pa).";
     if (!std::isfinite(s.unbalanced_ratio()) || !std::isfinite(s.kinetic_energy()))
         throw HealthError("the solution became NaN or infinite at step " + std::to_string(s.steps()) + "." + advice);
     const auto& b = s.blocks();

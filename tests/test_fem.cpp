@@ -303,3 +303,34 @@ TEST_CASE("fem: a P-wave travels down a deformable column at the P-wave speed wi
     MESSAGE("P-wave speed " << speed << " m/s, analytic " << c << " m/s, dt " << s.timestep() << " s");
     CHECK(speed == doctest::Approx(c).epsilon(0.02));
 }
+
+TEST_CASE("fem: the implicit solve names a floating block instead of returning garbage") {
+    const auto file = io::parse_model(R"(
+[[material]]
+name = "rock"
+young = 20.0e9
+[[region]]
+name = "base"
+material = "rock"
+outline = { type = "rectangle", min = [0.0, 0.0], max = [1.0, 1.0] }
+pattern = { type = "single" }
+mesh = { size = 0.25 }
+[[region]]
+name = "loose"
+material = "rock"
+outline = { type = "rectangle", min = [3.0, 0.0], max = [4.0, 1.0] }
+pattern = { type = "single" }
+[[boundary]]
+name = "fixed"
+type = "velocity"
+regions = ["base"]
+vx = 0.0
+vy = 0.0
+[[stage]]
+name = "equilibrium"
+type = "elastic"
+)", "floating.toml");
+    Solver s(meshing::generate_blocks(file.geometry), file.analysis);
+    CHECK_THROWS_WITH_AS(run(s, file.analysis.stages), doctest::Contains("region 'loose'"), std::runtime_error);
+    CHECK_THROWS_WITH_AS(s.solve_elastic(), doctest::Contains("floats"), std::runtime_error);
+}
