@@ -9,6 +9,7 @@
 #include "apps/run_model.hpp"
 #include "apps/vtk_output.hpp"
 #include "core/analysis.hpp"
+#include "core/calibrate.hpp"
 #include "core/labtest.hpp"
 #include "core/error.hpp"
 #include "meshing/blocks.hpp"
@@ -297,6 +298,93 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
     }
     return 0;
 }
+std::string fmt_number(double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.6g", v);
+    return b;
+}
+
+/// `bbm calibrate`: iterates the micro-properties and writes the joint property
+/// set as a TOML fragment, with the iteration table as JSON.
+int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iterations, const fs::path& out, bool quiet) {
+    CalibrationOptions o;
+    o.base = c.o;
+    const std::map<std::string, meshing::PatternSpec::Kind> kinds{
+        {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
+        {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
+        {"brick", meshing::PatternSpec::Kind::brick}};
+    o.base.pattern = kinds.at(c.pattern);
+    o.realizations = c.realizations;
+    o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    o.max_iterations = iterations;
+    fs::create_directories(out);
+    if (!quiet)
+        std::fprintf(stderr,
+                     "bbm calibrate: %s blocks of %.3g m, %g m x %g m, %d realizations of UCS and direct tension per "
+                     "iteration\ntargets: E %.4g GPa, nu %.3g, UCS %.4g MPa, tensile %.4g MPa\n"
+                     "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n",
+                     c.pattern.c_str(), o.base.size, o.base.width, o.base.height, o.realizations, targets.E / 1e9,
+                     targets.nu, targets.ucs / 1e6, targets.tensile / 1e6, "iter", "kn GPa/m", "ks GPa/m", "st MPa",
+                     "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
+    nlohmann::json table = nlohmann::json::array();
+    int k = 0;
+    const auto iterations_done = calibrate(targets, o, [&](const CalibrationIteration& it) {
+        ++k;
+        if (!quiet)
+            std::fprintf(stderr, "%4d %10.2f %10.2f %9.3f %9.3f | %9.2f %9.2f %7.3f %10.2f %10.3f %8.0f%s\n", k,
+                         it.joint.kn / 1e9, it.joint.ks / 1e9, it.joint.tensile / 1e6, it.joint.cohesion / 1e6,
+                         it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds, it.converged ? "  converged" : "");
+        table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
+                         {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
+                         {"nu_std", it.nu_std}, {"ucs", it.ucs}, {"ucs_std", it.ucs_std}, {"tensile_strength", it.tensile},
+                         {"tensile_strength_std", it.tensile_std}, {"seconds", it.seconds}, {"converged", it.converged}});
+    });
+    const auto& last = iterations_done.back();
+    const auto& j = last.joint;
+    // The calibrated set on seeds it has not seen: what a new model will get.
+    const auto fresh = measure_macro_properties(j, o, o.base.seed + 1000);
+    if (!quiet)
+        std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "
+                             "(std %.3f)\n",
+                     static_cast<unsigned long long>(o.base.seed + 1000), fresh.E / 1e9, fresh.E_test / 1e9, fresh.nu,
+                     fresh.ucs / 1e6, fresh.ucs_std / 1e6, fresh.tensile / 1e6, fresh.tensile_std / 1e6);
+    std::string toml = "# bbm calibrate: " + c.pattern + " blocks of " + fmt_number(o.base.size) + " m; targets E " +
+                       fmt_number(targets.E) + " Pa, nu " + fmt_number(targets.nu) + ", UCS " + fmt_number(targets.ucs) +
+                       " Pa, tensile " + fmt_number(targets.tensile) + " Pa.\n# Last iteration (mean of " +
+                       std::to_string(o.realizations) + "): E " + fmt_number(last.E) + " Pa, nu " + fmt_number(last.nu) +
+                       ", UCS " + fmt_number(last.ucs) + " Pa, tensile " + fmt_number(last.tensile) + " Pa" +
+                       (last.converged ? "" : " (NOT converged: see calibration.json)") + ".\n";
+    auto pts = [](const std::vector<std::pair<double, double>>& v) {
+        std::string s = "[";
+        for (std::size_t i = 0; i < v.size(); ++i)
+            s += (i ? ", [" : "[") + fmt_number(v[i].first) + ", " + fmt_number(v[i].second) + "]";
+        return s + "]";
+    };
+    toml += "[[joint_property]]\nname = \"calibrated\"\nlaw = \"softening\"\nkn = " + fmt_number(j.kn) +
+            "\nks = " + fmt_number(j.ks) + "\ntensile = " + fmt_number(j.tensile) + "\ncohesion = " +
+            fmt_number(j.cohesion) + "\nfriction = " + fmt_number(j.friction) +
+            "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
+    io::write_text_atomically(out / "joint_property.toml", toml);
+    io::write_text_atomically(out / "calibration.json",
+                              nlohmann::json{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
+                                                          {"tensile", targets.tensile}}},
+                                             {"pattern", c.pattern},
+                                             {"size", o.base.size},
+                                             {"realizations", o.realizations},
+                                             {"converged", last.converged},
+                                             {"fresh_seeds", {{"first_seed", o.base.seed + 1000}, {"E", fresh.E},
+                                                              {"E_ucs_curve", fresh.E_test}, {"nu", fresh.nu},
+                                                              {"ucs", fresh.ucs}, {"ucs_std", fresh.ucs_std},
+                                                              {"tensile_strength", fresh.tensile},
+                                                              {"tensile_strength_std", fresh.tensile_std}}},
+                                             {"iterations", table}}
+                                      .dump(2) + "\n");
+    if (!quiet)
+        std::fprintf(stderr, "wrote %s/joint_property.toml and calibration.json%s\n", out.string().c_str(),
+                     last.converged ? "" : " (not converged within the iteration limit)");
+    return last.converged ? 0 : 4;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -357,6 +445,22 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
 
+    LabTestCli calibrate_cli;
+    calibrate_cli.realizations = 3;
+    CalibrationTargets targets;
+    int calibrate_iterations = 6;
+    auto* calibrate_cmd = app.add_subcommand(
+        "calibrate", "Find kn, ks, tensile strength and cohesion that give target E, nu, UCS and direct tensile "
+                     "strength (means over --realizations seeds of UCS and tension tests). Prints the iterations, "
+                     "writes DIR/joint_property.toml (a [[joint_property]] for a model file) and calibration.json. "
+                     "Exit status 4 if not converged.");
+    add_labtest_options(calibrate_cmd, calibrate_cli, quiet);
+    calibrate_cmd->add_option("--target-E", targets.E, "Target Young's modulus (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    calibrate_cmd->add_option("--target-nu", targets.nu, "Target Poisson's ratio")->check(CLI::Range(0.01, 0.33))->capture_default_str();
+    calibrate_cmd->add_option("--target-ucs", targets.ucs, "Target uniaxial compressive strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    calibrate_cmd->add_option("--target-tensile", targets.tensile, "Target direct tensile strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    calibrate_cmd->add_option("--iterations", calibrate_iterations, "Iteration limit")->check(CLI::PositiveNumber)->capture_default_str();
+
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     LabTestCli ucs_cli, tension_cli, biaxial_cli, brazilian_cli;
     auto* ucs = app.add_subcommand("ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, "
@@ -392,6 +496,13 @@ int main(int argc, char** argv) {
             run_options.out = run_out;
             run_options.quiet = quiet;
             return io::run_model(run_options);
+        }
+        if (*calibrate_cmd) {
+            calibrate_cli.o.joint.tension_softening = {{calibrate_cli.tension_softening[1], calibrate_cli.tension_softening[0]},
+                                                       {calibrate_cli.tension_softening[2], 0.0}};
+            calibrate_cli.o.joint.shear_softening = {{calibrate_cli.shear_softening[1], calibrate_cli.shear_softening[0]},
+                                                     {calibrate_cli.shear_softening[2], 0.0}};
+            return run_calibrate(calibrate_cli, targets, calibrate_iterations, calibrate_cli.out, quiet);
         }
         if (*compare) return io::compare_models(compare_models, compare_out, compare_threads, quiet);
         if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);

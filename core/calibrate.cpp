@@ -1,0 +1,147 @@
+#include "core/calibrate.hpp"
+
+#include "core/solver.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+namespace bbm {
+
+namespace {
+double lattice_ratio(double nu) { return (1.0 - 3.0 * nu) / (1.0 + nu); }
+
+void mean_std(const std::vector<double>& v, double& mean, double& sd) {
+    mean = 0.0;
+    for (double x : v) mean += x;
+    mean /= double(v.size());
+    double s = 0.0;
+    for (double x : v) s += (x - mean) * (x - mean);
+    sd = v.size() > 1 ? std::sqrt(s / double(v.size() - 1)) : 0.0;
+}
+} // namespace
+
+ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOptions& base) {
+    // The specimen with elastic joints, bottom rows held, 1 MPa on the top edge;
+    // one implicit solve. Strains from the middle of the specimen, away from the ends.
+    LabTestOptions o = base;
+    o.kind = LabTestOptions::Kind::ucs;
+    const auto blocks = meshing::generate_blocks(labtest_geometry(o));
+    AnalysisSpec an = labtest_analysis(o);
+    an.joint_properties[0].law = JointPropertySpec::Law::elastic;
+    an.joint_properties[0].kn = joint.kn;
+    an.joint_properties[0].ks = joint.ks;
+    std::erase_if(an.boundaries, [](const BoundarySpec& b) { return b.name != "bottom"; });
+    BoundarySpec top;
+    top.name = "top";
+    top.kind = BoundarySpec::Kind::stress;
+    top.select.box = Box2{{-1.0, o.height * (1 - 1e-6)}, {o.width + 1.0, o.height + 1.0}};
+    top.stress.syy = -1e6;
+    an.boundaries.push_back(top);
+    Solver s(blocks, an);
+    s.solve_elastic();
+    const auto& b = s.blocks();
+    double y_lo = 0, y_hi = 0, x_left = 0, x_right = 0;
+    int n_lo = 0, n_hi = 0, n_left = 0, n_right = 0;
+    const double h = o.height, w = o.width, d = o.size;
+    for (int i = 0; i < b.count(); ++i) {
+        const Vec2 c = b.centroid0[i], u = b.centroid[i] - b.centroid0[i];
+        if (std::abs(c.y - 0.3 * h) < d) y_lo += u.y, ++n_lo;
+        if (std::abs(c.y - 0.7 * h) < d) y_hi += u.y, ++n_hi;
+        if (c.y > 0.3 * h && c.y < 0.7 * h && c.x < d) x_left += u.x, ++n_left;
+        if (c.y > 0.3 * h && c.y < 0.7 * h && c.x > w - d) x_right += u.x, ++n_right;
+    }
+    const double axial = (y_hi / n_hi - y_lo / n_lo) / (0.4 * h);
+    const double lateral = (x_right / n_right - x_left / n_left) / w;
+    return {-1e6 / axial, -lateral / axial};
+}
+
+JointPropertySpec calibration_start(const CalibrationTargets& t, const CalibrationOptions& o) {
+    JointPropertySpec j = o.base.joint;
+    const double a = 0.9523 * o.base.size, r = std::max(0.05, lattice_ratio(t.nu));
+    j.kn = t.E * (3.0 + r) / (2.0 * a * (1.0 + r));
+    j.ks = r * j.kn;
+    j.tensile = t.tensile / 0.53;
+    j.cohesion = 9.5e6 * t.ucs / 22.0e6;
+    return j;
+}
+
+CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
+                                              std::uint64_t first_seed) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const int n = o.realizations;
+    // 2n runs: UCS and direct tension for each seed, shared among the threads.
+    std::vector<LabTestResult> ucs(n), tension(n);
+    std::atomic<int> next{0};
+    auto worker = [&] {
+        for (int k = next++; k < 2 * n; k = next++) {
+            LabTestOptions lo = o.base;
+            lo.joint = joint;
+            lo.seed = first_seed + std::uint64_t(k % n);
+            lo.threads = 1;
+            if (k < n) {
+                lo.kind = LabTestOptions::Kind::ucs;
+                ucs[k] = run_labtest(lo);
+            } else {
+                lo.kind = LabTestOptions::Kind::tension;
+                lo.strain_per_step = 0.1 * o.base.strain_per_step; // its peak comes at a tenth of the strain
+                tension[k - n] = run_labtest(lo);
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < std::max(1, std::min(o.threads, 2 * n)); ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+    CalibrationIteration it;
+    it.joint = joint;
+    std::vector<double> E, nu, peak, ten;
+    for (int k = 0; k < n; ++k) {
+        E.push_back(ucs[k].E), nu.push_back(ucs[k].nu), peak.push_back(ucs[k].peak_stress);
+        ten.push_back(tension[k].peak_stress);
+    }
+    mean_std(E, it.E_test, it.E_test_std);
+    // E and ν from the elastic solve of each realization: the initial slope and
+    // the lateral strain of a cracking specimen are too noisy to steer by.
+    nu.clear(), E.clear();
+    for (int k = 0; k < n; ++k) {
+        LabTestOptions lo = o.base;
+        lo.seed = first_seed + std::uint64_t(k);
+        const auto m = elastic_measure(joint, lo);
+        E.push_back(m.E), nu.push_back(m.nu);
+    }
+    mean_std(E, it.E, it.E_std);
+    mean_std(nu, it.nu, it.nu_std);
+    mean_std(peak, it.ucs, it.ucs_std);
+    mean_std(ten, it.tensile, it.tensile_std);
+    it.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return it;
+}
+
+std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
+                                            const std::function<void(const CalibrationIteration&)>& report) {
+    std::vector<CalibrationIteration> out;
+    JointPropertySpec j = calibration_start(t, o);
+    for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
+        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed);
+        it.converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
+                       std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&
+                       std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile;
+        out.push_back(it);
+        if (report) report(it);
+        if (it.converged) break;
+        // Each unknown corrected by the measure it mainly controls.
+        const double r = j.ks / j.kn;
+        const double r_new = std::clamp(r + lattice_ratio(t.nu) - lattice_ratio(std::clamp(it.nu, -0.9, 0.33)), 0.02, 1.5);
+        // E ∝ kn (1 + r)/(3 + r) on the lattice: scale kn for the modulus and for the
+        // change of r, which moves the modulus too.
+        j.kn *= (t.E / it.E) * ((1.0 + r) / (3.0 + r)) / ((1.0 + r_new) / (3.0 + r_new));
+        j.ks = r_new * j.kn;
+        j.tensile *= t.tensile / it.tensile;
+        j.cohesion *= t.ucs / it.ucs;
+    }
+    return out;
+}
+
+} // namespace bbm

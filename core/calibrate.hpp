@@ -1,0 +1,73 @@
+// bbm core: calibration of joint micro-properties against macro targets
+// (`bbm calibrate`; paper §4.2 calls systematic calibration an open problem).
+//
+// Targets: Young's modulus E, Poisson's ratio ν, uniaxial compressive strength
+// and direct tensile strength of the rock mass, for a given block pattern and
+// size. Unknowns: kn, ks, σt, c (friction and the softening curves stay as given).
+//
+// Start (no test run): the hexagonal-lattice inversion of E and ν (the exact
+// elastic constants of a regular Voronoi assembly, docs/calibration.md):
+//   r = ks/kn = (1 − 3ν)/(1 + ν),  kn = E (3 + r) / (2 a (1 + r)),  a = 0.9523 d,
+// σt = tensile / 0.53 and c = 9.5 MPa × UCS / 22 MPa (the ratios bbm measured
+// with the paper's parameters). Then each iteration runs `realizations` UCS and
+// direct-tension tests (seeds seed, seed+1, ..., in parallel; E and ν from an
+// implicit elastic solve of each specimen, as the initial slope and lateral strain
+// of a cracking specimen are too noisy to steer kn and ks/kn by) and corrects each
+// unknown by the quantity it mainly controls:
+//   kn ← kn × E*/E,   r: shifted by the lattice value of r at ν* minus that at ν,
+//   σt ← σt × T*/T,   c ← c × UCS*/UCS,
+// stopping when all four means are within tolerance or after max_iterations.
+// The means are over realizations, so the result carries their scatter: a new
+// set of seeds reproduces the targets only to within the realization scatter
+// (reported as the standard deviation).
+#pragma once
+
+#include "core/labtest.hpp"
+
+#include <functional>
+#include <vector>
+
+namespace bbm {
+
+struct CalibrationTargets {
+    double E = 20e9, nu = 0.2, ucs = 20e6, tensile = 2.5e6;
+};
+
+struct CalibrationOptions {
+    LabTestOptions base = LabTestOptions::paper_ucs(); ///< pattern, size, specimen, friction, softening
+    int realizations = 3;
+    int threads = 2;          ///< realizations run in parallel on these
+    int max_iterations = 6;
+    double tolerance_E = 0.02, tolerance_nu = 0.05, tolerance_ucs = 0.03, tolerance_tensile = 0.05;
+};
+
+struct CalibrationIteration {
+    JointPropertySpec joint;
+    double E = 0, nu = 0, ucs = 0, tensile = 0;             ///< means over realizations
+    double E_std = 0, nu_std = 0, ucs_std = 0, tensile_std = 0;
+    double E_test = 0, E_test_std = 0; ///< E of the UCS curves (initial slope), for comparison
+    double seconds = 0;
+    bool converged = false;
+};
+
+/// The starting joint properties from the lattice inversion (see above).
+JointPropertySpec calibration_start(const CalibrationTargets& t, const CalibrationOptions& o);
+
+/// Runs the iteration; `report` (optional) sees each iteration as it ends.
+/// Returns all iterations; the last holds the calibrated set.
+std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
+                                            const std::function<void(const CalibrationIteration&)>& report = {});
+
+/// E and ν of the specimen of `base` with elastic joints (kn, ks of `joint`): one
+/// implicit solve under 1 MPa on top, strains from its middle (away from the ends).
+struct ElasticMeasure {
+    double E = 0, nu = 0;
+};
+ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOptions& base);
+
+/// Mean and sample standard deviation of the four measures for a joint set (ν
+/// from elastic_poisson_ratio, the others from the UCS and tension tests).
+CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
+                                              std::uint64_t first_seed);
+
+} // namespace bbm
