@@ -392,6 +392,11 @@ int main(int argc, char** argv) {
                  "Rigid or deformable blocks bonded by softening joints, one explicit loop.",
                  "bbm"};
     app.require_subcommand(1);
+    // Any command's options can come from a TOML file: a table per command, keys
+    // the long option names, e.g. [ucs] size = 0.3, pattern = "trigon" (docs/calibration.md).
+    app.set_config("--config", "", "Read options from a TOML file ([ucs], [tension], [calibrate], ... tables; keys "
+                                   "are the long option names)");
+    app.allow_config_extras(CLI::config_extras_mode::error);
     bool quiet = false;
     app.add_flag("-q,--quiet", quiet, "Print nothing but errors");
 
@@ -485,6 +490,12 @@ int main(int argc, char** argv) {
 
     try {
         app.parse(argc, argv);
+    } catch (const CLI::ConfigError& e) {
+        const auto* config = app.get_config_ptr();
+        std::fprintf(stderr, "bbm: error: %s: %s (keys are the long option names of the command, without '--'; "
+                             "see bbm COMMAND --help)\n",
+                     config && config->count() ? config->as<std::string>().c_str() : "--config", e.what());
+        return 2;
     } catch (const CLI::ParseError& e) {
         const int code = app.exit(e);
         return code == 0 ? 0 : 2;

@@ -23,3 +23,10 @@ execute_process(COMMAND ${BBM} mesh ${DIR}/bowtie.toml --out ${DIR}/out
 if(NOT status EQUAL 2 OR NOT err MATCHES "bowtie.toml:3: region\\[0\\]\\.outline: .*intersects itself")
   message(FATAL_ERROR "self-intersection not reported as expected (${status}): ${err}")
 endif()
+# Lab-test options from a TOML file: a misspelt key is an error naming the file and the key.
+file(WRITE ${DIR}/ucs.toml "[ucs]\nwidht = 2.0\n")
+execute_process(COMMAND ${BBM} --config ${DIR}/ucs.toml ucs --quiet --out ${DIR}/ucs_out
+                RESULT_VARIABLE status ERROR_VARIABLE err OUTPUT_VARIABLE out)
+if(NOT status EQUAL 2 OR NOT err MATCHES "ucs.toml" OR NOT err MATCHES "widht")
+  message(FATAL_ERROR "a bad key in --config should give status 2 naming file and key, got ${status}: ${err}")
+endif()
