@@ -2,9 +2,9 @@
 # vertical stress (σyy, tension positive, Pa), broken contacts drawn on top
 # coloured by mode (2 tensile, 3 shear), at the last time step, seen in 2D.
 #
-#   pvpython examples/paraview_view.py out/tunnel                 # opens the view
-#   pvpython examples/paraview_view.py out/tunnel --screenshot    # writes out/tunnel/paraview.png
-# or in the ParaView GUI: View > Python Shell > Run Script (reads out/tunnel).
+#   pvpython examples/paraview_view.py out/tunnel/tunnel_trigon   # opens the view
+#   pvpython examples/paraview_view.py DIR --screenshot           # writes DIR/paraview.png
+# or in the ParaView GUI: View > Python Shell > Run Script (reads out/tunnel/tunnel_trigon).
 import os
 import sys
 
@@ -12,7 +12,7 @@ from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetAnimationScene, 
                              SaveScreenshot, Show, Threshold)
 
 args = [a for a in sys.argv[1:] if not a.startswith('--')]
-out = args[0] if args else 'out/tunnel'
+out = args[0] if args else 'out/tunnel/tunnel_trigon'
 blocks = PVDReader(registrationName='blocks', FileName=os.path.join(out, 'blocks.pvd'))
 contacts = PVDReader(registrationName='contacts', FileName=os.path.join(out, 'contacts.pvd'))
 scene = GetAnimationScene()
