@@ -143,6 +143,13 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
                 if (dist < best_gap) best_gap = dist, best = int(e);
             }
             if (best < 0) continue;
+            if (in.junction_pairs) {
+                // Still on the corner the two blocks shared in the tessellation?
+                const Vec2 e0 = b.vertex[best], e1v = b.vertex[next_vertex(b.first, B, best)];
+                if ((norm(x - e0) <= tol || norm(x - e1v) <= tol) &&
+                    std::binary_search(in.junction_pairs->begin(), in.junction_pairs->end(), pair_key(A, B)))
+                    continue;
+            }
             auto& points = existing[pair_key(A, B)];
             bool known = false;
             for (Vec2 p : points) known = known || norm(p - x) <= tol;

@@ -39,7 +39,20 @@ struct DetectionInput {
     /// The step about to run: its contact update adds v·Δt, motion already in the
     /// measured gap, so a new contact's un starts at gap − v_rel·n Δt.
     double dt = 0.0;
+    /// Pairs of blocks that met only at a vertex of the initial tessellation
+    /// (pair keys min << 32 | max, sorted). A vertex of one still sitting on that
+    /// shared corner of the other gets no new contact: the point is interior to the
+    /// rock, and a corner-to-corner contact there (six trigon triangles meet at
+    /// each centre) would carry load no joint carries and lock the fragments once
+    /// the bonds break. Once the blocks have moved apart by more than the
+    /// tolerance, contacts between them form as between any others.
+    const std::vector<std::uint64_t>* junction_pairs = nullptr;
 };
+
+/// Key of an unordered block pair, as in DetectionInput::junction_pairs.
+inline std::uint64_t block_pair_key(int a, int b) {
+    return (std::uint64_t(std::uint32_t(a < b ? a : b)) << 32) | std::uint32_t(a < b ? b : a);
+}
 
 struct DetectionResult {
     int created = 0, removed = 0, transferred = 0;

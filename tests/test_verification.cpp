@@ -224,7 +224,8 @@ TEST_CASE("verification 8: determinism — the state hash after a cracking run i
     CHECK(a.state_hash() == b.state_hash());
     CHECK(a.cracks(contact::JointState::broken_tension) > 0);
     // Pinned for this compiler and flags (g++ 12, Release, x86-64); see the model file.
-    CHECK(a.state_hash() == 4223968763398179421ull);
+    // Re-pinned when detection stopped creating contacts on tessellation junctions.
+    CHECK(a.state_hash() == 8848124731686225044ull);
 }
 
 TEST_CASE("excavation stage: support relaxed gradually, walls move in, hoop stress concentrates") {
