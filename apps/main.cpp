@@ -210,6 +210,19 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
     io::write_text_atomically(dir / "summary.json", labtest_json(r).dump(2) + "\n");
 }
 
+/// --tension-softening / --shear-softening b1,a1,a2 -> the points (a1, b1), (a2, 0)
+/// of the joint's curves, checked.
+void apply_softening_flags(LabTestCli& c) {
+    auto curve = [](const std::vector<double>& v, const char* flag) {
+        const double b1 = v[0], a1 = v[1], a2 = v[2];
+        if (!(b1 > 0 && b1 < 1 && a1 > 1 && a2 > a1 && a2 > 0 && a1 - b1 < a2))
+            throw InputError(flag, 0, "", "needs 0 < b1 < 1, 1 < a1 < a2 (points (a1, b1), (a2, 0) after the peak)");
+        return std::vector<std::pair<double, double>>{{a1, b1}, {a2, 0.0}};
+    };
+    c.o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
+    c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
+}
+
 int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* name, bool quiet) {
     auto& o = c.o;
     o.kind = kind;
@@ -218,14 +231,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
         {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
         {"brick", meshing::PatternSpec::Kind::brick}};
     o.pattern = kinds.at(c.pattern);
-    auto curve = [](const std::vector<double>& v, const char* flag) {
-        const double b1 = v[0], a1 = v[1], a2 = v[2];
-        if (!(b1 > 0 && b1 < 1 && a1 > 1 && a2 > a1 && a2 > 0 && a1 - b1 < a2))
-            throw InputError(flag, 0, "", "needs 0 < b1 < 1, 1 < a1 < a2 (points (a1, b1), (a2, 0) after the peak)");
-        return std::vector<std::pair<double, double>>{{a1, b1}, {a2, 0.0}};
-    };
-    o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
-    o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
+    apply_softening_flags(c);
     o.rough_platens = c.platens == "rough";
     const fs::path out = c.out;
     fs::create_directories(out);
@@ -509,10 +515,7 @@ int main(int argc, char** argv) {
             return io::run_model(run_options);
         }
         if (*calibrate_cmd) {
-            calibrate_cli.o.joint.tension_softening = {{calibrate_cli.tension_softening[1], calibrate_cli.tension_softening[0]},
-                                                       {calibrate_cli.tension_softening[2], 0.0}};
-            calibrate_cli.o.joint.shear_softening = {{calibrate_cli.shear_softening[1], calibrate_cli.shear_softening[0]},
-                                                     {calibrate_cli.shear_softening[2], 0.0}};
+            apply_softening_flags(calibrate_cli);
             return run_calibrate(calibrate_cli, targets, calibrate_iterations, calibrate_cli.out, quiet);
         }
         if (*compare) return io::compare_models(compare_models, compare_out, compare_threads, quiet);

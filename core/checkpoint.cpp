@@ -66,25 +66,28 @@ std::uint64_t Solver::model_fingerprint() const {
     return h;
 }
 
+/// Every evolving array and scalar, in checkpoint order: save and load walk the
+/// same list, so they cannot drift apart.
+template <class Self, class Visit>
+void Solver::visit_state(Self& s, Visit&& v) {
+    v(s.b_.centroid), v(s.b_.velocity), v(s.b_.theta), v(s.b_.omega);
+    v(s.b_.mass), v(s.b_.inertia), v(s.b_.removed), v(s.b_.inv_edge_length);
+    v(s.n_.position), v(s.n_.velocity), v(s.n_.mass);
+    v(s.z_.stress), v(s.z_.strain);
+    v(s.c_.vertex_block), v(s.c_.vertex_id), v(s.c_.edge_block), v(s.c_.edge_id), v(s.c_.edge_end);
+    v(s.c_.length), v(s.c_.property), v(s.c_.history), v(s.c_.normal);
+    v(s.relaxing_), v(s.relax_total_), v(s.relax_left_);
+    v(s.dt_), v(s.time_), v(s.ratio_), v(s.work_), v(s.steps_);
+    v(s.contact_force_sum_), v(s.zone_force_sum_), v(s.boundary_force_);
+    v(s.detected_at_), v(s.detected_theta_), v(s.detected_vertex_), v(s.active_);
+    v(s.detection_totals_);
+}
+
 void Solver::save_state(std::ostream& o) const {
     put(o, magic);
     put(o, std::int64_t(b_.count())), put(o, std::int64_t(n_.count())), put(o, std::int64_t(z_.size()));
     put(o, model_fingerprint());
-    // Blocks.
-    put(o, b_.centroid), put(o, b_.velocity), put(o, b_.theta), put(o, b_.omega);
-    put(o, b_.mass), put(o, b_.inertia), put(o, b_.removed), put(o, b_.inv_edge_length);
-    // Nodes and zones.
-    put(o, n_.position), put(o, n_.velocity), put(o, n_.mass);
-    put(o, z_.stress), put(o, z_.strain);
-    // Contacts.
-    put(o, c_.vertex_block), put(o, c_.vertex_id), put(o, c_.edge_block), put(o, c_.edge_id), put(o, c_.edge_end);
-    put(o, c_.length), put(o, c_.property), put(o, c_.history), put(o, c_.normal);
-    // Loop bookkeeping.
-    put(o, relaxing_), put(o, relax_total_), put(o, relax_left_);
-    put(o, dt_), put(o, time_), put(o, ratio_), put(o, work_), put(o, steps_);
-    put(o, contact_force_sum_), put(o, zone_force_sum_), put(o, boundary_force_);
-    put(o, detected_at_), put(o, detected_theta_), put(o, detected_vertex_), put(o, active_);
-    put(o, detection_totals_);
+    visit_state(*this, [&](const auto& x) { put(o, x); });
     put(o, state_hash());
     if (!o) throw std::runtime_error("cannot write the checkpoint");
 }
@@ -105,17 +108,7 @@ void Solver::load_state(std::istream& i) {
     if (fingerprint != model_fingerprint())
         throw std::runtime_error("checkpoint is of a different model (same counts, but the geometry, materials, "
                                  "joint properties or boundaries differ: was the model file edited?)");
-    get(i, b_.centroid), get(i, b_.velocity), get(i, b_.theta), get(i, b_.omega);
-    get(i, b_.mass), get(i, b_.inertia), get(i, b_.removed), get(i, b_.inv_edge_length);
-    get(i, n_.position), get(i, n_.velocity), get(i, n_.mass);
-    get(i, z_.stress), get(i, z_.strain);
-    get(i, c_.vertex_block), get(i, c_.vertex_id), get(i, c_.edge_block), get(i, c_.edge_id), get(i, c_.edge_end);
-    get(i, c_.length), get(i, c_.property), get(i, c_.history), get(i, c_.normal);
-    get(i, relaxing_), get(i, relax_total_), get(i, relax_left_);
-    get(i, dt_), get(i, time_), get(i, ratio_), get(i, work_), get(i, steps_);
-    get(i, contact_force_sum_), get(i, zone_force_sum_), get(i, boundary_force_);
-    get(i, detected_at_), get(i, detected_theta_), get(i, detected_vertex_), get(i, active_);
-    get(i, detection_totals_);
+    visit_state(*this, [&](auto& x) { get(i, x); });
     std::uint64_t hash = 0;
     get(i, hash);
     c_.rebuild_batches(int(laws_.size()), b_.deformable.data());

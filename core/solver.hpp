@@ -159,6 +159,8 @@ private:
     void add_external_forces();
     void release_relaxation();
     double force_scale() const;
+    template <class Self, class Visit>
+    static void visit_state(Self& self, Visit&& visit); ///< core/checkpoint.cpp
     void integrate();
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
