@@ -160,9 +160,12 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--strain-rate", o.strain_per_step, "Platen velocity over specimen height, per step")
         ->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--platens", c.platens, "rough: platen rows held horizontally; smooth: free to slide")
+    sub->add_option("--platens", c.platens, "rough: the face blocks are held horizontally; smooth: free to slide")
         ->check(CLI::IsMember({"rough", "smooth"}))->capture_default_str();
     sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
+        ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    sub->add_option("--failure-drop", o.failure_drop,
+                    "A drop by this fraction from the peak marks failure; the run stops if the stress then climbs back above the peak")
         ->check(CLI::Range(0.0, 1.0))->capture_default_str();
     sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
@@ -178,6 +181,7 @@ nlohmann::json labtest_json(const LabTestResult& r) {
     return {{"E", r.E}, {"nu", r.nu}, {"peak_stress", r.peak_stress}, {"strain_at_peak", r.strain_at_peak},
             {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
             {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
+            {"post_peak_locking", r.post_peak_locking},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
                                    {"within_30_of_vertical", r.cracks_near_vertical},
@@ -273,6 +277,10 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                 std::fprintf(stderr, "\r  seed %llu: E %.2f GPa  nu %.3f  peak %.2f MPa at strain %.3e  cracks %d T %d S  %ld steps  %.1f s\n",
                              static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.nu, r.peak_stress / 1e6,
                              r.strain_at_peak, r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
+                if (r.post_peak_locking)
+                    std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
+                                         "jammed between the platens): stopped there; peak is the strength before failure\n",
+                                 static_cast<unsigned long long>(ok.seed));
             }
         }
     };
@@ -312,9 +320,15 @@ std::string fmt_number(double v) {
 
 /// `bbm calibrate`: iterates the micro-properties and writes the joint property
 /// set as a TOML fragment, with the iteration table as JSON.
-int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iterations, const fs::path& out, bool quiet) {
+int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iterations, const fs::path& out, bool quiet,
+                  const CLI::App& cmd) {
     CalibrationOptions o;
     o.base = c.o;
+    // Joint values given on the command line (or in --config) are the starting point.
+    o.start_kn = cmd.count("--kn") > 0;
+    o.start_ks = cmd.count("--ks") > 0;
+    o.start_tensile = cmd.count("--tensile") > 0;
+    o.start_cohesion = cmd.count("--cohesion") > 0;
     const std::map<std::string, meshing::PatternSpec::Kind> kinds{
         {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
         {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
@@ -516,7 +530,7 @@ int main(int argc, char** argv) {
         }
         if (*calibrate_cmd) {
             apply_softening_flags(calibrate_cli);
-            return run_calibrate(calibrate_cli, targets, calibrate_iterations, calibrate_cli.out, quiet);
+            return run_calibrate(calibrate_cli, targets, calibrate_iterations, calibrate_cli.out, quiet, *calibrate_cmd);
         }
         if (*compare) return io::compare_models(compare_models, compare_out, compare_threads, quiet);
         if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);

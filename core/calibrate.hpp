@@ -8,8 +8,9 @@
 // Start (no test run): the hexagonal-lattice inversion of E and ν (the exact
 // elastic constants of a regular Voronoi assembly, docs/calibration.md):
 //   r = ks/kn = (1 − 3ν)/(1 + ν),  kn = E (3 + r) / (2 a (1 + r)),  a = 0.9523 d,
-// σt = tensile / 0.53 and c = 9.5 MPa × UCS / 22 MPa (the ratios bbm measured
-// with the paper's parameters). Then each iteration runs `realizations` UCS and
+// σt = tensile / 0.72 and c = 9.5 MPa × UCS / 27.6 MPa (the ratios bbm measures
+// with the paper's parameters), unless the user gave kn, ks, σt or c: those start
+// from the given values. Then each iteration runs `realizations` UCS and
 // direct-tension tests (seeds seed, seed+1, ..., in parallel; E and ν from an
 // implicit elastic solve of each specimen, as the initial slope and lateral strain
 // of a cracking specimen are too noisy to steer kn and ks/kn by) and corrects each
@@ -39,6 +40,9 @@ struct CalibrationOptions {
     int threads = 2;          ///< realizations run in parallel on these
     int max_iterations = 6;
     double tolerance_E = 0.02, tolerance_nu = 0.05, tolerance_ucs = 0.03, tolerance_tensile = 0.05;
+    /// Starting values the user gave (kn, ks, tensile, cohesion of base.joint);
+    /// the others start from the lattice inversion.
+    bool start_kn = false, start_ks = false, start_tensile = false, start_cohesion = false;
 };
 
 struct CalibrationIteration {

@@ -2,12 +2,12 @@
 // SPEC §8): uniaxial compression, direct tension, biaxial compression and the
 // Brazilian test on a bonded-block specimen.
 //
-// Loading (documented choice): the platens are the rows of specimen blocks whose
-// centroids lie within half a block size of the loaded faces; their velocities are
-// prescribed (the top row moves, the bottom row is held). With `platen_friction`
-// ("rough", the default) their horizontal velocity is held at zero too, like a
-// platen bonded to the specimen; with "smooth" it is free, and only the bottom
-// row's middle block is held horizontally against drift. Confinement (biaxial) is
+// Loading (documented choice): the platens are the specimen blocks with an edge on
+// a loaded face (a disc: the blocks within half a block size of its poles); their
+// velocities are prescribed (the top ones move, the bottom ones are held, no
+// rotation). With `rough_platens` (the default) their horizontal velocity is held at
+// zero too, like a platen bonded to the specimen; otherwise it is free, and only
+// the bottom face's middle blocks are held horizontally against drift. Confinement (biaxial) is
 // a constant stress on the side faces. Quasi-static mode, Δt = 1, mass scaling
 // and local damping 0.8, so the platen velocity is a displacement per step.
 //
@@ -21,7 +21,8 @@
 //   ν  = −(least-squares slope of lateral against axial strain) over the same points
 // Brazilian: indirect tensile strength σt = 2P / (π D), P the peak line load.
 // The run stops when the stress has dropped below `stop_fraction` of the peak
-// after it, or at `max_strain`.
+// after it, when it climbs back above the peak after a failure drop (see
+// `failure_drop`), or at `max_strain`.
 #pragma once
 
 #include "core/model_spec.hpp"
@@ -47,6 +48,9 @@ struct LabTestOptions {
     double strain_per_step = 5e-8;      ///< platen velocity over height, per step
     bool rough_platens = true;
     double stop_fraction = 0.5;         ///< stop after the peak below this fraction of it
+    /// A drop by this fraction from the peak marks failure: the peak is then the
+    /// strength, and the run stops if the stress climbs back above it.
+    double failure_drop = 0.1;
     double max_strain = 0.01;
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
@@ -81,6 +85,9 @@ struct LabTestResult {
     std::array<int, 12> crack_orientation{};
     int cracks_near_vertical = 0, cracks_near_horizontal = 0; ///< within 30° of each
     bool peak_passed = false;
+    /// After failure the stress climbed back above the peak (a jammed rubble core):
+    /// the run stopped there and peak_stress is the peak before failure.
+    bool post_peak_locking = false;
     std::vector<StressStrainPoint> curve;
 };
 
