@@ -162,6 +162,10 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
         ->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--platens", c.platens, "rough: the face blocks are held horizontally; smooth: free to slide")
         ->check(CLI::IsMember({"rough", "smooth"}))->capture_default_str();
+    sub->add_option("--platen-friction", o.platen_friction,
+                    "Rigid platen blocks pressing on the faces through contacts of this friction angle (degrees), "
+                    "instead of prescribed face blocks (--platens); ucs and biaxial")
+        ->check(CLI::Range(0.0, 89.9));
     sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
         ->check(CLI::Range(0.0, 1.0))->capture_default_str();
     sub->add_option("--failure-drop", o.failure_drop,
@@ -237,6 +241,10 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
     o.pattern = kinds.at(c.pattern);
     apply_softening_flags(c);
     o.rough_platens = c.platens == "rough";
+    if (o.platen_friction >= 0.0 && (kind == LabTestOptions::Kind::tension || kind == LabTestOptions::Kind::brazilian))
+        throw InputError("--platen-friction", 0, "",
+                         std::string("applies to ucs and biaxial only: ") + name +
+                             " needs platens that hold the specimen (use --platens rough or smooth)");
     const fs::path out = c.out;
     fs::create_directories(out);
     const int n = c.realizations;

@@ -28,6 +28,7 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
     // one implicit solve. Strains from the middle of the specimen, away from the ends.
     LabTestOptions o = base;
     o.kind = LabTestOptions::Kind::ucs;
+    o.platen_friction = -1.0; // the bottom face held directly: no unbonded platen contacts to float on
     const auto blocks = meshing::generate_blocks(labtest_geometry(o));
     AnalysisSpec an = labtest_analysis(o);
     an.joint_properties[0].law = JointPropertySpec::Law::elastic;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 namespace bbm {
 
@@ -20,6 +21,10 @@ LabTestOptions LabTestOptions::paper_ucs() {
     o.joint.tension_softening = {{1.7, 0.5}, {4.0, 0.0}};
     o.joint.shear_softening = {{1.3, 0.5}, {2.1, 0.0}};
     return o;
+}
+
+bool uses_platen_blocks(const LabTestOptions& o) {
+    return o.platen_friction >= 0.0 && (o.kind == LabTestOptions::Kind::ucs || o.kind == LabTestOptions::Kind::biaxial);
 }
 
 meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
@@ -44,6 +49,18 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
         r.mesh.size = o.mesh_size > 0.0 ? o.mesh_size : 0.5 * o.size;
     }
     g.regions.push_back(r);
+    if (uses_platen_blocks(o)) {
+        // One block each, a block size thick, sharing the specimen's faces.
+        for (const auto& [name, y0, y1] : {std::tuple{"platen_bottom", -o.size, 0.0},
+                                           std::tuple{"platen_top", o.height, o.height + o.size}}) {
+            meshing::RegionSpec p;
+            p.name = name;
+            p.outline.min = {0.0, y0};
+            p.outline.max = {o.width, y1};
+            p.pattern.kind = meshing::PatternSpec::Kind::single;
+            g.regions.push_back(p);
+        }
+    }
     return g;
 }
 
@@ -65,7 +82,19 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     }
     an.materials.push_back(rock);
     an.joint_properties.push_back(o.joint);
-    an.joint_assignments.push_back({o.joint.name, {}, {}});
+    const bool platen_blocks = uses_platen_blocks(o);
+    if (platen_blocks) {
+        JointPropertySpec platen;
+        platen.name = "platen";
+        platen.law = JointPropertySpec::Law::coulomb;
+        platen.kn = o.joint.kn;
+        platen.ks = o.joint.ks;
+        platen.friction = o.platen_friction;
+        an.joint_properties.push_back(platen);
+        an.joint_assignments.push_back({platen.name, {}, {}});
+    }
+    // The bond between specimen blocks (a later rule wins over the platen one).
+    an.joint_assignments.push_back({o.joint.name, {}, {"specimen"}});
     const double h = specimen_height(o), band = 0.5 * o.size, v = o.strain_per_step * h;
     const double big = 10.0 * (o.width + h);
     // Rectangular specimens: every block with an edge on the loaded face moves with
@@ -86,7 +115,12 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     top.name = "top";
     top.select.box = Box2{{-big, disc ? h - band : h - face}, {big, big}};
     top.vy = o.kind == LabTestOptions::Kind::tension ? v : -v;
-    if (o.rough_platens) {
+    if (platen_blocks) {
+        bottom.select = {{"platen_bottom"}, std::nullopt, false};
+        top.select = {{"platen_top"}, std::nullopt, false};
+        bottom.vx = top.vx = 0.0;
+        an.boundaries = {bottom, top};
+    } else if (o.rough_platens) {
         bottom.vx = top.vx = 0.0;
         an.boundaries = {bottom, top};
     } else {

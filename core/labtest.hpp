@@ -7,7 +7,9 @@
 // velocities are prescribed (the top ones move, the bottom ones are held, no
 // rotation). With `rough_platens` (the default) their horizontal velocity is held at
 // zero too, like a platen bonded to the specimen; otherwise it is free, and only
-// the bottom face's middle blocks are held horizontally against drift. Confinement (biaxial) is
+// the bottom face's middle blocks are held horizontally against drift. With
+// `platen_friction` ≥ 0 the platens are separate rigid blocks instead, pressing on
+// the faces through frictional contacts (finite friction between the two). Confinement (biaxial) is
 // a constant stress on the side faces. Quasi-static mode, Δt = 1, mass scaling
 // and local damping 0.8, so the platen velocity is a displacement per step.
 //
@@ -47,6 +49,11 @@ struct LabTestOptions {
     double confinement = 0.0;           ///< biaxial: lateral stress, Pa (positive = compression)
     double strain_per_step = 5e-8;      ///< platen velocity over height, per step
     bool rough_platens = true;
+    /// ≥ 0: instead of prescribing the face blocks, rigid platen blocks (one block
+    /// size thick, as wide as the specimen) press on the faces through Coulomb
+    /// contacts of this friction angle (degrees; kn, ks of the bond). Compression
+    /// and biaxial tests only. < 0: the face blocks are the platens (rough_platens).
+    double platen_friction = -1.0;
     double stop_fraction = 0.5;         ///< stop after the peak below this fraction of it
     /// A drop by this fraction from the peak marks failure: the peak is then the
     /// strength, and the run stops if the stress climbs back above it.
@@ -90,6 +97,9 @@ struct LabTestResult {
     bool post_peak_locking = false;
     std::vector<StressStrainPoint> curve;
 };
+
+/// Whether the test has separate platen blocks (platen_friction ≥ 0, compression).
+bool uses_platen_blocks(const LabTestOptions& o);
 
 /// Geometry and analysis of a lab test (also what `bbm ucs --write-model` saves).
 meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o);
