@@ -171,6 +171,9 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--failure-drop", o.failure_drop,
                     "A drop by this fraction from the peak marks failure; the run stops if the stress then climbs back above the peak")
         ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    sub->add_option("--frame-every", o.frame_every,
+                    "Steps between frames of the failure series in result.pvd (0: the final state only)")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
     sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
         ->check(CLI::PositiveNumber)->capture_default_str();
@@ -192,7 +195,21 @@ nlohmann::json labtest_json(const LabTestResult& r) {
                                    {"within_30_of_horizontal", r.cracks_near_horizontal}}}};
 }
 
-void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path& dir, const std::string& title) {
+/// The failure series: one frame of blocks and contacts every `frame_every` steps,
+/// named by step; `frames` collects them for result.pvd.
+void write_labtest_frame(const Solver& s, const fs::path& dir, std::vector<std::pair<double, std::string>>& frames) {
+    fs::create_directories(dir / "vtk");
+    char name[64];
+    std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
+    io::write_state_blocks_vtu(s, dir / name);
+    frames.push_back({double(s.steps()), name});
+    std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
+    io::write_state_contacts_vtu(s, dir / name);
+    frames.push_back({double(s.steps()), name});
+}
+
+void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path& dir, const std::string& title,
+                         std::vector<std::pair<double, std::string>> frames) {
     fs::create_directories(dir / "vtk");
     std::ostringstream csv;
     csv << "step,axial_strain,axial_stress_Pa,lateral_strain,cracks_tensile,cracks_shear\n";
@@ -214,7 +231,10 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
     io::draw_failure(s, dir / "failure.svg", fo);
     io::write_state_blocks_vtu(s, dir / "vtk/blocks_final.vtu");
     io::write_state_contacts_vtu(s, dir / "vtk/contacts_final.vtu");
-    io::write_pvd(dir / "result.pvd", {{double(r.steps), "vtk/blocks_final.vtu"}, {double(r.steps), "vtk/contacts_final.vtu"}});
+    if (!frames.empty() && frames.back().first == double(r.steps)) frames.resize(frames.size() - 2);
+    frames.push_back({double(r.steps), "vtk/blocks_final.vtu"});
+    frames.push_back({double(r.steps), "vtk/contacts_final.vtu"});
+    io::write_pvd(dir / "result.pvd", frames);
     io::write_text_atomically(dir / "summary.json", labtest_json(r).dump(2) + "\n");
 }
 
@@ -274,11 +294,15 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                 std::fprintf(stderr, "\r  step %8ld  strain %.3e  stress %7.2f MPa  cracks %5d T %5d S   ", p.step,
                              p.axial_strain, p.axial_stress / 1e6, p.cracks_tensile, p.cracks_shear);
             };
-            const LabTestResult r = run_labtest(ok, progress, [&](const Solver& s, const LabTestResult& res) {
-                char title[64];
-                std::snprintf(title, sizeof title, "%s, seed %llu", name, static_cast<unsigned long long>(ok.seed));
-                write_labtest_files(res, s, dir, title);
-            });
+            std::vector<std::pair<double, std::string>> frames;
+            const LabTestResult r = run_labtest(
+                ok, progress,
+                [&](const Solver& s, const LabTestResult& res) {
+                    char title[64];
+                    std::snprintf(title, sizeof title, "%s, seed %llu", name, static_cast<unsigned long long>(ok.seed));
+                    write_labtest_files(res, s, dir, title, frames);
+                },
+                [&](const Solver& s, const StressStrainPoint&) { write_labtest_frame(s, dir, frames); });
             results[k] = r;
             if (!quiet) {
                 std::lock_guard lock(print);
@@ -330,6 +354,14 @@ std::string fmt_number(double v) {
 /// set as a TOML fragment, with the iteration table as JSON.
 int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iterations, const fs::path& out, bool quiet,
                   const CLI::App& cmd) {
+    if ((targets.biaxial > 0.0) != (targets.confinement > 0.0))
+        throw InputError(targets.biaxial > 0.0 ? "--target-biaxial" : "--target-confinement", 0, "",
+                         "--target-biaxial and --target-confinement go together (the strength and the lateral stress "
+                         "of one biaxial test)");
+    if (targets.biaxial > 0.0 && targets.biaxial <= targets.ucs)
+        throw InputError("--target-biaxial", 0, "",
+                         "a confined strength must exceed the UCS target (" + fmt_number(targets.ucs) + " Pa); got " +
+                             fmt_number(targets.biaxial) + " Pa");
     CalibrationOptions o;
     o.base = c.o;
     // Joint values given on the command line (or in --config) are the starting point.
@@ -354,33 +386,51 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
                      c.pattern.c_str(), o.base.size, o.base.width, o.base.height, o.realizations, targets.E / 1e9,
                      targets.nu, targets.ucs / 1e6, targets.tensile / 1e6, "iter", "kn GPa/m", "ks GPa/m", "st MPa",
                      "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
+    const bool with_phi = targets.biaxial > 0.0;
+    if (!quiet && with_phi)
+        std::fprintf(stderr, "and biaxial strength %.4g MPa at %.4g MPa confinement: friction angle calibrated too "
+                             "(phi and sigma1 at the end of each row)\n",
+                     targets.biaxial / 1e6, targets.confinement / 1e6);
     nlohmann::json table = nlohmann::json::array();
     int k = 0;
     const auto iterations_done = calibrate(targets, o, [&](const CalibrationIteration& it) {
         ++k;
-        if (!quiet)
-            std::fprintf(stderr, "%4d %10.2f %10.2f %9.3f %9.3f | %9.2f %9.2f %7.3f %10.2f %10.3f %8.0f%s\n", k,
+        if (!quiet) {
+            std::fprintf(stderr, "%4d %10.2f %10.2f %9.3f %9.3f | %9.2f %9.2f %7.3f %10.2f %10.3f %8.0f", k,
                          it.joint.kn / 1e9, it.joint.ks / 1e9, it.joint.tensile / 1e6, it.joint.cohesion / 1e6,
-                         it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds, it.converged ? "  converged" : "");
+                         it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds);
+            if (with_phi) std::fprintf(stderr, "   phi %5.2f  sigma1 %7.2f MPa", it.joint.friction, it.biaxial / 1e6);
+            std::fprintf(stderr, "%s\n", it.converged ? "  converged" : "");
+        }
         table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
                          {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
                          {"nu_std", it.nu_std}, {"ucs", it.ucs}, {"ucs_std", it.ucs_std}, {"tensile_strength", it.tensile},
-                         {"tensile_strength_std", it.tensile_std}, {"seconds", it.seconds}, {"converged", it.converged}});
+                         {"tensile_strength_std", it.tensile_std}, {"friction", it.joint.friction},
+                         {"biaxial_strength", it.biaxial}, {"biaxial_strength_std", it.biaxial_std},
+                         {"seconds", it.seconds}, {"converged", it.converged}});
     });
     const auto& last = iterations_done.back();
     const auto& j = last.joint;
     // The calibrated set on seeds it has not seen: what a new model will get.
-    const auto fresh = measure_macro_properties(j, o, o.base.seed + 1000);
-    if (!quiet)
+    const auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, with_phi ? targets.confinement : 0.0);
+    if (!quiet) {
         std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "
-                             "(std %.3f)\n",
+                             "(std %.3f)",
                      static_cast<unsigned long long>(o.base.seed + 1000), fresh.E / 1e9, fresh.E_test / 1e9, fresh.nu,
                      fresh.ucs / 1e6, fresh.ucs_std / 1e6, fresh.tensile / 1e6, fresh.tensile_std / 1e6);
+        if (with_phi) std::fprintf(stderr, ", sigma1 %.2f MPa (std %.2f)", fresh.biaxial / 1e6, fresh.biaxial_std / 1e6);
+        std::fprintf(stderr, "\n");
+    }
     std::string toml = "# bbm calibrate: " + c.pattern + " blocks of " + fmt_number(o.base.size) + " m; targets E " +
                        fmt_number(targets.E) + " Pa, nu " + fmt_number(targets.nu) + ", UCS " + fmt_number(targets.ucs) +
-                       " Pa, tensile " + fmt_number(targets.tensile) + " Pa.\n# Last iteration (mean of " +
+                       " Pa, tensile " + fmt_number(targets.tensile) + " Pa" +
+                       (with_phi ? ", biaxial " + fmt_number(targets.biaxial) + " Pa at " + fmt_number(targets.confinement) +
+                                       " Pa"
+                                 : std::string()) +
+                       ".\n# Last iteration (mean of " +
                        std::to_string(o.realizations) + "): E " + fmt_number(last.E) + " Pa, nu " + fmt_number(last.nu) +
                        ", UCS " + fmt_number(last.ucs) + " Pa, tensile " + fmt_number(last.tensile) + " Pa" +
+                       (with_phi ? ", biaxial " + fmt_number(last.biaxial) + " Pa" : std::string()) +
                        (last.converged ? "" : " (NOT converged: see calibration.json)") + ".\n";
     auto pts = [](const std::vector<std::pair<double, double>>& v) {
         std::string s = "[";
@@ -395,7 +445,8 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
     io::write_text_atomically(out / "joint_property.toml", toml);
     io::write_text_atomically(out / "calibration.json",
                               nlohmann::json{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
-                                                          {"tensile", targets.tensile}}},
+                                                          {"tensile", targets.tensile}, {"biaxial", targets.biaxial},
+                                                          {"confinement", targets.confinement}}},
                                              {"pattern", c.pattern},
                                              {"size", o.base.size},
                                              {"realizations", o.realizations},
@@ -404,7 +455,9 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
                                                               {"E_ucs_curve", fresh.E_test}, {"nu", fresh.nu},
                                                               {"ucs", fresh.ucs}, {"ucs_std", fresh.ucs_std},
                                                               {"tensile_strength", fresh.tensile},
-                                                              {"tensile_strength_std", fresh.tensile_std}}},
+                                                              {"tensile_strength_std", fresh.tensile_std},
+                                                              {"biaxial_strength", fresh.biaxial},
+                                                              {"biaxial_strength_std", fresh.biaxial_std}}},
                                              {"iterations", table}}
                                       .dump(2) + "\n");
     if (!quiet)
@@ -484,7 +537,8 @@ int main(int argc, char** argv) {
     int calibrate_iterations = 6;
     auto* calibrate_cmd = app.add_subcommand(
         "calibrate", "Find kn, ks, tensile strength and cohesion that give target E, nu, UCS and direct tensile "
-                     "strength (means over --realizations seeds of UCS and tension tests). Prints the iterations, "
+                     "strength (means over --realizations seeds of UCS and tension tests), and the friction angle "
+                     "too given a biaxial strength (--target-biaxial, --target-confinement). Prints the iterations, "
                      "writes DIR/joint_property.toml (a [[joint_property]] for a model file) and calibration.json. "
                      "Exit status 4 if not converged.");
     add_labtest_options(calibrate_cmd, calibrate_cli, quiet);
@@ -492,6 +546,13 @@ int main(int argc, char** argv) {
     calibrate_cmd->add_option("--target-nu", targets.nu, "Target Poisson's ratio")->check(CLI::Range(0.01, 0.33))->capture_default_str();
     calibrate_cmd->add_option("--target-ucs", targets.ucs, "Target uniaxial compressive strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
     calibrate_cmd->add_option("--target-tensile", targets.tensile, "Target direct tensile strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    calibrate_cmd->add_option("--target-biaxial", targets.biaxial,
+                              "Optional: target strength sigma1 of a biaxial test at --target-confinement (Pa); "
+                              "calibrates the friction angle too")
+        ->check(CLI::PositiveNumber);
+    calibrate_cmd->add_option("--target-confinement", targets.confinement,
+                              "Lateral stress of the --target-biaxial test (Pa, compression positive)")
+        ->check(CLI::PositiveNumber);
     calibrate_cmd->add_option("--iterations", calibrate_iterations, "Iteration limit")->check(CLI::PositiveNumber)->capture_default_str();
 
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <thread>
 
 namespace bbm {
@@ -72,14 +73,15 @@ JointPropertySpec calibration_start(const CalibrationTargets& t, const Calibrati
 }
 
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed) {
+                                              std::uint64_t first_seed, double confinement) {
     const auto t0 = std::chrono::steady_clock::now();
     const int n = o.realizations;
-    // 2n runs: UCS and direct tension for each seed, shared among the threads.
-    std::vector<LabTestResult> ucs(n), tension(n);
+    // UCS, direct tension (and biaxial) runs for each seed, shared among the threads.
+    const int kinds = confinement > 0.0 ? 3 : 2;
+    std::vector<LabTestResult> ucs(n), tension(n), biaxial(n);
     std::atomic<int> next{0};
     auto worker = [&] {
-        for (int k = next++; k < 2 * n; k = next++) {
+        for (int k = next++; k < kinds * n; k = next++) {
             LabTestOptions lo = o.base;
             lo.joint = joint;
             lo.seed = first_seed + std::uint64_t(k % n);
@@ -87,15 +89,20 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
             if (k < n) {
                 lo.kind = LabTestOptions::Kind::ucs;
                 ucs[k] = run_labtest(lo);
-            } else {
+            } else if (k < 2 * n) {
                 lo.kind = LabTestOptions::Kind::tension;
                 lo.strain_per_step = 0.1 * o.base.strain_per_step; // its peak comes at a tenth of the strain
+                lo.platen_friction = -1.0;                           // tension needs platens that hold
                 tension[k - n] = run_labtest(lo);
+            } else {
+                lo.kind = LabTestOptions::Kind::biaxial;
+                lo.confinement = confinement;
+                biaxial[k - 2 * n] = run_labtest(lo);
             }
         }
     };
     std::vector<std::thread> pool;
-    for (int t = 0; t < std::max(1, std::min(o.threads, 2 * n)); ++t) pool.emplace_back(worker);
+    for (int t = 0; t < std::max(1, std::min(o.threads, kinds * n)); ++t) pool.emplace_back(worker);
     for (auto& t : pool) t.join();
     CalibrationIteration it;
     it.joint = joint;
@@ -118,6 +125,11 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     mean_std(nu, it.nu, it.nu_std);
     mean_std(peak, it.ucs, it.ucs_std);
     mean_std(ten, it.tensile, it.tensile_std);
+    if (confinement > 0.0) {
+        std::vector<double> s1;
+        for (const auto& r : biaxial) s1.push_back(r.peak_stress);
+        mean_std(s1, it.biaxial, it.biaxial_std);
+    }
     it.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return it;
 }
@@ -126,11 +138,16 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
                                             const std::function<void(const CalibrationIteration&)>& report) {
     std::vector<CalibrationIteration> out;
     JointPropertySpec j = calibration_start(t, o);
+    const bool with_phi = t.biaxial > 0.0 && t.confinement > 0.0;
+    // Slope of the strength envelope, σ1 = UCS + k σ3 (k = tan²(45° + φ/2) for Coulomb).
+    const double k_target = with_phi ? (t.biaxial - t.ucs) / t.confinement : 0.0;
+    double prev_tan = 0.0, prev_k = 0.0;
     for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
-        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed);
+        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, with_phi ? t.confinement : 0.0);
         it.converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
                        std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&
-                       std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile;
+                       std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile &&
+                       (!with_phi || std::abs(it.biaxial / t.biaxial - 1) <= o.tolerance_biaxial);
         out.push_back(it);
         if (report) report(it);
         if (it.converged) break;
@@ -143,6 +160,16 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         j.ks = r_new * j.kn;
         j.tensile *= t.tensile / it.tensile;
         j.cohesion *= t.ucs / it.ucs;
+        if (with_phi) {
+            constexpr double deg = std::numbers::pi / 180.0;
+            const double k = (it.biaxial - it.ucs) / t.confinement, tan_phi = std::tan(j.friction * deg);
+            double tan_new = tan_phi * std::max(0.05, k_target - 1.0) / std::max(0.05, k - 1.0);
+            if (iteration > 0 && std::abs(k - prev_k) > 1e-6 * std::abs(k) && std::abs(tan_phi - prev_tan) > 1e-9)
+                tan_new = tan_phi + (k_target - k) * (tan_phi - prev_tan) / (k - prev_k); // secant
+            prev_tan = tan_phi, prev_k = k;
+            const double phi = std::clamp(std::atan(std::max(tan_new, 0.0)) / deg, j.friction - 10.0, j.friction + 10.0);
+            j.friction = std::clamp(phi, 5.0, 60.0);
+        }
     }
     return out;
 }

@@ -17,7 +17,11 @@
 // unknown by the quantity it mainly controls:
 //   kn ← kn × E*/E,   r: shifted by the lattice value of r at ν* minus that at ν,
 //   σt ← σt × T*/T,   c ← c × UCS*/UCS,
-// stopping when all four means are within tolerance or after max_iterations.
+// and, with a biaxial target σ1* at confinement σ3, φ by the slope of the
+// strength envelope k = (σ1 − UCS)/σ3 (k* from the targets): tan φ scaled by
+// (k* − 1)/(k − 1) at first, then by the secant through the last two iterations,
+// steps within ±10°, φ within 5–60°;
+// stopping when all the means are within tolerance or after max_iterations.
 // The means are over realizations, so the result carries their scatter: a new
 // set of seeds reproduces the targets only to within the realization scatter
 // (reported as the standard deviation).
@@ -32,6 +36,10 @@ namespace bbm {
 
 struct CalibrationTargets {
     double E = 20e9, nu = 0.2, ucs = 20e6, tensile = 2.5e6;
+    /// Optional: the strength σ1 of a biaxial test at lateral stress `confinement`
+    /// (both Pa, compression positive); with it the friction angle φ is calibrated
+    /// too. 0 = φ stays as given.
+    double biaxial = 0.0, confinement = 0.0;
 };
 
 struct CalibrationOptions {
@@ -40,6 +48,7 @@ struct CalibrationOptions {
     int threads = 2;          ///< realizations run in parallel on these
     int max_iterations = 6;
     double tolerance_E = 0.02, tolerance_nu = 0.05, tolerance_ucs = 0.03, tolerance_tensile = 0.05;
+    double tolerance_biaxial = 0.03;
     /// Starting values the user gave (kn, ks, tensile, cohesion of base.joint);
     /// the others start from the lattice inversion.
     bool start_kn = false, start_ks = false, start_tensile = false, start_cohesion = false;
@@ -49,6 +58,7 @@ struct CalibrationIteration {
     JointPropertySpec joint;
     double E = 0, nu = 0, ucs = 0, tensile = 0;             ///< means over realizations
     double E_std = 0, nu_std = 0, ucs_std = 0, tensile_std = 0;
+    double biaxial = 0, biaxial_std = 0; ///< σ1 of the biaxial tests (with a biaxial target)
     double E_test = 0, E_test_std = 0; ///< E of the UCS curves (initial slope), for comparison
     double seconds = 0;
     bool converged = false;
@@ -69,9 +79,10 @@ struct ElasticMeasure {
 };
 ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOptions& base);
 
-/// Mean and sample standard deviation of the four measures for a joint set (ν
-/// from elastic_poisson_ratio, the others from the UCS and tension tests).
+/// Mean and sample standard deviation of the measures for a joint set (E and ν
+/// from elastic_measure, the strengths from the UCS and tension tests, and from
+/// biaxial tests at `confinement` if it is > 0).
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed);
+                                              std::uint64_t first_seed, double confinement = 0.0);
 
 } // namespace bbm

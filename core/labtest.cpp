@@ -151,6 +151,40 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     return an;
 }
 
+namespace {
+/// Applies the biaxial confinement gradually with the platens held still, then lets
+/// the specimen settle; returns the step at which axial loading starts.
+long confine(Solver& s) {
+    auto& b = s.blocks();
+    auto& n = s.nodes();
+    const auto block_load = b.applied;
+    const auto block_moment = b.applied_moment;
+    const auto node_load = n.applied;
+    // The moving platen: what has a prescribed, non-zero vertical velocity.
+    std::vector<int> moving_blocks, moving_nodes;
+    std::vector<double> vy_blocks, vy_nodes;
+    for (int i = 0; i < b.count(); ++i)
+        if ((b.fixed[i] & 2) && b.fixed_velocity[i].y != 0.0)
+            moving_blocks.push_back(i), vy_blocks.push_back(b.fixed_velocity[i].y), b.fixed_velocity[i].y = 0.0;
+    for (int k = 0; k < n.count(); ++k)
+        if ((n.fixed[k] & 2) && n.fixed_velocity[k].y != 0.0)
+            moving_nodes.push_back(k), vy_nodes.push_back(n.fixed_velocity[k].y), n.fixed_velocity[k].y = 0.0;
+    auto scale = [&](double f) {
+        for (int i = 0; i < b.count(); ++i) b.applied[i] = f * block_load[i], b.applied_moment[i] = f * block_moment[i];
+        for (int k = 0; k < n.count(); ++k) n.applied[k] = f * node_load[k];
+    };
+    constexpr long ramp = 3000, settle_max = 20000;
+    for (long k = 1; k <= ramp; ++k) {
+        scale(double(k) / double(ramp));
+        s.step();
+    }
+    for (long k = 0; k < settle_max && !(k > 200 && s.unbalanced_ratio() < 1e-5); ++k) s.step();
+    for (std::size_t j = 0; j < moving_blocks.size(); ++j) b.fixed_velocity[moving_blocks[j]].y = vy_blocks[j];
+    for (std::size_t j = 0; j < moving_nodes.size(); ++j) n.fixed_velocity[moving_nodes[j]].y = vy_nodes[j];
+    return s.steps();
+}
+} // namespace
+
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y) {
     const std::size_t n = x.size();
     if (n < 2) return 0.0;
@@ -163,7 +197,8 @@ double fit_slope(const std::vector<double>& x, const std::vector<double>& y) {
 }
 
 LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(const StressStrainPoint&)>& progress,
-                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish) {
+                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish,
+                          const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto blocks = meshing::generate_blocks(labtest_geometry(o));
     Solver s(blocks, labtest_analysis(o));
@@ -216,23 +251,31 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         }
     };
     const double v = o.strain_per_step * h;
+    // Biaxial: the confinement first, ramped with the platens held, then settled
+    // (applied at once it is a shock that cracks the specimen before any axial load).
+    const long start = o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0 ? confine(s) : 0;
     double peak = 0.0;
     long peak_step = 0;
-    bool failed = false; ///< the stress has dropped by failure_drop from the peak
-    while (s.steps() < o.max_steps) {
+    bool failed = false; ///< the stress has dropped by failure_drop from the peak, or stalled
+    const int cracks_at_start = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
+    // A stall: no net rise of the stress over this many records (2e-4 of strain).
+    const std::size_t stall_records =
+        std::max<std::size_t>(5, std::size_t(std::lround(2e-4 / (o.strain_per_step * o.record_every))));
+    while (s.steps() - start < o.max_steps) {
         s.step();
-        if (s.steps() % o.record_every != 0) continue;
+        if ((s.steps() - start) % o.record_every != 0) continue;
         record_new_cracks();
         const double force = sign * s.boundary_force("top").y;
         StressStrainPoint p;
         p.step = s.steps();
-        p.axial_strain = v * double(s.steps()) / h;
+        p.axial_strain = v * double(s.steps() - start) / h;
         p.axial_stress = brazilian ? 2.0 * force / (std::numbers::pi * o.width) : force / o.width;
         p.lateral_strain = (mean_ux(right) - mean_ux(left)) / o.width;
         p.cracks_tensile = s.cracks(contact::JointState::broken_tension);
         p.cracks_shear = s.cracks(contact::JointState::broken_shear);
         r.curve.push_back(p);
         if (progress) progress(p);
+        if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
         // After a failure drop the peak is the strength: rigid fragments cannot
         // break further, and a rubble core jammed between the platens can re-stiffen
         // like dry masonry (trigon: new corner contacts carry most of the load).
@@ -242,9 +285,18 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             break;
         }
         if (p.axial_stress > peak) peak = p.axial_stress, peak_step = p.step;
-        // (Only with broken bonds: the start-up transient of the platens is no failure.)
-        failed = failed || (peak > 0 && p.axial_stress < (1.0 - o.failure_drop) * peak &&
-                            p.cracks_tensile + p.cracks_shear > 0);
+        // Failure: a drop by failure_drop from the peak, or (confined specimens, whose
+        // fragments lock without a drop) a stall — the stress no higher than
+        // 2e-4 of strain ago, with the peak inside that stretch. Only with bonds broken
+        // under the axial load: the start-up transient of the platens is no failure.
+        const bool cracking = p.cracks_tensile + p.cracks_shear > cracks_at_start;
+        const bool dropped = peak > 0 && p.axial_stress < (1.0 - o.failure_drop) * peak;
+        bool stalled = false;
+        if (r.curve.size() > stall_records) {
+            const auto& back = r.curve[r.curve.size() - 1 - stall_records];
+            stalled = p.axial_stress <= back.axial_stress && peak_step >= back.step;
+        }
+        failed = failed || (cracking && (dropped || stalled));
         // Past the peak once the stress is clearly down from it.
         if (peak > 0 && p.step > peak_step && p.axial_stress < o.stop_fraction * peak) {
             r.peak_passed = true;
@@ -254,7 +306,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     }
     r.steps = s.steps();
     r.peak_stress = peak;
-    r.strain_at_peak = v * double(peak_step) / h;
+    r.strain_at_peak = v * double(peak_step - start) / h;
     if (brazilian) r.tensile_strength = peak;
     // E and ν on the initial linear part: pre-peak points between 10% and 50% of the peak.
     std::vector<double> eps, sig, lat;

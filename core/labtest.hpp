@@ -9,9 +9,11 @@
 // zero too, like a platen bonded to the specimen; otherwise it is free, and only
 // the bottom face's middle blocks are held horizontally against drift. With
 // `platen_friction` ≥ 0 the platens are separate rigid blocks instead, pressing on
-// the faces through frictional contacts (finite friction between the two). Confinement (biaxial) is
-// a constant stress on the side faces. Quasi-static mode, Δt = 1, mass scaling
-// and local damping 0.8, so the platen velocity is a displacement per step.
+// the faces through frictional contacts (finite friction between the two).
+// Confinement (biaxial) is a constant stress on the side faces, ramped up with the
+// platens held and settled before the axial loading starts. Quasi-static mode,
+// Δt = 1, mass scaling and local damping 0.8, so the platen velocity is a
+// displacement per step.
 //
 // Measures, from the platen reaction and displacement:
 //   axial stress  = −(reaction on the top platen) / width (compression positive)
@@ -23,8 +25,9 @@
 //   ν  = −(least-squares slope of lateral against axial strain) over the same points
 // Brazilian: indirect tensile strength σt = 2P / (π D), P the peak line load.
 // The run stops when the stress has dropped below `stop_fraction` of the peak
-// after it, when it climbs back above the peak after a failure drop (see
-// `failure_drop`), or at `max_strain`.
+// after it, when it climbs back above the peak after failure (a drop by
+// `failure_drop`, or a stall of the stress over 2e-4 of strain: fragments locked
+// between the platens), or at `max_strain`.
 #pragma once
 
 #include "core/model_spec.hpp"
@@ -61,6 +64,7 @@ struct LabTestOptions {
     double max_strain = 0.01;
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
+    long frame_every = 4000;            ///< steps between frames of the failure series (0: none)
     int threads = 1;                    ///< threads of the contact loop
     /// Deformable blocks (SPEC §6): with 0 < f < 1 every block is meshed (triangles
     /// of mesh_size, default size / 2) and takes the fraction f of the deformation:
@@ -107,10 +111,13 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o);
 
 class Solver;
 /// Runs one test. `progress` (optional) is called with every recorded point;
-/// `on_finish` (optional) sees the final solver state and the result (for output).
+/// `on_finish` (optional) sees the final solver state and the result (for output);
+/// `on_frame` (optional) sees the state every `frame_every` steps of loading, with
+/// the last recorded point (for a series of the failure).
 LabTestResult run_labtest(const LabTestOptions& o,
                           const std::function<void(const StressStrainPoint&)>& progress = {},
-                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish = {});
+                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish = {},
+                          const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame = {});
 
 /// Least-squares slope of y on x.
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y);

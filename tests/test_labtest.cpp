@@ -66,3 +66,30 @@ TEST_CASE("uniaxial compression, paper specimen, 3 realizations: modulus of the 
                                             << " MPa (paper 20.7), coefficient of variation of the peak " << cv);
     CHECK(cv < 0.06);
 }
+
+TEST_CASE("biaxial, paper specimen at 5 MPa: confinement applied without cracking, strength envelope of a frictional rock") {
+    auto o = LabTestOptions::paper_ucs();
+    o.kind = LabTestOptions::Kind::biaxial;
+    o.confinement = 5e6;
+    o.threads = 2;
+    const auto r = run_labtest(o);
+    auto u = LabTestOptions::paper_ucs();
+    u.threads = 2;
+    const auto ucs = run_labtest(u);
+    // σ1 = UCS + k σ3 with k = tan²(45° + φ/2) for a Coulomb material.
+    const double k = (r.peak_stress - ucs.peak_stress) / o.confinement;
+    const double phi = 2.0 * std::atan(std::sqrt(k)) * 180.0 / std::numbers::pi - 90.0;
+    INFO("sigma1 " << r.peak_stress / 1e6 << " MPa at 5 MPa (UCS " << ucs.peak_stress / 1e6 << " MPa): k " << k
+                   << ", macro friction " << phi << " deg; cracks before axial loading "
+                   << r.curve.front().cracks_tensile + r.curve.front().cracks_shear << " of " << r.contacts
+                   << " contacts; locking " << r.post_peak_locking);
+    CHECK(r.peak_passed);
+    // Ramped, the confinement breaks almost nothing (at once it broke joints).
+    CHECK(r.curve.front().cracks_tensile + r.curve.front().cracks_shear < r.contacts / 200);
+    // The axial stress starts near the Poisson response, not at a shock.
+    CHECK(r.curve.front().axial_stress < o.confinement);
+    // A frictional envelope: confinement strengthens, by a macro friction angle
+    // above the joints' 25° (interlocking of the cells) and below 50°.
+    CHECK(phi > 25.0);
+    CHECK(phi < 50.0);
+}
