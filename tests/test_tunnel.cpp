@@ -1,5 +1,6 @@
 // The paper's tunnel end to end (issue 6): the elastic reference against Kirsch,
-// the side-wall failure of the trigon model, and exact restart from a checkpoint.
+// the side-wall failure of the trigon model and of Voronoi blocks with joints
+// calibrated in bbm, and exact restart from a checkpoint.
 #include "apps/model_input.hpp"
 #include "core/analysis.hpp"
 #include "core/solver.hpp"
@@ -18,6 +19,24 @@ io::ModelFile read_example(const std::string& name) {
 }
 
 struct Quiet : StageObserver {};
+
+/// Runs an example tunnel model to the end of its stages (the last one limited to
+/// `max_steps` if > 0) on 2 threads; returns the opening measures and the cracks.
+struct TunnelRun {
+    OpeningMeasures opening;
+    int tensile = 0, shear = 0;
+};
+TunnelRun run_tunnel(const std::string& name, long max_steps = 0) {
+    auto file = read_example(name);
+    if (max_steps > 0) file.analysis.stages.back().max_steps = max_steps;
+    file.analysis.solver.threads = 2;
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    Solver s(blocks, file.analysis);
+    Quiet q;
+    run_stages(s, file.analysis.stages, q);
+    return {measure_opening(s, {0, 0}, {4, 0}, {0, 4}), s.cracks(contact::JointState::broken_tension),
+            s.cracks(contact::JointState::broken_shear)};
+}
 
 /// Stops the run after `stop_at` steps, keeping the cursor reached.
 struct StopAt : StageObserver {
@@ -110,38 +129,25 @@ TEST_CASE("tunnel: a run resumed from a checkpoint ends in the same state as an 
 }
 
 TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown") {
-    auto file = read_example("tunnel_trigon.toml");
-    file.analysis.stages.back().max_steps = 8000; // the failure is well developed by then
-    const auto blocks = meshing::generate_blocks(file.geometry);
-    file.analysis.solver.threads = 2;
-    Solver s(blocks, file.analysis);
-    Quiet q;
-    run_stages(s, file.analysis.stages, q);
-    const auto m = measure_opening(s, {0, 0}, {4, 0}, {0, 4});
-    const int tensile = s.cracks(contact::JointState::broken_tension), shear = s.cracks(contact::JointState::broken_shear);
-    MESSAGE("cracks " << tensile << " tensile, " << shear << " shear; springline sector " << m.cracks_springline_sector
+    const auto r = run_tunnel("tunnel_trigon.toml", 8000); // the failure is well developed by then
+    const auto& m = r.opening;
+    MESSAGE("cracks " << r.tensile << " tensile, " << r.shear << " shear; springline sector " << m.cracks_springline_sector
                       << ", crown sector " << m.cracks_crown_sector << "; failed depth " << m.failed_depth_springline
                       << " m (springline), " << m.failed_depth_crown << " m (crown)");
     CHECK(m.cracks_springline_sector >= 20);
     CHECK(m.cracks_springline_sector >= 3 * m.cracks_crown_sector);
-    CHECK(shear > 0); // trigon: sliding along the triangle edges takes part
+    CHECK(r.shear > 0); // trigon: sliding along the triangle edges takes part
 }
 
 TEST_CASE("tunnel: Voronoi blocks with joints calibrated in bbm (macro friction 25°) fail at the side walls") {
     // The joint set bbm calibrate found for the paper's rock including its
     // confined strength (examples/tunnel_voronoi_calibrated.toml); with the
     // paper's UDEC values the Voronoi wall barely breaks (docs/calibration.md).
-    auto file = read_example("tunnel_voronoi_calibrated.toml");
-    const auto blocks = meshing::generate_blocks(file.geometry);
-    file.analysis.solver.threads = 2;
-    Solver s(blocks, file.analysis);
-    Quiet q;
-    run_stages(s, file.analysis.stages, q);
-    const auto m = measure_opening(s, {0, 0}, {4, 0}, {0, 4});
-    MESSAGE("cracks " << s.cracks(contact::JointState::broken_tension) << " tensile, "
-                      << s.cracks(contact::JointState::broken_shear) << " shear; springline sector "
-                      << m.cracks_springline_sector << ", crown sector " << m.cracks_crown_sector << "; failed depth "
-                      << m.failed_depth_springline << " m (springline)");
+    const auto r = run_tunnel("tunnel_voronoi_calibrated.toml");
+    const auto& m = r.opening;
+    MESSAGE("cracks " << r.tensile << " tensile, " << r.shear << " shear; springline sector " << m.cracks_springline_sector
+                      << ", crown sector " << m.cracks_crown_sector << "; failed depth " << m.failed_depth_springline
+                      << " m (springline)");
     CHECK(m.cracks_springline_sector >= 20);
     CHECK(m.cracks_springline_sector >= 3 * m.cracks_crown_sector);
     CHECK(m.failed_depth_springline > 0.5);
