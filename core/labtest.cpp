@@ -95,6 +95,19 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     }
     // The bond between specimen blocks (a later rule wins over the platen one).
     an.joint_assignments.push_back({o.joint.name, {}, {"specimen"}});
+    // Contacts that form during the test (fragments touching anew) are the rock's
+    // broken joints: unbonded, with the bond's stiffness and residual friction
+    // (not the solver's built-in 30°); with deformable blocks, as stiff as the
+    // bonds after the split (SPEC §6).
+    const double joint_share = o.deformable_fraction > 0.0 ? 1.0 - o.deformable_fraction : 1.0;
+    JointPropertySpec unbonded;
+    unbonded.name = "unbonded";
+    unbonded.law = JointPropertySpec::Law::coulomb;
+    unbonded.kn = o.joint.kn / joint_share;
+    unbonded.ks = o.joint.ks / joint_share;
+    unbonded.friction = o.joint.residual_friction >= 0 ? o.joint.residual_friction : o.joint.friction;
+    an.joint_properties.push_back(unbonded);
+    an.solver.new_contact_property = unbonded.name;
     const double h = specimen_height(o), band = 0.5 * o.size, v = o.strain_per_step * h;
     const double big = 10.0 * (o.width + h);
     // Rectangular specimens: every block with an edge on the loaded face moves with

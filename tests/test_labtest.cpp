@@ -71,10 +71,8 @@ TEST_CASE("biaxial, paper specimen at 5 MPa: confinement applied without crackin
     auto o = LabTestOptions::paper_ucs();
     o.kind = LabTestOptions::Kind::biaxial;
     o.confinement = 5e6;
-    o.threads = 2;
     const auto r = run_labtest(o);
-    auto u = LabTestOptions::paper_ucs();
-    u.threads = 2;
+    const auto u = LabTestOptions::paper_ucs();
     const auto ucs = run_labtest(u);
     // σ1 = UCS + k σ3 with k = tan²(45° + φ/2) for a Coulomb material.
     const double k = (r.peak_stress - ucs.peak_stress) / o.confinement;
