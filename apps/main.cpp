@@ -62,7 +62,8 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
                            {"blocks", n},
                            {"area", area},
                            {"target_size", a.region_size[r]},
-                           {"mean_block_size", meshing::mean_block_size(a, r)}});
+                           {"mean_feret_diameter", meshing::mean_feret_diameter(a, r)},
+                           {"equal_area_diameter", meshing::mean_block_size(a, r)}});
     }
     std::map<std::string, int> tags;
     for (const auto& j : a.joints) ++tags[meshing::to_string(j.tag)];
@@ -71,7 +72,7 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
             {"joints_by_tag", tags},
             {"total_area", total_area},
             {"inner_blocks", inner_blocks},
-            {"mean_block_size",
+            {"equal_area_diameter",
              inner_blocks ? std::sqrt(4.0 * inner_area / inner_blocks / 3.141592653589793) : 0.0},
             {"min_edge_length", inner_blocks ? min_edge : 0.0},
             {"collapsed_edges", st.collapsed_edges},
@@ -102,13 +103,14 @@ int run_mesh(const std::string& model_path, const fs::path& out, const io::Pictu
     const auto summary = mesh_summary(blocks, stats, seconds);
     io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
     if (!quiet) {
-        std::printf("%s: %d blocks, %zu joints, area %.6g m², mean inner block size %.4g m (%.2f s)\n",
-                    model_path.c_str(), blocks.block_count(), blocks.joints.size(),
-                    summary["total_area"].get<double>(), summary["mean_block_size"].get<double>(), seconds);
+        std::printf("%s: %d blocks, %zu joints, area %.6g m² (%.2f s)\n", model_path.c_str(),
+                    blocks.block_count(), blocks.joints.size(), summary["total_area"].get<double>(), seconds);
         for (const auto& r : summary["regions"])
-            std::printf("  region %-12s %-9s %7d blocks  %10.4f m²  mean size %.4g m\n",
+            std::printf("  region %-12s %-9s %7d blocks  %10.4f m²  mean Feret diameter %.4g m, equal-area "
+                        "diameter %.4g m\n",
                         r["name"].get<std::string>().c_str(), r["pattern"].get<std::string>().c_str(),
-                        r["blocks"].get<int>(), r["area"].get<double>(), r["mean_block_size"].get<double>());
+                        r["blocks"].get<int>(), r["area"].get<double>(), r["mean_feret_diameter"].get<double>(),
+                        r["equal_area_diameter"].get<double>());
         std::printf("  wrote %s/{blocks.vtu, joints.vtu, blocks.png, summary.json}\n", out.string().c_str());
     }
     return 0;
@@ -121,6 +123,7 @@ struct LabTestCli {
     std::string pattern = "voronoi";
     std::vector<double> tension_softening{0.5, 1.7, 4.0}, shear_softening{0.5, 1.3, 2.1};
     std::string platens = "rough";
+    std::string size_measure = "feret";
     int realizations = 1;
     int threads = 0;
     std::string out = "out";
@@ -131,11 +134,18 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--pattern", c.pattern, "Inner-block pattern")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
         ->capture_default_str();
-    sub->add_option("--size", o.size, "Mean block size d (m)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--size", o.size, "Mean block size d (m), measured as --size-measure says")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--size-measure", c.size_measure,
+                    "feret: the blocks' mean Feret (caliper) diameter, perimeter / pi (for trigon, of the triangles); "
+                    "area: the diameter of the circle of the mean area of the Voronoi cells (trigon: before "
+                    "splitting) or Delaunay triangles")
+        ->check(CLI::IsMember({"feret", "area"}))->capture_default_str();
     sub->add_option("--width", o.width, "Specimen width (m); brazilian: disc diameter")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--height", o.height, "Specimen height (m)")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--seed", o.seed, "Random seed of the block pattern")->capture_default_str();
-    sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations")->check(CLI::NonNegativeNumber)->capture_default_str();
+    sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations (0: cells of random points; more: more regular cells)")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
     sub->add_option("--kn", o.joint.kn, "Joint normal stiffness (Pa/m)")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--ks", o.joint.ks, "Joint shear stiffness (Pa/m)")->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--tensile", o.joint.tensile, "Joint tensile strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
@@ -238,6 +248,17 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
     io::write_text_atomically(dir / "summary.json", labtest_json(r).dump(2) + "\n");
 }
 
+/// --pattern and --size-measure -> the options' pattern.
+void apply_pattern_flags(LabTestCli& c) {
+    const std::map<std::string, meshing::PatternSpec::Kind> kinds{
+        {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
+        {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
+        {"brick", meshing::PatternSpec::Kind::brick}};
+    c.o.pattern = kinds.at(c.pattern);
+    c.o.size_measure =
+        c.size_measure == "area" ? meshing::PatternSpec::SizeMeasure::area : meshing::PatternSpec::SizeMeasure::feret;
+}
+
 /// --tension-softening / --shear-softening b1,a1,a2 -> the points (a1, b1), (a2, 0)
 /// of the joint's curves, checked.
 void apply_softening_flags(LabTestCli& c) {
@@ -254,11 +275,7 @@ void apply_softening_flags(LabTestCli& c) {
 int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* name, bool quiet) {
     auto& o = c.o;
     o.kind = kind;
-    const std::map<std::string, meshing::PatternSpec::Kind> kinds{
-        {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
-        {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
-        {"brick", meshing::PatternSpec::Kind::brick}};
-    o.pattern = kinds.at(c.pattern);
+    apply_pattern_flags(c);
     apply_softening_flags(c);
     o.rough_platens = c.platens == "rough";
     if (o.platen_friction >= 0.0 && (kind == LabTestOptions::Kind::tension || kind == LabTestOptions::Kind::brazilian))
@@ -369,11 +386,9 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
     o.start_ks = cmd.count("--ks") > 0;
     o.start_tensile = cmd.count("--tensile") > 0;
     o.start_cohesion = cmd.count("--cohesion") > 0;
-    const std::map<std::string, meshing::PatternSpec::Kind> kinds{
-        {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
-        {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
-        {"brick", meshing::PatternSpec::Kind::brick}};
-    o.base.pattern = kinds.at(c.pattern);
+    apply_pattern_flags(c);
+    o.base.pattern = c.o.pattern;
+    o.base.size_measure = c.o.size_measure;
     o.realizations = c.realizations;
     o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     o.max_iterations = iterations;
@@ -421,7 +436,15 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
         if (with_phi) std::fprintf(stderr, ", sigma1 %.2f MPa (std %.2f)", fresh.biaxial / 1e6, fresh.biaxial_std / 1e6);
         std::fprintf(stderr, "\n");
     }
-    std::string toml = "# bbm calibrate: " + c.pattern + " blocks of " + fmt_number(o.base.size) + " m; targets E " +
+    // The set holds for this pattern only: say which, as a model file writes it.
+    const std::string pattern_line = "pattern = { type = \"" + c.pattern + "\", size = " + fmt_number(o.base.size) +
+                                     ", size_measure = \"" + c.size_measure + "\", lloyd = " +
+                                     std::to_string(o.base.lloyd) + " }";
+    std::string toml = "# bbm calibrate: " + c.pattern + " blocks of " + fmt_number(o.base.size) + " m (" +
+                       (c.size_measure == "area" ? "equal-area diameter" : "mean Feret diameter") + "), Lloyd " +
+                       std::to_string(o.base.lloyd) + ", in a " + fmt_number(o.base.width) + " m x " +
+                       fmt_number(o.base.height) + " m specimen; for regions with\n#   " + pattern_line +
+                       "\n# Targets E " +
                        fmt_number(targets.E) + " Pa, nu " + fmt_number(targets.nu) + ", UCS " + fmt_number(targets.ucs) +
                        " Pa, tensile " + fmt_number(targets.tensile) + " Pa" +
                        (with_phi ? ", biaxial " + fmt_number(targets.biaxial) + " Pa at " + fmt_number(targets.confinement) +
@@ -449,6 +472,8 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
                                                           {"confinement", targets.confinement}}},
                                              {"pattern", c.pattern},
                                              {"size", o.base.size},
+                                             {"size_measure", c.size_measure},
+                                             {"lloyd", o.base.lloyd},
                                              {"realizations", o.realizations},
                                              {"converged", last.converged},
                                              {"fresh_seeds", {{"first_seed", o.base.seed + 1000}, {"E", fresh.E},

@@ -395,15 +395,15 @@ constexpr std::array<std::string_view, 12> all_outline_keys{
     "type",  "min",   "max",   "points", "center", "radius",
     "start", "steps", "width", "floor",  "half",   "max_segment"};
 
-constexpr std::array<std::string_view, 5> random_pattern_keys{"type", "size", "lloyd", "min_edge",
-                                                              "seed"};
+constexpr std::array<std::string_view, 6> random_pattern_keys{"type", "size",  "size_measure",
+                                                              "lloyd", "min_edge", "seed"};
 constexpr std::array<std::string_view, 5> hexagonal_keys{"type", "size", "min_edge", "origin",
                                                          "angle"};
 constexpr std::array<std::string_view, 7> brick_keys{"type",  "size",   "min_edge", "origin",
                                                      "angle", "aspect", "bond"};
 constexpr std::array<std::string_view, 1> single_keys{"type"};
-constexpr std::array<std::string_view, 9> all_pattern_keys{
-    "type", "size", "lloyd", "min_edge", "seed", "origin", "angle", "aspect", "bond"};
+constexpr std::array<std::string_view, 10> all_pattern_keys{
+    "type", "size", "size_measure", "lloyd", "min_edge", "seed", "origin", "angle", "aspect", "bond"};
 
 Keys outline_keys(OutlineSpec::Kind k) {
     switch (k) {
@@ -547,6 +547,11 @@ PatternSpec read_pattern(const Ctx& c, const toml::node& node, const Path& p) {
             c.fail(*t.get("min_edge"), p.key("min_edge"),
                    "must be smaller than size = " + fmt(s.size) + " m, got " + fmt(*e));
         s.min_edge = *e;
+    }
+    if (t.contains("size_measure")) {
+        static constexpr std::array<std::string_view, 2> measures{"feret", "area"};
+        s.size_measure = static_cast<PatternSpec::SizeMeasure>(
+            choice(c, t, p, "size_measure", measures, "size measure"));
     }
     s.lloyd_iterations =
         static_cast<int>(integer(c, t, p, "lloyd", 0, std::numeric_limits<int>::max()).value_or(0));

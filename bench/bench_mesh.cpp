@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
             r.outline.max = {w, w};
             r.pattern.kind = PatternSpec::Kind::voronoi;
             r.pattern.size = d;
+            r.pattern.size_measure = PatternSpec::SizeMeasure::area; // the scene as recorded: `target` cells
             r.pattern.lloyd_iterations = lloyd;
             ModelGeometrySpec spec;
             spec.regions.push_back(r);

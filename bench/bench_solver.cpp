@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
         r.outline.max = {width, 2 * width};
         r.pattern.kind = meshing::PatternSpec::Kind::voronoi;
         r.pattern.size = d;
+        r.pattern.size_measure = meshing::PatternSpec::SizeMeasure::area; // the scenes as recorded
         r.pattern.lloyd_iterations = 2;
         meshing::ModelGeometrySpec g;
         g.regions.push_back(r);

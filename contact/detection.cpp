@@ -28,6 +28,57 @@ int prev_vertex(const std::uint32_t* first, int block, int v) {
 
 } // namespace
 
+std::vector<Junction> find_junctions(const std::vector<Vec2>& vertex, const std::vector<std::uint32_t>& first,
+                                     const std::vector<std::uint64_t>& joined, double eps) {
+    std::vector<Junction> out;
+    const int nb = int(first.size()) - 1;
+    if (nb < 2) return out;
+    // Vertices in a uniform grid of about one edge per cell.
+    Box2 all;
+    double edges = 0.0;
+    std::vector<int> owner(vertex.size());
+    for (int k = 0; k < nb; ++k)
+        for (std::uint32_t v = first[k]; v < first[k + 1]; ++v) {
+            owner[v] = k;
+            all.add(vertex[v]);
+            edges += norm(vertex[next_vertex(first.data(), k, int(v))] - vertex[v]);
+        }
+    const double cell = std::max(edges / double(vertex.size()), 1e-12);
+    const long nx = std::clamp(long(all.width() / cell) + 1, 1L, 1L << 20);
+    auto cx = [&](double x) { return std::clamp(long((x - all.lo.x) / cell), 0L, nx - 1); };
+    const long ny = std::clamp(long(all.height() / cell) + 1, 1L, 1L << 20);
+    auto cy = [&](double y) { return std::clamp(long((y - all.lo.y) / cell), 0L, ny - 1); };
+    std::unordered_map<long, std::vector<int>> grid;
+    for (int v = 0; v < int(vertex.size()); ++v) grid[cy(vertex[v].y) * nx + cx(vertex[v].x)].push_back(v);
+    for (int k = 0; k < nb; ++k)
+        for (std::uint32_t e = first[k]; e < first[k + 1]; ++e) {
+            const int e1 = next_vertex(first.data(), k, int(e));
+            const Vec2 p = vertex[e], d = vertex[e1] - p;
+            const double l2 = norm2(d);
+            if (l2 <= 0.0) continue;
+            Box2 box;
+            box.add(p);
+            box.add(vertex[e1]);
+            for (long j = cy(box.lo.y - eps); j <= cy(box.hi.y + eps); ++j)
+                for (long i = cx(box.lo.x - eps); i <= cx(box.hi.x + eps); ++i) {
+                    const auto it = grid.find(j * nx + i);
+                    if (it == grid.end()) continue;
+                    for (int v : it->second) {
+                        if (owner[v] == k) continue;
+                        const double s = dot(vertex[v] - p, d) / l2;
+                        if (s < -1e-9 || s > 1.0 + 1e-9 || norm(vertex[v] - (p + s * d)) > eps) continue;
+                        if (std::binary_search(joined.begin(), joined.end(), block_pair_key(owner[v], k))) continue;
+                        out.push_back({v, k, int(e), e1, std::clamp(s, 0.0, 1.0)});
+                    }
+                }
+        }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end(),
+                          [](const Junction& a, const Junction& b) { return a.vertex == b.vertex && a.block == b.block; }),
+              out.end());
+    return out;
+}
+
 DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
@@ -143,12 +194,14 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
                 if (dist < best_gap) best_gap = dist, best = int(e);
             }
             if (best < 0) continue;
-            if (in.junction_pairs) {
-                // Still on the corner the two blocks shared in the tessellation?
-                const Vec2 e0 = b.vertex[best], e1v = b.vertex[next_vertex(b.first, B, best)];
-                if ((norm(x - e0) <= tol || norm(x - e1v) <= tol) &&
-                    std::binary_search(in.junction_pairs->begin(), in.junction_pairs->end(), pair_key(A, B)))
-                    continue;
+            if (in.junctions) {
+                // Still on the point it touched in the tessellation?
+                const auto& J = *in.junctions;
+                const auto it = std::lower_bound(J.begin(), J.end(), Junction{int(v), B, 0, 0, 0.0});
+                if (it != J.end() && it->vertex == int(v) && it->block == B) {
+                    const Vec2 touched = b.vertex[it->e0] + it->s * (b.vertex[it->e1] - b.vertex[it->e0]);
+                    if (norm(x - touched) <= tol) continue;
+                }
             }
             auto& points = existing[pair_key(A, B)];
             bool known = false;

@@ -27,6 +27,17 @@
 
 namespace bbm::contact {
 
+/// A vertex of one block on the boundary of another block it has no joint with:
+/// at one of that block's vertices or inside one of its edges. The touching point
+/// moves with the other block: the point at parameter s of its edge (e0, e1).
+struct Junction {
+    int vertex; ///< global id of the touching vertex
+    int block;  ///< the block it touches
+    int e0, e1; ///< that block's edge, as global vertex ids (e1 follows e0)
+    double s;   ///< position of the point along the edge, 0 at e0, 1 at e1
+    bool operator<(const Junction& o) const { return vertex < o.vertex || (vertex == o.vertex && block < o.block); }
+};
+
 struct DetectionInput {
     BlockView blocks;
     int block_count = 0;
@@ -39,20 +50,27 @@ struct DetectionInput {
     /// The step about to run: its contact update adds v·Δt, motion already in the
     /// measured gap, so a new contact's un starts at gap − v_rel·n Δt.
     double dt = 0.0;
-    /// Pairs of blocks that met only at a vertex of the initial tessellation
-    /// (pair keys min << 32 | max, sorted). A vertex of one still sitting on that
-    /// shared corner of the other gets no new contact: the point is interior to the
-    /// rock, and a corner-to-corner contact there (six trigon triangles meet at
-    /// each centre) would carry load no joint carries and lock the fragments once
-    /// the bonds break. Once the blocks have moved apart by more than the
-    /// tolerance, contacts between them form as between any others.
-    const std::vector<std::uint64_t>* junction_pairs = nullptr;
+    /// Vertices that touched another block, with no joint between the two, in the
+    /// initial tessellation (sorted by vertex, then block). Such a vertex still
+    /// within the tolerance of the point it touched gets no new contact with that
+    /// block: the point is interior to the rock, and a contact there would carry
+    /// load no joint carries — corner to corner where six trigon triangles meet at
+    /// each centre (locking the fragments once the bonds break), or a cell's corner
+    /// pressed into a meshed region it touched only at that point. Once they have
+    /// moved apart by more than the tolerance, contacts form as between any blocks.
+    const std::vector<Junction>* junctions = nullptr;
 };
 
-/// Key of an unordered block pair, as in DetectionInput::junction_pairs.
+/// Key of an unordered block pair.
 inline std::uint64_t block_pair_key(int a, int b) {
     return (std::uint64_t(std::uint32_t(a < b ? a : b)) << 32) | std::uint32_t(a < b ? b : a);
 }
+
+/// The junctions of an assembly: every vertex lying (within `eps`) on the
+/// boundary of another block that it shares no joint with. `joined`: the sorted
+/// pair keys of the blocks that have a joint. O(vertices) with a uniform grid.
+std::vector<Junction> find_junctions(const std::vector<Vec2>& vertex, const std::vector<std::uint32_t>& first,
+                                     const std::vector<std::uint64_t>& joined, double eps);
 
 struct DetectionResult {
     int created = 0, removed = 0, transferred = 0;

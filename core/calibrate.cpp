@@ -62,13 +62,15 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
 
 JointPropertySpec calibration_start(const CalibrationTargets& t, const CalibrationOptions& o) {
     JointPropertySpec j = o.base.joint;
-    const double a = 0.9523 * o.base.size, r = std::max(0.05, lattice_ratio(t.nu));
+    // The lattice spacing from the blocks' mean area (whatever measure `size` is in).
+    const double d = meshing::mean_block_size(meshing::generate_blocks(labtest_geometry(o.base)));
+    const double a = 0.9523 * d, r = std::max(0.05, lattice_ratio(t.nu));
     if (!o.start_kn) j.kn = t.E * (3.0 + r) / (2.0 * a * (1.0 + r));
     if (!o.start_ks) j.ks = r * j.kn;
-    // Strengths scale with the paper's set on its specimen (face-loaded): direct
-    // tension 0.72 σt, UCS 27.6 MPa with c = 9.5 MPa.
-    if (!o.start_tensile) j.tensile = t.tensile / 0.72;
-    if (!o.start_cohesion) j.cohesion = 9.5e6 * t.ucs / 27.6e6;
+    // Strengths scale with the paper's set on its specimen (default pattern,
+    // face-loaded): direct tension 0.66 σt, UCS 22.9 MPa with c = 9.5 MPa.
+    if (!o.start_tensile) j.tensile = t.tensile / 0.66;
+    if (!o.start_cohesion) j.cohesion = 9.5e6 * t.ucs / 22.9e6;
     return j;
 }
 

@@ -8,8 +8,9 @@
 // Start (no test run): the hexagonal-lattice inversion of E and ν (the exact
 // elastic constants of a regular Voronoi assembly, docs/calibration.md):
 //   r = ks/kn = (1 − 3ν)/(1 + ν),  kn = E (3 + r) / (2 a (1 + r)),  a = 0.9523 d,
-// σt = tensile / 0.72 and c = 9.5 MPa × UCS / 27.6 MPa (the ratios bbm measures
-// with the paper's parameters), unless the user gave kn, ks, σt or c: those start
+// d the diameter of the blocks' mean area; σt = tensile / 0.66 and
+// c = 9.5 MPa × UCS / 22.9 MPa (the ratios bbm measures with the paper's
+// parameters), unless the user gave kn, ks, σt or c: those start
 // from the given values. Then each iteration runs `realizations` UCS and
 // direct-tension tests (seeds seed, seed+1, ..., in parallel; E and ν from an
 // implicit elastic solve of each specimen, as the initial slope and lateral strain

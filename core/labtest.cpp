@@ -42,6 +42,7 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
     }
     r.pattern.kind = o.pattern;
     r.pattern.size = o.size;
+    r.pattern.size_measure = o.size_measure;
     r.pattern.lloyd_iterations = o.lloyd;
     r.pattern.seed = o.seed;
     if (o.deformable_fraction > 0.0) {

@@ -45,7 +45,12 @@ struct LabTestOptions {
     Kind kind = Kind::ucs;
     meshing::PatternSpec::Kind pattern = meshing::PatternSpec::Kind::voronoi;
     double size = 0.3, width = 8.0, height = 16.0; ///< m (brazilian: width = diameter)
-    int lloyd = 2;
+    /// What `size` measures (meshing/spec.hpp): by default the blocks' mean Feret
+    /// diameter, the paper's "average dimension".
+    meshing::PatternSpec::SizeMeasure size_measure = meshing::PatternSpec::SizeMeasure::feret;
+    /// Lloyd iterations: 0 = the Voronoi cells of random points, as the paper's
+    /// "randomly generated" blocks (relaxed cells are ~15% stronger: docs/calibration.md).
+    int lloyd = 0;
     std::uint64_t seed = 1;
     JointPropertySpec joint;            ///< the bond (law softening by default: paper values)
     double density = 2700.0;
@@ -105,7 +110,7 @@ struct LabTestResult {
 /// Whether the test has separate platen blocks (platen_friction ≥ 0, compression).
 bool uses_platen_blocks(const LabTestOptions& o);
 
-/// Geometry and analysis of a lab test (also what `bbm ucs --write-model` saves).
+/// Geometry and analysis of a lab test.
 meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o);
 AnalysisSpec labtest_analysis(const LabTestOptions& o);
 

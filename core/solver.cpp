@@ -244,26 +244,14 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     detected_at_ = b_.centroid;
     detected_theta_.assign(nb, 0.0);
     detected_vertex_ = b_.vertex;
-    // Blocks that share a vertex point of the tessellation but no joint.
+    // Vertices on the boundary of a block they have no joint with (detection.hpp).
     {
-        std::map<std::pair<double, double>, std::vector<int>> at_point;
-        for (int i = 0; i < nb; ++i)
-            for (std::uint32_t v = a.first[i]; v < a.first[i + 1]; ++v) {
-                auto& list = at_point[{a.points[v].x, a.points[v].y}];
-                if (list.empty() || list.back() != i) list.push_back(i);
-            }
         std::vector<std::uint64_t> joined;
         for (const auto& j : a.joints) joined.push_back(contact::block_pair_key(j.block_a, j.block_b));
         std::sort(joined.begin(), joined.end());
-        for (const auto& [p, list] : at_point)
-            for (std::size_t x = 0; x < list.size(); ++x)
-                for (std::size_t y = x + 1; y < list.size(); ++y) {
-                    const auto key = contact::block_pair_key(list[x], list[y]);
-                    if (list[x] != list[y] && !std::binary_search(joined.begin(), joined.end(), key))
-                        junction_pairs_.push_back(key);
-                }
-        std::sort(junction_pairs_.begin(), junction_pairs_.end());
-        junction_pairs_.erase(std::unique(junction_pairs_.begin(), junction_pairs_.end()), junction_pairs_.end());
+        Box2 all;
+        for (Vec2 p : a.points) all.add(p);
+        junctions_ = contact::find_junctions(a.points, a.first, joined, 1e-9 * std::max(all.width(), all.height()));
     }
     active_.assign(nb, 0);
     c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
@@ -648,7 +636,7 @@ void Solver::detect_if_due() {
     }
     if (!any) return;
     contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
-                               new_contact_property_, dt_, &junction_pairs_};
+                               new_contact_property_, dt_, &junctions_};
     const auto r = contact::update_contacts(c_, in);
     for (int i = 0; i < b_.count(); ++i) {
         if (!active_[i]) continue;

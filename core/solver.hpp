@@ -198,7 +198,7 @@ private:
     std::vector<double> detected_theta_;
     std::vector<Vec2> detected_vertex_; ///< deformable blocks: vertex positions at their last pass
     std::vector<std::uint8_t> active_; ///< moved enough since its last detection pass
-    std::vector<std::uint64_t> junction_pairs_; ///< blocks meeting only at a vertex initially (detection.hpp)
+    std::vector<contact::Junction> junctions_; ///< vertices touching a block they have no joint with (detection.hpp)
     contact::DetectionResult detection_totals_;
     long steps_ = 0;
 };

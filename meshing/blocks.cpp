@@ -481,9 +481,10 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
         a.real_segments.insert(a.real_segments.end(), cut.dangling.begin(), cut.dangling.end());
 
         detail::Random rng(reg.pattern.seed);
+        const PatternSpec pattern = detail::generator_pattern(reg.pattern);
         RegionBlocks rb;
         for (const auto& face : cut.faces) {
-            auto fill = detail::fill_face(face, reg.pattern, rng);
+            auto fill = detail::fill_face(face, pattern, rng);
             st.collapsed_edges += fill.collapsed_edges;
             const int offset = rb.parent.empty() ? 0 : *std::max_element(rb.parent.begin(), rb.parent.end()) + 1;
             for (std::size_t k = 0; k < fill.polygons.size(); ++k) {
@@ -497,7 +498,7 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
         for (std::size_t k = 0; k < rb.polygons.size(); ++k)
             a.add_block(rb.polygons[k], r, reg.pattern.kind, parent_base + rb.parent[k]);
         if (reg.pattern.kind != PatternSpec::Kind::single) {
-            const double min_edge = reg.pattern.min_edge >= 0 ? reg.pattern.min_edge : 0.1 * reg.pattern.size;
+            const double min_edge = pattern.min_edge >= 0 ? pattern.min_edge : 0.1 * pattern.size;
             for (int b = parent_base; b < a.block_count(); ++b) {
                 const auto poly = a.block(b);
                 for (std::size_t i = 0; i < poly.size(); ++i)

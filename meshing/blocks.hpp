@@ -117,4 +117,10 @@ std::vector<Vec2> outline_polygon(const OutlineSpec& o, double default_max_segme
 /// Mean block size of the given blocks: diameter of the circle of their mean area.
 double mean_block_size(const BlockAssembly& a, int region = -1);
 
+/// Mean Feret (caliper) diameter of a polygon: its width averaged over all
+/// directions, the perimeter of its convex hull / π (Cauchy's formula).
+double mean_feret_diameter(std::span<const Vec2> poly);
+/// Mean of it over the blocks of a region (all regions: −1), cut blocks included.
+double mean_feret_diameter(const BlockAssembly& a, int region = -1);
+
 } // namespace bbm::meshing

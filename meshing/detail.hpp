@@ -62,6 +62,11 @@ struct FaceFill {
 };
 FaceFill fill_face(const cgal::PolygonWithHoles& face, const PatternSpec& pattern, Random& rng);
 
+/// The pattern the generators run with: `size` as the diameter of the mean area of
+/// their cells (SizeMeasure::area). A size given as a mean Feret diameter is
+/// converted with the ratio measured on a reference patch of the same pattern.
+PatternSpec generator_pattern(const PatternSpec& pattern);
+
 /// Collapses edges shorter than min_edge; shared vertices move together so the
 /// polygons still tile the same area. Outline vertices of `face` never move, and
 /// vertices on the outline move only along it. Returns the number collapsed.

@@ -290,6 +290,43 @@ FaceFill fill_single(const PolygonWithHoles& face) {
 
 } // namespace
 
+PatternSpec generator_pattern(const PatternSpec& p) {
+    using K = PatternSpec::Kind;
+    const bool random = p.kind == K::voronoi || p.kind == K::trigon || p.kind == K::delaunay;
+    if (!random || p.size_measure == PatternSpec::SizeMeasure::area) return p;
+    // The mean Feret diameter of the blocks is proportional to the generator's size
+    // (same seeds, scaled), so their ratio is a property of the pattern: measured on
+    // a square patch of about 600 cells with the same settings, its blocks clear of
+    // the patch's sides (cut blocks are smaller). The minimum edge stays the one of
+    // the size asked for. Two passes: the first guess (typical ratios) only sets the
+    // scale of the minimum edge relative to the cells.
+    PatternSpec q = p;
+    q.size_measure = PatternSpec::SizeMeasure::area;
+    q.min_edge = min_edge_of(p);
+    double ratio = p.kind == K::trigon ? 0.6 : (p.kind == K::delaunay ? 1.35 : 1.13);
+    for (int pass = 0; pass < 2; ++pass) {
+        q.size = p.size / ratio;
+        const double side = q.size * std::sqrt(600.0 * std::numbers::pi / 4.0);
+        PolygonWithHoles patch;
+        patch.outer = {{0.0, 0.0}, {side, 0.0}, {side, side}, {0.0, side}};
+        Random rng(q.seed ^ 0x5eed5eed5eed5eedull);
+        const FaceFill fill = fill_face(patch, q, rng);
+        const double margin = 1e-9 * side;
+        double sum = 0.0;
+        int n = 0;
+        for (const auto& poly : fill.polygons) {
+            const bool cut = std::any_of(poly.begin(), poly.end(), [&](Vec2 v) {
+                return v.x < margin || v.y < margin || v.x > side - margin || v.y > side - margin;
+            });
+            if (!cut) sum += mean_feret_diameter(poly), ++n;
+        }
+        if (n == 0) break; // cannot happen with ~600 cells; keep the first guess
+        ratio = sum / n / q.size;
+    }
+    q.size = p.size / ratio;
+    return q;
+}
+
 FaceFill fill_face(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
     using K = PatternSpec::Kind;
     switch (p.kind) {
@@ -304,3 +341,36 @@ FaceFill fill_face(const PolygonWithHoles& face, const PatternSpec& p, Random& r
 }
 
 } // namespace bbm::meshing::detail
+
+namespace bbm::meshing {
+
+double mean_feret_diameter(std::span<const Vec2> poly) {
+    // Cauchy: the mean width of a convex set over all directions is its perimeter / π;
+    // a non-convex block has the mean width of its convex hull (monotone chain).
+    std::vector<Vec2> pts(poly.begin(), poly.end());
+    std::sort(pts.begin(), pts.end(), [](Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    if (pts.size() < 3) return pts.size() == 2 ? 2.0 * norm(pts[1] - pts[0]) / std::numbers::pi : 0.0;
+    std::vector<Vec2> hull(2 * pts.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        while (k >= 2 && cross(hull[k - 1] - hull[k - 2], pts[i] - hull[k - 2]) <= 0) --k;
+        hull[k++] = pts[i];
+    }
+    for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
+        while (k >= lower && cross(hull[k - 1] - hull[k - 2], pts[i] - hull[k - 2]) <= 0) --k;
+        hull[k++] = pts[i];
+    }
+    double perimeter = 0.0;
+    for (std::size_t i = 0; i + 1 < k; ++i) perimeter += norm(hull[i + 1] - hull[i]);
+    return perimeter / std::numbers::pi;
+}
+
+double mean_feret_diameter(const BlockAssembly& a, int region) {
+    double total = 0.0;
+    int n = 0;
+    for (int b = 0; b < a.block_count(); ++b)
+        if (region < 0 || a.region[b] == region) total += mean_feret_diameter(a.block(b)), ++n;
+    return n ? total / n : 0.0;
+}
+
+} // namespace bbm::meshing

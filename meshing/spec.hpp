@@ -56,11 +56,21 @@ struct OutlineSpec {
 
 struct PatternSpec {
     enum class Kind { voronoi, trigon, delaunay, hexagonal, brick, single };
+    /// What `size` measures for the random patterns (voronoi, trigon, delaunay).
+    ///   feret: the mean Feret (caliper) diameter of the blocks — a block's width
+    ///          averaged over all directions, perimeter / π for a convex block —
+    ///          the "average dimension" of paper §4.1 (docs/input.md, Patterns:
+    ///          with it the paper's Voronoi and trigon calibrations give the same
+    ///          modulus in bbm as in the paper). For trigon, of the triangles.
+    ///   area:  the diameter of the circle of the mean area of the generator's
+    ///          cells (voronoi, trigon: the Voronoi cells before splitting;
+    ///          delaunay: the triangles).
+    enum class SizeMeasure { feret, area };
     Kind kind = Kind::voronoi;
-    /// Mean block size d (m): the diameter of the circle with the mean block area
-    /// (voronoi, trigon: of the Voronoi cells before splitting; delaunay: of the
-    /// triangles). hexagonal: lattice spacing. brick: brick height.
+    /// Mean block size d (m), measured as `size_measure` says (random patterns);
+    /// hexagonal: lattice spacing; brick: brick height.
     double size = 0.0;
+    SizeMeasure size_measure = SizeMeasure::feret;
     int lloyd_iterations = 0;
     /// Edges shorter than this are collapsed (m); < 0 = default 0.1 × size.
     double min_edge = -1.0;

@@ -43,6 +43,25 @@ ModelGeometrySpec one(RegionSpec r) {
     return m;
 }
 
+/// Mean Feret diameter of the blocks of `region` whose whole boundary is jointed
+/// to blocks of the same region (the others are cut by its outline).
+double interior_feret(const BlockAssembly& a, int region) {
+    std::vector<double> jointed(a.block_count(), 0.0);
+    for (const auto& j : a.joints)
+        if (a.region[j.block_a] == region && a.region[j.block_b] == region)
+            jointed[j.block_a] += j.length(), jointed[j.block_b] += j.length();
+    double sum = 0.0;
+    int n = 0;
+    for (int b = 0; b < a.block_count(); ++b) {
+        if (a.region[b] != region) continue;
+        const auto p = a.block(b);
+        double perimeter = 0.0;
+        for (std::size_t i = 0; i < p.size(); ++i) perimeter += norm(p[(i + 1) % p.size()] - p[i]);
+        if (jointed[b] > perimeter * (1 - 1e-9)) sum += mean_feret_diameter(p), ++n;
+    }
+    return n ? sum / n : 0.0;
+}
+
 /// The paper's tunnel model (examples/tunnel_*.toml) built in code.
 ModelGeometrySpec tunnel(PatternSpec::Kind kind) {
     ModelGeometrySpec m;
@@ -50,7 +69,6 @@ ModelGeometrySpec tunnel(PatternSpec::Kind kind) {
     outer.minus = {"bonded"};
     auto bonded = rect_region("bonded", {0, -8}, {8, 8}, kind, 0.3, 7);
     bonded.minus = {"opening"};
-    bonded.pattern.lloyd_iterations = 2;
     RegionSpec opening;
     opening.name = "opening";
     opening.outline.kind = OutlineSpec::Kind::path;
@@ -150,6 +168,41 @@ TEST_CASE("polygon integrals are exact for a rectangle and a triangle") {
     CHECK(centroid(t).x == doctest::Approx(1e6 + 1.0).epsilon(1e-14));
 }
 
+TEST_CASE("mean Feret diameter: perimeter of the convex hull over pi") {
+    const std::vector<Vec2> square{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    CHECK(mean_feret_diameter(square) == doctest::Approx(4.0 / std::numbers::pi).epsilon(1e-14));
+    // An L-shape has the mean width of its hull (the unit square with a corner cut).
+    const std::vector<Vec2> ell{{0, 0}, {1, 0}, {1, 0.5}, {0.5, 0.5}, {0.5, 1}, {0, 1}};
+    CHECK(mean_feret_diameter(ell) == doctest::Approx((3.0 + std::sqrt(0.5)) / std::numbers::pi).epsilon(1e-14));
+    // A regular hexagon of side s: 6 s / π, against 1.82 s for the diameter of its area.
+    std::vector<Vec2> hex;
+    for (int k = 0; k < 6; ++k) hex.push_back({std::cos(k * std::numbers::pi / 3), std::sin(k * std::numbers::pi / 3)});
+    CHECK(mean_feret_diameter(hex) == doctest::Approx(6.0 / std::numbers::pi).epsilon(1e-14));
+}
+
+TEST_CASE("random patterns: size is the blocks' mean Feret diameter, or the diameter of their mean area") {
+    for (auto kind : {PatternSpec::Kind::voronoi, PatternSpec::Kind::trigon, PatternSpec::Kind::delaunay}) {
+        for (int lloyd : {0, 2}) {
+            INFO(std::string(to_string(kind)) << ", lloyd " << lloyd);
+            auto r = rect_region("rock", {0, 0}, {12, 12}, kind, 0.4, 5);
+            r.pattern.lloyd_iterations = lloyd;
+            const auto feret = generate_blocks(one(r));
+            CHECK(interior_feret(feret, 0) == doctest::Approx(0.4).epsilon(0.03));
+            check_tiling(feret, 144.0, 48.0);
+            r.pattern.size_measure = PatternSpec::SizeMeasure::area;
+            const auto area = generate_blocks(one(r));
+            // By area: Voronoi cells of that equal-area diameter; trigon splits such
+            // cells (about six triangles each). (Delaunay drops seeds closer than its
+            // hard core, so its triangles by area come out larger: tested below.)
+            if (kind == PatternSpec::Kind::voronoi)
+                CHECK(mean_block_size(area) == doctest::Approx(0.4).epsilon(0.05));
+            if (kind == PatternSpec::Kind::trigon)
+                CHECK(double(area.block_count()) / 6.0 ==
+                      doctest::Approx(144.0 / (std::numbers::pi * 0.04)).epsilon(0.1));
+        }
+    }
+}
+
 TEST_CASE("the paper's tunnel model tiles its 20 m x 40 m domain") {
     for (auto kind : {PatternSpec::Kind::voronoi, PatternSpec::Kind::trigon, PatternSpec::Kind::delaunay}) {
         INFO("pattern " << to_string(kind));
@@ -170,14 +223,15 @@ TEST_CASE("the paper's tunnel model tiles its 20 m x 40 m domain") {
             interface += j.tag == JointTag::interface;
         }
         CHECK(interface > 0);
+        // Blocks of 0.3 m average dimension (mean Feret diameter) away from the
+        // region's outline, which cuts the others.
+        CHECK(interior_feret(a, 1) == doctest::Approx(0.3).epsilon(0.03));
         if (kind == PatternSpec::Kind::voronoi) {
-            // ~1,450 blocks: 102.9 m² over the 0.0707 m² of a 0.3 m block.
-            int bonded = 0;
-            for (int r : a.region) bonded += r == 1;
-            CHECK(bonded == doctest::Approx(1455).epsilon(0.01));
-            CHECK(mean_block_size(a, 1) == doctest::Approx(0.3).epsilon(0.05));
-            CHECK(min_edge(a) >= 0.03 * (1 - 1e-12));
-            CHECK(st.short_edges_left == 0);
+            // A short edge is collapsed unless that would shrink a block by more than
+            // 3/4 or move the region's outline: with the cells of random points a
+            // couple of such edges remain at the opening, reported and just short.
+            CHECK(min_edge(a) >= 0.9 * 0.03);
+            CHECK(st.short_edges_left <= 4);
         }
     }
 }
@@ -186,6 +240,7 @@ TEST_CASE("voronoi: size, minimum edge and Lloyd relaxation") {
     for (int lloyd : {0, 3}) {
         auto r = rect_region("rock", {0, 0}, {10, 6}, PatternSpec::Kind::voronoi, 0.4, 11);
         r.holes.push_back(circle({5, 3}, 1.5));
+        r.pattern.size_measure = PatternSpec::SizeMeasure::area;
         r.pattern.lloyd_iterations = lloyd;
         r.pattern.min_edge = 0.06;
         GenerationStats st;
@@ -243,7 +298,9 @@ TEST_CASE("generation is reproducible from the seed") {
 }
 
 TEST_CASE("trigon: each Voronoi cell becomes as many triangles as it has vertices") {
+    // Sized by area, a trigon pattern splits the very cells of the Voronoi one.
     auto v = rect_region("rock", {0, 0}, {6, 4}, PatternSpec::Kind::voronoi, 0.5, 9);
+    v.pattern.size_measure = PatternSpec::SizeMeasure::area;
     auto t = v;
     t.pattern.kind = PatternSpec::Kind::trigon;
     const auto cells = generate_blocks(one(v));
@@ -301,6 +358,7 @@ TEST_CASE("brick: running bond gives T-junction joints, stack bond full edges") 
 
 TEST_CASE("delaunay: triangles of the target mean size with no short edges") {
     auto r = rect_region("rock", {0, 0}, {8, 6}, PatternSpec::Kind::delaunay, 0.4, 4);
+    r.pattern.size_measure = PatternSpec::SizeMeasure::area;
     GenerationStats st;
     const auto a = generate_blocks(one(r), &st);
     check_tiling(a, 48.0, 28.0);
