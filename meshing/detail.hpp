@@ -64,7 +64,8 @@ FaceFill fill_face(const cgal::PolygonWithHoles& face, const PatternSpec& patter
 
 /// The pattern the generators run with: `size` as the diameter of the mean area of
 /// their cells (SizeMeasure::area). A size given as a mean Feret diameter is
-/// converted with the ratio measured on a reference patch of the same pattern.
+/// converted with the ratio measured on a reference patch of the same pattern
+/// (same settings, a fixed seed).
 PatternSpec generator_pattern(const PatternSpec& pattern);
 
 /// Collapses edges shorter than min_edge; shared vertices move together so the

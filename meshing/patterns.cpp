@@ -296,20 +296,21 @@ PatternSpec generator_pattern(const PatternSpec& p) {
     if (!random || p.size_measure == PatternSpec::SizeMeasure::area) return p;
     // The mean Feret diameter of the blocks is proportional to the generator's size
     // (same seeds, scaled), so their ratio is a property of the pattern: measured on
-    // a square patch of about 600 cells with the same settings, its blocks clear of
-    // the patch's sides (cut blocks are smaller). The minimum edge stays the one of
-    // the size asked for. Two passes: the first guess (typical ratios) only sets the
-    // scale of the minimum edge relative to the cells.
+    // a square patch of about 1,500 cells with the same settings, its blocks clear
+    // of the patch's sides (cut blocks are smaller), always with the same seed, so
+    // that every realization of a pattern gets the same number of cells per area.
+    // The minimum edge stays the one of the size asked for. Two passes: the first
+    // guess (typical ratios) only sets the scale of the minimum edge.
     PatternSpec q = p;
     q.size_measure = PatternSpec::SizeMeasure::area;
     q.min_edge = min_edge_of(p);
     double ratio = p.kind == K::trigon ? 0.6 : (p.kind == K::delaunay ? 1.35 : 1.13);
     for (int pass = 0; pass < 2; ++pass) {
         q.size = p.size / ratio;
-        const double side = q.size * std::sqrt(600.0 * std::numbers::pi / 4.0);
+        const double side = q.size * std::sqrt(1500.0 * std::numbers::pi / 4.0);
         PolygonWithHoles patch;
         patch.outer = {{0.0, 0.0}, {side, 0.0}, {side, side}, {0.0, side}};
-        Random rng(q.seed ^ 0x5eed5eed5eed5eedull);
+        Random rng(0x5eed5eed5eed5eedull);
         const FaceFill fill = fill_face(patch, q, rng);
         const double margin = 1e-9 * side;
         double sum = 0.0;
