@@ -392,20 +392,28 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
     o.realizations = c.realizations;
     o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     o.max_iterations = iterations;
+    // SPEC §8's first estimates, kn = E/d and ks = G/d, for reference; the iteration
+    // starts from the lattice inversion on the generated blocks (calibrate.hpp).
+    const double first_kn = targets.E / o.base.size, first_ks = targets.E / (2.0 * (1.0 + targets.nu)) / o.base.size;
+    const JointPropertySpec start = calibration_start(targets, o);
     fs::create_directories(out);
-    if (!quiet)
+    const bool with_phi = targets.biaxial > 0.0;
+    if (!quiet) {
         std::fprintf(stderr,
                      "bbm calibrate: %s blocks of %.3g m, %g m x %g m, %d realizations of UCS and direct tension per "
-                     "iteration\ntargets: E %.4g GPa, nu %.3g, UCS %.4g MPa, tensile %.4g MPa\n"
-                     "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n",
+                     "iteration\ntargets: E %.4g GPa, nu %.3g, UCS %.4g MPa, tensile %.4g MPa\n",
                      c.pattern.c_str(), o.base.size, o.base.width, o.base.height, o.realizations, targets.E / 1e9,
-                     targets.nu, targets.ucs / 1e6, targets.tensile / 1e6, "iter", "kn GPa/m", "ks GPa/m", "st MPa",
-                     "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
-    const bool with_phi = targets.biaxial > 0.0;
-    if (!quiet && with_phi)
-        std::fprintf(stderr, "and biaxial strength %.4g MPa at %.4g MPa confinement: friction angle calibrated too "
-                             "(phi and sigma1 at the end of each row)\n",
-                     targets.biaxial / 1e6, targets.confinement / 1e6);
+                     targets.nu, targets.ucs / 1e6, targets.tensile / 1e6);
+        if (with_phi)
+            std::fprintf(stderr, "and biaxial strength %.4g MPa at %.4g MPa confinement: friction angle calibrated too "
+                                 "(phi and sigma1 at the end of each row)\n",
+                         targets.biaxial / 1e6, targets.confinement / 1e6);
+        std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start (lattice inversion on the "
+                             "generated blocks) kn %.2f, ks %.2f GPa/m\n",
+                     first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9);
+        std::fprintf(stderr, "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n", "iter", "kn GPa/m", "ks GPa/m",
+                     "st MPa", "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
+    }
     nlohmann::json table = nlohmann::json::array();
     int k = 0;
     const auto iterations_done = calibrate(targets, o, [&](const CalibrationIteration& it) {
@@ -476,6 +484,9 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
                                              {"lloyd", o.base.lloyd},
                                              {"realizations", o.realizations},
                                              {"converged", last.converged},
+                                             {"first_estimate", {{"kn", first_kn}, {"ks", first_ks}}},
+                                             {"start", {{"kn", start.kn}, {"ks", start.ks}, {"tensile", start.tensile},
+                                                        {"cohesion", start.cohesion}}},
                                              {"fresh_seeds", {{"first_seed", o.base.seed + 1000}, {"E", fresh.E},
                                                               {"E_ucs_curve", fresh.E_test}, {"nu", fresh.nu},
                                                               {"ucs", fresh.ucs}, {"ucs_std", fresh.ucs_std},
