@@ -72,7 +72,7 @@ name = "bonded"
 outline = { type = "rectangle", min = [0.0, -8.0], max = [8.0, 8.0] }
 holes = [ { type = "circle", center = [6.0, 6.0], radius = 0.5, max_segment = 0.05 } ]
 minus = ["opening"]
-pattern = { type = "voronoi", size = 0.3, lloyd = 2, min_edge = 0.03, seed = 7 }
+pattern = { type = "voronoi", size = 0.3, size_measure = "area", lloyd = 2, min_edge = 0.03, seed = 7 }
 joints = [ { from = [0.0, -6.0], to = [8.0, -5.0] } ]
 
 [[region.joint_set]]
@@ -124,6 +124,7 @@ TEST_CASE("a complete model file reads into the geometry description") {
     CHECK(bonded.minus == std::vector<std::string>{"opening"});
     CHECK(bonded.pattern.kind == PatternSpec::Kind::voronoi);
     CHECK(bonded.pattern.size == 0.3);
+    CHECK(bonded.pattern.size_measure == PatternSpec::SizeMeasure::area);
     CHECK(bonded.pattern.lloyd_iterations == 2);
     CHECK(bonded.pattern.min_edge == 0.03);
     CHECK(bonded.pattern.seed == 7);
@@ -151,6 +152,7 @@ TEST_CASE("a complete model file reads into the geometry description") {
     CHECK_FALSE(opening.outline.steps[0].clockwise);
     CHECK(opening.outline.max_segment == 0.0); // the model's default
     CHECK(opening.pattern.lloyd_iterations == 0);
+    CHECK(opening.pattern.size_measure == PatternSpec::SizeMeasure::feret); // the default
     CHECK(opening.pattern.min_edge < 0.0); // default: 0.1 x size, applied by meshing/
     CHECK(opening.pattern.seed == 1);
     CHECK(opening.joint_sets.empty());
@@ -267,6 +269,19 @@ outline = { type = "circle", center = [0, 0], radius = 1 }
 pattern = { type = "hexagonal", size = 0.3, lloyd = 2 }
 )",
                 "lloyd", "region[0].pattern.lloyd", "does not apply to a hexagonal pattern");
+    check_error(R"([[region]]
+name = "a"
+outline = { type = "circle", center = [0, 0], radius = 1 }
+pattern = { type = "voronoi", size = 0.3, size_measure = "diameter" }
+)",
+                "size_measure", "region[0].pattern.size_measure",
+                "unknown size measure 'diameter'; expected one of: feret, area");
+    check_error(R"([[region]]
+name = "a"
+outline = { type = "circle", center = [0, 0], radius = 1 }
+pattern = { type = "brick", size = 0.3, size_measure = "area" }
+)",
+                "size_measure", "region[0].pattern.size_measure", "does not apply to a brick pattern");
     check_error(R"([[region]]
 name = "a"
 outline = { type = "rectangle", min = [0, 0], max = [1, 1], radius = 1 }
