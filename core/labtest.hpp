@@ -49,7 +49,7 @@ struct LabTestOptions {
     /// diameter, the paper's "average dimension".
     meshing::PatternSpec::SizeMeasure size_measure = meshing::PatternSpec::SizeMeasure::feret;
     /// Lloyd iterations: 0 = the Voronoi cells of random points, as the paper's
-    /// "randomly generated" blocks (relaxed cells are ~15% stronger: docs/calibration.md).
+    /// "randomly generated" blocks (relaxed cells are ~20% stronger: docs/calibration.md).
     int lloyd = 0;
     std::uint64_t seed = 1;
     JointPropertySpec joint;            ///< the bond (law softening by default: paper values)

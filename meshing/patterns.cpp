@@ -321,7 +321,7 @@ PatternSpec generator_pattern(const PatternSpec& p) {
             });
             if (!cut) sum += mean_feret_diameter(poly), ++n;
         }
-        if (n == 0) break; // cannot happen with ~600 cells; keep the first guess
+        if (n == 0) break; // cannot happen with ~1,500 cells; keep the first guess
         ratio = sum / n / q.size;
     }
     q.size = p.size / ratio;
