@@ -408,9 +408,9 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
             std::fprintf(stderr, "and biaxial strength %.4g MPa at %.4g MPa confinement: friction angle calibrated too "
                                  "(phi and sigma1 at the end of each row)\n",
                          targets.biaxial / 1e6, targets.confinement / 1e6);
-        std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start (lattice inversion on the "
-                             "generated blocks) kn %.2f, ks %.2f GPa/m\n",
-                     first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9);
+        std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start kn %.2f, ks %.2f GPa/m (%s)\n",
+                     first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9,
+                     o.start_kn || o.start_ks ? "as given" : "lattice inversion on the generated blocks");
         std::fprintf(stderr, "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n", "iter", "kn GPa/m", "ks GPa/m",
                      "st MPa", "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
     }
