@@ -18,10 +18,6 @@ EdgeFrame frame(Vec2 x, Vec2 p, Vec2 q) {
     return {dot(x - p, d) / l2, cross(d, x - p) / -l};
 }
 
-std::uint64_t pair_key(int a, int b) {
-    return (std::uint64_t(std::uint32_t(std::min(a, b))) << 32) | std::uint32_t(std::max(a, b));
-}
-
 int prev_vertex(const std::uint32_t* first, int block, int v) {
     return v == int(first[block]) ? int(first[block + 1]) - 1 : v - 1;
 }
@@ -126,7 +122,7 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
     std::unordered_map<std::uint64_t, std::vector<Vec2>> existing;
     for (int i = 0; i < c.size(); ++i)
         if (is_active(c.vertex_block[i]) || is_active(c.edge_block[i]))
-            existing[pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
+            existing[block_pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
 
     // 3. Broad phase: inflated boxes in a uniform grid. A block with many vertices
     // (a deformable block's boundary, hundreds of nodes) enters as chunks of at
@@ -203,7 +199,7 @@ DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
                     if (norm(x - touched) <= tol) continue;
                 }
             }
-            auto& points = existing[pair_key(A, B)];
+            auto& points = existing[block_pair_key(A, B)];
             bool known = false;
             for (Vec2 p : points) known = known || norm(p - x) <= tol;
             if (known) continue;
