@@ -174,12 +174,13 @@ public:
         write_text_atomically(out_ / "checkpoint.bin", o.str());
     }
     /// Reads the run part of a checkpoint; the solver part follows in the stream.
-    static std::string read_model_name(std::istream& i, int& threads) {
+    /// (The thread count it records is informational: results do not depend on it.)
+    static std::string read_model_name(std::istream& i) {
         std::string magic(std::char_traits<char>::length(checkpoint_magic), '\0');
         i.read(magic.data(), std::streamsize(magic.size()));
         if (!i || magic != checkpoint_magic) throw std::runtime_error("not a bbm checkpoint");
         std::string model = get_string(i);
-        threads = get<int>(i);
+        (void)get<int>(i);
         return model;
     }
     void restore(std::istream& i) {
@@ -282,13 +283,12 @@ int run_model(const RunOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     std::string model_path = opt.model;
     std::ifstream checkpoint;
-    int saved_threads = opt.threads;
     if (opt.resume) {
         checkpoint.open(opt.out / "checkpoint.bin", std::ios::binary);
         if (!checkpoint)
             throw InputError((opt.out / "checkpoint.bin").string(), 0, "",
                              "no checkpoint to resume from (run with --checkpoint-every N, or stop a run with Ctrl-C)");
-        model_path = RunOutput::read_model_name(checkpoint, saved_threads);
+        model_path = RunOutput::read_model_name(checkpoint);
     }
     io::ModelFile model = io::read_model(model_path);
     model.analysis.solver.threads = opt.threads;
@@ -317,9 +317,6 @@ int run_model(const RunOptions& opt) {
     RunOutput output(opt.out, model.analysis, *solver, opt, fs::absolute(model_path).string());
     StageCursor start;
     if (opt.resume) {
-        if (saved_threads != opt.threads && !opt.quiet)
-            std::fprintf(stderr, "note: the checkpoint was written with --threads %d; continuing with %d gives a "
-                                 "valid but not bit-identical result\n", saved_threads, opt.threads);
         output.restore(checkpoint);
         solver->load_state(checkpoint);
         start = output.cursor();

@@ -1,9 +1,10 @@
 #include "contact/contacts.hpp"
 
 #include <algorithm>
+#include <numeric>
+#include <tuple>
 #include <span>
 
-#include <omp.h>
 #include <cmath>
 
 namespace bbm::contact {
@@ -41,11 +42,85 @@ void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
     normal.resize(out);
 }
 
-void Contacts::rebuild_batches(int property_sets, const std::uint8_t* deformable) {
-    batches.assign(2 * property_sets, {});
-    for (int i = 0; i < size(); ++i) {
-        const bool mixed = deformable && (deformable[vertex_block[i]] || deformable[edge_block[i]]);
+bool Contacts::sort_by_blocks() {
+    const int n = size();
+    auto key = [&](int i) {
+        const int a = vertex_block[i], b = edge_block[i];
+        return std::tuple{std::min(a, b), std::max(a, b), vertex_id[i], edge_id[i]};
+    };
+    bool sorted = true;
+    for (int i = 1; i < n && sorted; ++i) sorted = !(key(i) < key(i - 1));
+    if (sorted) return false;
+    fill_.resize(n);
+    std::iota(fill_.begin(), fill_.end(), 0);
+    std::sort(fill_.begin(), fill_.end(), [&](int i, int j) { return key(i) < key(j); });
+    // Apply the permutation in place, cycle by cycle (new position k takes the
+    // contact at fill_[k]); a visited cycle is marked by negating its entries.
+    for (int start = 0; start < n; ++start) {
+        if (fill_[start] < 0 || fill_[start] == start) continue;
+        auto rotate_cycle = [&](auto& v) {
+            auto held = v[start];
+            int k = start;
+            while (fill_[k] != start) {
+                v[k] = v[fill_[k]];
+                k = fill_[k];
+            }
+            v[k] = held;
+        };
+        rotate_cycle(vertex_block), rotate_cycle(vertex_id), rotate_cycle(edge_block), rotate_cycle(edge_id);
+        rotate_cycle(edge_end), rotate_cycle(length), rotate_cycle(property), rotate_cycle(history);
+        rotate_cycle(normal);
+        for (int k = start; fill_[k] >= 0;) {
+            const int next = fill_[k];
+            fill_[k] = -1 - next;
+            k = next;
+        }
+    }
+    return true;
+}
+
+void Contacts::rebuild_index(int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
+                             const int* vertex_node) {
+    const int n = size();
+    auto is_deformable = [&](int blk) { return deformable && deformable[blk]; };
+    batches.resize(2 * property_sets);
+    for (auto& batch : batches) batch.clear();
+    for (int i = 0; i < n; ++i) {
+        const bool mixed = is_deformable(vertex_block[i]) || is_deformable(edge_block[i]);
         batches[2 * property[i] + (mixed ? 1 : 0)].push_back(i);
+    }
+    work.clear();
+    for (int k = 0; k < int(batches.size()); ++k)
+        for (int begin = 0; begin < int(batches[k].size()); begin += work_item_size)
+            work.push_back({k, begin, std::min(int(batches[k].size()), begin + work_item_size)});
+    force.resize(n);
+    partial_sum.resize(work.size());
+
+    // Per-block and per-node lists in contact order: count, prefix sum, fill
+    // (`fill_` is kept between calls: this runs inside steps that change contacts).
+    block_first.assign(blocks + 1, 0);
+    node_first.assign(nodes + 1, 0);
+    for (int i = 0; i < n; ++i) {
+        ++block_first[vertex_block[i] + 1], ++block_first[edge_block[i] + 1];
+        if (is_deformable(vertex_block[i])) ++node_first[vertex_node[vertex_id[i]] + 1];
+        if (is_deformable(edge_block[i])) ++node_first[vertex_node[edge_id[i]] + 1], ++node_first[vertex_node[edge_end[i]] + 1];
+    }
+    for (int k = 0; k < blocks; ++k) block_first[k + 1] += block_first[k];
+    for (int k = 0; k < nodes; ++k) node_first[k + 1] += node_first[k];
+    block_entry.resize(block_first[blocks]);
+    node_entry.resize(node_first[nodes]);
+    fill_.assign(block_first.begin(), block_first.end() - 1);
+    for (int i = 0; i < n; ++i) {
+        block_entry[fill_[vertex_block[i]]++] = 2 * i;
+        block_entry[fill_[edge_block[i]]++] = 2 * i + 1;
+    }
+    fill_.assign(node_first.begin(), node_first.end() - 1);
+    for (int i = 0; i < n; ++i) {
+        if (is_deformable(vertex_block[i])) node_entry[fill_[vertex_node[vertex_id[i]]]++] = 4 * i;
+        if (is_deformable(edge_block[i])) {
+            node_entry[fill_[vertex_node[edge_id[i]]]++] = 4 * i + 1;
+            node_entry[fill_[vertex_node[edge_end[i]]]++] = 4 * i + 2;
+        }
     }
 }
 
@@ -54,16 +129,15 @@ void update_normals(Contacts& c, const BlockView& b, double corner_radius) {
 }
 
 namespace {
-// The fused loop reads everything through local restrict pointers: through the
-// Contacts members the compiler must assume the force stores alias them and would
+// The first pass reads everything through local restrict pointers: through the
+// Contacts members the compiler must assume the stores alias them and would
 // reload every base pointer on every contact. `Mixed` batches have a deformable
 // side: the vertex velocity comes from its node, the edge velocity is interpolated
-// between the edge's nodes, and the forces go to those nodes with the same weights
-// (so the contact does no work the nodes do not see).
+// between the edge's nodes (weights w), and the gather splits the force to those
+// nodes with the same weights (so the contact does no work the nodes do not see).
 template <bool Mixed, class Law>
-double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const BlockView& b, double dt,
-                  double corner_radius, Vec2* __restrict force, double* __restrict moment,
-                  Vec2* __restrict node_force) {
+double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const BlockView& b, double dt,
+                    double corner_radius) {
     const int* __restrict va = c.vertex_block.data();
     const int* __restrict vid = c.vertex_id.data();
     const int* __restrict eb = c.edge_block.data();
@@ -71,11 +145,9 @@ double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const B
     const int* __restrict e1 = c.edge_end.data();
     const double* __restrict len = c.length.data();
     JointHistory* __restrict hist = c.history.data();
-    Vec2* __restrict normal = c.normal.data();
+    ContactForce* __restrict out = c.force.data();
     const Vec2* __restrict vertex = b.vertex;
-    const Vec2* __restrict centroid = b.centroid;
-    const Vec2* __restrict velocity = b.velocity;
-    const double* __restrict omega = b.omega;
+    const BodyState* __restrict body = b.body;
     const double* __restrict inv_edge = b.inv_edge_length;
     double sum = 0.0;
     const std::size_t count = ids.size();
@@ -83,12 +155,13 @@ double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const B
         const int i = ids[k];
         // The block and vertex data a few contacts ahead are random gathers: ask for
         // them early (measured: the loop is bound by these loads, not arithmetic).
-        if (k + 8 < count) {
-            const int j = ids[k + 8];
+        if (k + 32 < count) {
+            const int j = ids[k + 32];
             __builtin_prefetch(&vertex[vid[j]]);
             __builtin_prefetch(&vertex[e0[j]]);
-            __builtin_prefetch(&velocity[eb[j]]);
-            __builtin_prefetch(&force[eb[j]], 1);
+            __builtin_prefetch(&inv_edge[e0[j]]);
+            __builtin_prefetch(&body[va[j]]);
+            __builtin_prefetch(&body[eb[j]]);
         }
         const int A = va[i], B = eb[i];
         const Vec2 x = vertex[vid[i]], p = vertex[e0[i]], q = vertex[e1[i]];
@@ -102,100 +175,46 @@ double step_batch(const Law& law, std::span<const int> ids, Contacts& c, const B
             const double rl = norm(r);
             if (rl > 0.0) n = r / rl, t = Vec2{-n.y, n.x};
         }
-        const Vec2 ra = x - centroid[A], rb = x - centroid[B];
+        const BodyState& bA = body[A];
+        const BodyState& bB = body[B];
+        const Vec2 ra = x - bA.centroid, rb = x - bB.centroid;
         Vec2 vr;
         if constexpr (Mixed)
             vr = vertex_velocity(b, A, vid[i], x) - edge_velocity(b, B, e0[i], e1[i], s, x);
         else
-            vr = (velocity[A] + omega[A] * perp(ra)) - (velocity[B] + omega[B] * perp(rb));
+            vr = (bA.velocity + bA.omega * perp(ra)) - (bB.velocity + bB.omega * perp(rb));
         const double du_n = dot(vr, n) * dt, du_s = dot(vr, t) * dt;
-        normal[i] = n;
         law.update(h, du_n, du_s);
         const Vec2 f = len[i] * (h.sn * n - h.tau * t);
-        if constexpr (Mixed) {
-            if (b.deformable[A]) {
-                node_force[b.vertex_node[vid[i]]] += f;
-            } else {
-                force[A] += f;
-                moment[A] += cross(ra, f);
-            }
-            if (b.deformable[B]) {
-                const double w = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
-                node_force[b.vertex_node[e0[i]]] -= (1.0 - w) * f;
-                node_force[b.vertex_node[e1[i]]] -= w * f;
-            } else {
-                force[B] -= f;
-                moment[B] -= cross(rb, f);
-            }
-        } else {
-            force[A] += f;
-            moment[A] += cross(ra, f);
-            force[B] -= f;
-            moment[B] -= cross(rb, f);
-        }
+        double moment_b = -cross(rb, f);
+        if constexpr (Mixed)
+            if (b.deformable[B]) moment_b = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+        out[i] = {f, {cross(ra, f), moment_b}};
         sum += norm2(f);
     }
     return sum;
 }
 } // namespace
 
-double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                     double corner_radius, const ForceTargets& out, int threads, ThreadForces& scratch) {
-    auto run = [&](std::size_t k, std::size_t begin, std::size_t end, Vec2* f, double* m, Vec2* nf) {
-        const std::span<const int> ids(c.batches[k].data() + begin, end - begin);
-        return std::visit(
+void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
+                  double corner_radius) {
+    const int items = int(c.work.size());
+#pragma omp for schedule(dynamic, 1) nowait
+    for (int w = 0; w < items; ++w) {
+        const auto& item = c.work[w];
+        const std::span<const int> ids(c.batches[item.batch].data() + item.begin, item.end - item.begin);
+        c.partial_sum[w] = std::visit(
             [&](const auto& law) {
-                return k % 2 ? step_batch<true>(law, ids, c, b, dt, corner_radius, f, m, nf)
-                             : step_batch<false>(law, ids, c, b, dt, corner_radius, f, m, nf);
+                return item.batch % 2 ? batch_pass<true>(law, ids, c, b, dt, corner_radius)
+                                      : batch_pass<false>(law, ids, c, b, dt, corner_radius);
             },
-            laws[k / 2]);
-    };
-    if (threads <= 1) {
-        double sum = 0.0;
-        for (std::size_t k = 0; k < c.batches.size(); ++k)
-            sum += run(k, 0, c.batches[k].size(), out.force, out.moment, out.node_force);
-        return sum;
+            laws[item.batch / 2]);
     }
-    const std::size_t nb = std::size_t(out.blocks), nn = std::size_t(out.nodes);
-    if (scratch.force.size() != nb * threads || scratch.node_force.size() != nn * threads) {
-        scratch.force.assign(nb * threads, {});
-        scratch.moment.assign(nb * threads, 0.0);
-        scratch.node_force.assign(nn * threads, {});
-        scratch.sum.assign(threads, 0.0);
-    }
-#pragma omp parallel num_threads(threads)
-    {
-        const int t = omp_get_thread_num();
-        Vec2* f = scratch.force.data() + nb * t;
-        double* m = scratch.moment.data() + nb * t;
-        Vec2* nf = scratch.node_force.data() + nn * t;
-        std::fill(f, f + nb, Vec2{});
-        std::fill(m, m + nb, 0.0);
-        std::fill(nf, nf + nn, Vec2{});
-        double sum = 0.0;
-        for (std::size_t k = 0; k < c.batches.size(); ++k) {
-            const std::size_t n = c.batches[k].size();
-            sum += run(k, n * t / threads, n * (t + 1) / threads, f, m, nf);
-        }
-        scratch.sum[t] = sum;
-#pragma omp barrier
-#pragma omp for schedule(static)
-        for (std::size_t k = 0; k < nb; ++k) {
-            Vec2 fs{};
-            double ms = 0.0;
-            for (int u = 0; u < threads; ++u) fs += scratch.force[nb * u + k], ms += scratch.moment[nb * u + k];
-            out.force[k] += fs;
-            out.moment[k] += ms;
-        }
-#pragma omp for schedule(static)
-        for (std::size_t k = 0; k < nn; ++k) {
-            Vec2 fs{};
-            for (int u = 0; u < threads; ++u) fs += scratch.node_force[nn * u + k];
-            out.node_force[k] += fs;
-        }
-    }
+}
+
+double contact_force_squares(const Contacts& c) {
     double sum = 0.0;
-    for (int u = 0; u < threads; ++u) sum += scratch.sum[u];
+    for (double s : c.partial_sum) sum += s;
     return sum;
 }
 

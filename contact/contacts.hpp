@@ -24,6 +24,12 @@
 // Storage is flat (structure of arrays) and indexed by contact id; histories are
 // one fixed record per contact (contact/joint_law.hpp). Contacts are grouped in
 // batches of one property set so that each law is dispatched once per batch.
+//
+// Determinism: a block's force is the sum of its contacts' forces in contact-id
+// order, whatever the number of threads (step_contacts computes every contact's
+// force first, then gathers per block), so a run gives the same bits on 1 or 64
+// threads — failure is chaotic, and a result that depends on the partition of the
+// work cannot be reproduced on another machine.
 #pragma once
 
 #include "contact/joint_law.hpp"
@@ -34,9 +40,20 @@
 
 namespace bbm::contact {
 
+/// What the contact loop reads of a block, packed into one 48-byte record so
+/// that a contact touches one cache line per block, not one per array (the
+/// solver refreshes it from its arrays at the start of every step).
+struct BodyState {
+    Vec2 centroid, velocity;
+    double omega;
+    double pad_ = 0.0;
+};
+static_assert(sizeof(BodyState) == 48);
+
 /// The geometry the contact kernels read: flat per-block and per-vertex arrays
 /// owned by the solver (core/solver.hpp).
 struct BlockView {
+    const BodyState* body;    ///< per block, packed copy of the three arrays below
     const Vec2* centroid;     ///< per block
     const Vec2* velocity;     ///< per block
     const double* omega;      ///< per block
@@ -63,6 +80,16 @@ inline Vec2 edge_velocity(const BlockView& b, int blk, int e0, int e1, double s,
     return (1.0 - w) * b.node_velocity[b.vertex_node[e0]] + w * b.node_velocity[b.vertex_node[e1]];
 }
 
+/// Stage 2's first pass writes one record per contact; the second pass gathers
+/// them per block and per node (see step_contacts).
+struct ContactForce {
+    Vec2 force; ///< on the vertex block A (B gets −force)
+    /// [0]: moment about A's centroid (rigid A); [1]: about B's centroid, of −force
+    /// (rigid B) — on a deformable B instead the weight w of its edge's second node
+    /// (the first gets 1 − w). Indexed by the side bit of a block entry.
+    double moment[2];
+};
+
 struct Contacts {
     // Topology (cold).
     std::vector<int> vertex_block, vertex_id; ///< A and the global id of its vertex
@@ -71,18 +98,47 @@ struct Contacts {
     std::vector<double> length;               ///< L, m
     std::vector<int> property;                ///< property set (index into the law table)
     std::vector<JointHistory> history;
-    /// Current normal n (written every step); the tangent is t = (−n.y, n.x).
+    /// Normal n as of the last step (written by update_normals; the step itself
+    /// does not store it); the tangent is t = (−n.y, n.x).
     std::vector<Vec2> normal;
-    /// Contacts by property set and kind, rebuilt when contacts are added or
-    /// removed: batch 2p holds the rigid–rigid contacts of set p (the fast kernel),
-    /// batch 2p+1 those with a deformable side.
+
+    // Derived index, rebuilt by rebuild_index() whenever contacts are added or removed.
+    /// Contacts by property set and kind: batch 2p holds the rigid–rigid contacts
+    /// of set p (the fast kernel), batch 2p+1 those with a deformable side.
     std::vector<std::vector<int>> batches;
+    /// Fixed pieces of the batches (at most `work_item_size` contacts each): the
+    /// units of parallel work, and of the partial sums of Σ|F|², so that neither
+    /// depends on the thread count.
+    struct WorkItem {
+        int batch, begin, end;
+    };
+    static constexpr int work_item_size = 512;
+    std::vector<WorkItem> work;
+    /// Per block, the contacts it takes part in, in contact order (CSR): entry
+    /// 2·contact + side, side 0 = the block is A, 1 = it is B. Rigid blocks gather
+    /// their forces from it; detection finds a block's contacts in it.
+    std::vector<int> block_first, block_entry;
+    /// Per FE node likewise: entry 4·contact + role, role 0 = A's vertex node
+    /// (+F), 1 = first node of B's edge (−(1−w)F), 2 = second node (−wF).
+    std::vector<int> node_first, node_entry;
+    // Per-step scratch of step_contacts (sized by rebuild_index, never in a step).
+    std::vector<ContactForce> force;
+    std::vector<double> partial_sum; ///< per work item
+    std::vector<int> fill_;          ///< rebuild_index's cursor
 
     int size() const { return static_cast<int>(length.size()); }
     void add(int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h);
     void remove_if_flagged(const std::vector<std::uint8_t>& remove);
-    /// `deformable`: per block, non-zero for deformable blocks (null = all rigid).
-    void rebuild_batches(int property_sets, const std::uint8_t* deformable);
+    /// Renumbers the contacts in order of their block pair (lower block id first,
+    /// then the other; ties by vertex): with blocks numbered along a space-filling
+    /// curve, a contact's blocks then sit near those of the contacts before it, and
+    /// the loop reads them from cache. Returns whether anything moved.
+    bool sort_by_blocks();
+    /// Rebuilds batches, work items and the per-block and per-node index.
+    /// `deformable`: per block, non-zero for deformable blocks; `vertex_node`: per
+    /// vertex, its FE node (−1 on rigid blocks); both may be null for rigid models.
+    void rebuild_index(int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
+                       const int* vertex_node);
 };
 
 /// Global id of the vertex after `v` around its block.
@@ -123,32 +179,52 @@ inline Vec2 contact_force(const Contacts& c, int i) {
     return c.length[i] * (h.sn * n - h.tau * tangent_of(n));
 }
 
-/// Per-thread force accumulators for step_contacts, kept between steps (sized
-/// once, not allocated per step).
-struct ThreadForces {
-    std::vector<Vec2> force, node_force;
-    std::vector<double> moment, sum;
-};
+/// Stage 2 of a step, first pass: per contact (work items, each law dispatched
+/// once per batch) its kinematics, the law, and its force and moments into
+/// `c.force` — no contact writes anything another contact reads. An OpenMP
+/// work-sharing loop without a parallel region of its own and without a barrier
+/// at its end (`nowait`): a team calling it shares the work and must meet at a
+/// barrier before the gathers below; called outside a team it runs serially.
+void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
+                  double corner_radius);
 
-/// Force accumulators of stage 2: per block (force, moment) and per FE node.
-struct ForceTargets {
-    Vec2* force;
-    double* moment;
-    int blocks;
-    Vec2* node_force;
-    int nodes;
-};
+/// Second pass, per block: the force and moment of its contacts, summed in
+/// contact order — so the sum does not depend on which thread computed what.
+inline void block_contact_force(const Contacts& c, int block, Vec2& force, double& moment) {
+    const ContactForce* cf = c.force.data();
+    const int last = c.block_first[block + 1], entries = int(c.block_entry.size());
+    Vec2 f{};
+    double m = 0.0;
+    for (int e = c.block_first[block]; e < last; ++e) {
+        if (e + 32 < entries) __builtin_prefetch(&cf[c.block_entry[e + 32] >> 1]);
+        // Branch-free: the side bit picks the sign and the moment (a side is as
+        // good as random to the branch predictor).
+        const int entry = c.block_entry[e], side = entry & 1;
+        const ContactForce& r = cf[entry >> 1];
+        f += double(1 - 2 * side) * r.force;
+        m += r.moment[side];
+    }
+    force = f, moment = m;
+}
 
-/// Stage 2 of a step, fused per batch so each contact's data is loaded once:
-/// kinematics, the batch's law (one dispatch per batch), and the forces and
-/// moments added to the blocks' and nodes' accumulators (zeroed by the caller;
-/// a force on a deformable edge is split to its two nodes with the weights that
-/// interpolate the edge's velocity). Returns Σ|F|² over the contacts (the RMS
-/// contact force is the scale of the unbalanced-force ratio; squares spare a
-/// square root per contact). With threads > 1 each thread takes a contiguous part
-/// of every batch into its own accumulators, summed per block afterwards in thread
-/// order: results are deterministic for a given thread count.
-double step_contacts(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                     double corner_radius, const ForceTargets& out, int threads, ThreadForces& scratch);
+/// Per FE node likewise; a force on a deformable edge is split to its two nodes
+/// with the weights that interpolate the edge's velocity.
+inline Vec2 node_contact_force(const Contacts& c, int node) {
+    const ContactForce* cf = c.force.data();
+    Vec2 f{};
+    for (int e = c.node_first[node]; e < c.node_first[node + 1]; ++e) {
+        const int entry = c.node_entry[e], role = entry & 3;
+        const ContactForce& r = cf[entry >> 2];
+        const double w = r.moment[1];
+        const double weight = role == 0 ? 1.0 : (role == 1 ? -(1.0 - w) : -w);
+        f += weight * r.force;
+    }
+    return f;
+}
+
+/// Σ|F|² over the contacts of the last pass (the RMS contact force is the scale
+/// of the unbalanced-force ratio; squares spare a square root per contact): per
+/// work item, then over the items in order.
+double contact_force_squares(const Contacts& c);
 
 } // namespace bbm::contact

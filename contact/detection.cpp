@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <unordered_map>
 
 namespace bbm::contact {
@@ -75,168 +76,269 @@ std::vector<Junction> find_junctions(const std::vector<Vec2>& vertex, const std:
     return out;
 }
 
-DetectionResult update_contacts(Contacts& c, const DetectionInput& in) {
+bool Detector::known(const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) const {
+    // An existing contact of the pair (either way round) at this point? Searched
+    // among the contacts of the block that has fewer.
+    const Vec2 x = in.blocks.vertex[vertex];
+    const double tol2 = in.tolerance * in.tolerance;
+    const int a = vertex_block, b = edge_block;
+    const bool from_a = c.block_first[a + 1] - c.block_first[a] <= c.block_first[b + 1] - c.block_first[b];
+    const int own = from_a ? a : b, other = from_a ? b : a;
+    for (int e = c.block_first[own]; e < c.block_first[own + 1]; ++e) {
+        const int i = c.block_entry[e] >> 1;
+        const int partner = (c.block_entry[e] & 1) ? c.vertex_block[i] : c.edge_block[i];
+        if (partner != other || drop_[i]) continue;
+        if (norm2(in.blocks.vertex[c.vertex_id[i]] - x) <= tol2) return true;
+    }
+    return false;
+}
+
+Box2 Detector::current_box(const Piece& pc, const BlockView& b, double inflate) const {
+    // An edge's box holds both its ends: the next vertex closes it.
+    Box2 box;
+    for (std::uint32_t v = pc.v0; v < pc.v1; ++v) {
+        box.add(b.vertex[v]);
+        box.add(b.vertex[next_vertex(b.first, pc.block, int(v))]);
+    }
+    box.lo -= Vec2{inflate, inflate};
+    box.hi += Vec2{inflate, inflate};
+    return box;
+}
+
+void Detector::build_grid(const DetectionInput& in) {
+    // A block with many vertices (a deformable block's boundary, hundreds of
+    // nodes) enters as pieces of at most `chunk` consecutive vertices, each with
+    // its own box: otherwise its one box, as large as the model, would pair it
+    // with every block and the narrow phase would test every vertex against all
+    // its edges.
+    constexpr std::uint32_t chunk = 16;
+    const BlockView& b = in.blocks;
+    const int nb = in.block_count;
+    if (int(block_piece_.size()) != nb + 1) {
+        pieces_.clear();
+        block_piece_.assign(1, 0);
+        for (int k = 0; k < nb; ++k) {
+            for (std::uint32_t v0 = b.first[k]; v0 < b.first[k + 1]; v0 += chunk)
+                pieces_.push_back({k, v0, std::min(b.first[k + 1], v0 + chunk)});
+            block_piece_.push_back(int(pieces_.size()));
+        }
+    }
+    const int np = int(pieces_.size());
+    stored_.resize(np);
+    grid_box_ = Box2{};
+    double extent = 0.0;
+    int counted = 0;
+    for (int p = 0; p < np; ++p) {
+        if (in.removed && in.removed[pieces_[p].block]) continue;
+        stored_[p] = current_box(pieces_[p], b, in.tolerance);
+        extent += stored_[p].width() + stored_[p].height();
+        ++counted;
+    }
+    extent /= std::max(1, 2 * counted);
+    margin_ = std::max(4.0 * in.tolerance, 0.1 * extent);
+    for (int p = 0; p < np; ++p) {
+        if (in.removed && in.removed[pieces_[p].block]) continue;
+        stored_[p].lo -= Vec2{margin_, margin_};
+        stored_[p].hi += Vec2{margin_, margin_};
+        grid_box_.add(stored_[p].lo);
+        grid_box_.add(stored_[p].hi);
+    }
+    cell_ = std::max(extent + 2.0 * margin_, 1e-12);
+    nx_ = std::clamp(int(grid_box_.width() / cell_) + 1, 1, 1 << 14);
+    ny_ = std::clamp(int(grid_box_.height() / cell_) + 1, 1, 1 << 14);
+    auto for_cells = [&](const Box2& bx, auto&& visit) {
+        const int i0 = std::clamp(int((bx.lo.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
+        const int i1 = std::clamp(int((bx.hi.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
+        const int j0 = std::clamp(int((bx.lo.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
+        const int j1 = std::clamp(int((bx.hi.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
+        for (int j = j0; j <= j1; ++j)
+            for (int i = i0; i <= i1; ++i) visit(std::size_t(j) * nx_ + i);
+    };
+    // Counting sort of the pieces into the cells their stored boxes cover.
+    cell_first_.assign(std::size_t(nx_) * ny_ + 1, 0);
+    for (int p = 0; p < np; ++p)
+        if (!(in.removed && in.removed[pieces_[p].block])) for_cells(stored_[p], [&](std::size_t k) { ++cell_first_[k + 1]; });
+    for (std::size_t k = 0; k + 1 < cell_first_.size(); ++k) cell_first_[k + 1] += cell_first_[k];
+    cell_piece_.resize(cell_first_.back());
+    for (int p = 0; p < np; ++p)
+        if (!(in.removed && in.removed[pieces_[p].block]))
+            for_cells(stored_[p], [&](std::size_t k) { cell_piece_[cell_first_[k]++] = p; });
+    for (std::size_t k = cell_first_.size() - 1; k > 0; --k) cell_first_[k] = cell_first_[k - 1];
+    cell_first_[0] = 0;
+    grid_valid_ = true;
+    ++grid_builds_;
+}
+
+void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in) {
+    // Vertices of P against edges of Q.
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
-    DetectionResult res;
-
-    // 1–2. Transfer along the edge block's boundary, and removal of separated
-    // unbonded contacts.
-    std::vector<std::uint8_t> drop(c.size(), 0);
-    auto is_active = [&](int k) { return !in.active || in.active[k]; };
-    for (int i = 0; i < c.size(); ++i) {
-        const int A = c.vertex_block[i], B = c.edge_block[i];
-        if ((in.removed && (in.removed[A] || in.removed[B]))) {
-            drop[i] = 1;
-            continue;
+    const int A = P.block, B = Q.block;
+    for (std::uint32_t v = P.v0; v < P.v1; ++v) {
+        const Vec2 x = b.vertex[v];
+        if (x.x < q_box.lo.x || x.x > q_box.hi.x || x.y < q_box.lo.y || x.y > q_box.hi.y) continue;
+        int best = -1;
+        double best_gap = INFINITY;
+        for (std::uint32_t e = Q.v0; e < Q.v1; ++e) {
+            const int e1 = next_vertex(b.first, B, int(e));
+            const EdgeFrame f = frame(x, b.vertex[e], b.vertex[e1]);
+            const double len = 1.0 / b.inv_edge_length[e];
+            const double beyond = std::max({0.0, -f.s, f.s - 1.0}) * len;
+            if (f.gap > tol || f.gap < -tol || beyond > tol) continue;
+            const double dist = std::abs(f.gap) + beyond;
+            if (dist < best_gap) best_gap = dist, best = int(e);
         }
-        if (!is_active(A) && !is_active(B)) continue;
-        const Vec2 x = b.vertex[c.vertex_id[i]];
-        EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
-        if (c.history[i].bonded) continue; // intact joints keep their edges (contacts.hpp)
-        const double len = 1.0 / b.inv_edge_length[c.edge_id[i]];
-        if (std::max(-f.s, f.s - 1.0) * len > tol) {
-            const bool back = f.s < 0.0;
-            const int e0 = back ? prev_vertex(b.first, B, c.edge_id[i]) : c.edge_end[i];
-            const int e1 = back ? c.edge_id[i] : next_vertex(b.first, B, c.edge_end[i]);
-            const EdgeFrame g = frame(x, b.vertex[e0], b.vertex[e1]);
-            if (g.s >= 0.0 && g.s <= 1.0 && g.gap > -tol) {
-                c.edge_id[i] = e0;
-                c.edge_end[i] = e1;
-                f = g;
-                ++res.transferred;
+        if (best < 0) continue;
+        if (in.junctions) {
+            // Still on the point it touched in the tessellation?
+            const auto& J = *in.junctions;
+            const auto it = std::lower_bound(J.begin(), J.end(), Junction{int(v), B, 0, 0, 0.0});
+            if (it != J.end() && it->vertex == int(v) && it->block == B) {
+                const Vec2 touched = b.vertex[it->e0] + it->s * (b.vertex[it->e1] - b.vertex[it->e0]);
+                if (norm(x - touched) <= tol) continue;
             }
         }
-        const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
-        if (f.gap > tol || beyond > 2.0 * tol) drop[i] = 1;
+        const int e1 = next_vertex(b.first, B, best);
+        const Vec2 tb = b.inv_edge_length[best] * (b.vertex[e1] - b.vertex[best]);
+        // The vertex's share: half of its adjacent edge that lies most along B's edge.
+        const int vp = prev_vertex(b.first, A, int(v)), vn = next_vertex(b.first, A, int(v));
+        const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
+        const double l = 0.5 * (std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? norm(ep) : norm(en));
+        const Vec2 n{tb.y, -tb.x};
+        const double s_on = dot(x - b.vertex[best], tb) * b.inv_edge_length[best];
+        const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
+        const double un = frame(x, b.vertex[best], b.vertex[e1]).gap - dot(vr, n) * in.dt;
+        candidates_.push_back({block_pair_key(A, B), A, int(v), B, best, e1, l, un});
     }
-    for (int i = 0; i < c.size(); ++i) {
-        if (!drop[i]) continue;
+}
+
+DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
+    const BlockView& b = in.blocks;
+    const double tol = in.tolerance;
+    const int nb = in.block_count;
+    DetectionResult res;
+    auto is_active = [&](int k) { return (!in.active || in.active[k]) && !(in.removed && in.removed[k]); };
+    drop_.resize(c.size(), 0);
+    dropped_.clear();
+
+    // 1–2. Transfer along the edge block's boundary, and removal of separated
+    // unbonded contacts: the contacts of active blocks, each once (from its
+    // vertex block if that is active).
+    for (int k = 0; k < nb; ++k) {
+        if (!is_active(k)) continue;
+        for (int e = c.block_first[k]; e < c.block_first[k + 1]; ++e) {
+            const int i = c.block_entry[e] >> 1;
+            const int A = c.vertex_block[i], B = c.edge_block[i];
+            if (k == B && is_active(A)) continue;
+            if (c.history[i].bonded) continue; // intact joints keep their edges (contacts.hpp)
+            const Vec2 x = b.vertex[c.vertex_id[i]];
+            EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
+            const double len = 1.0 / b.inv_edge_length[c.edge_id[i]];
+            if (std::max(-f.s, f.s - 1.0) * len > tol) {
+                const bool back = f.s < 0.0;
+                const int e0 = back ? prev_vertex(b.first, B, c.edge_id[i]) : c.edge_end[i];
+                const int e1 = back ? c.edge_id[i] : next_vertex(b.first, B, c.edge_end[i]);
+                const EdgeFrame g = frame(x, b.vertex[e0], b.vertex[e1]);
+                if (g.s >= 0.0 && g.s <= 1.0 && g.gap > -tol) {
+                    c.edge_id[i] = e0;
+                    c.edge_end[i] = e1;
+                    f = g;
+                    ++res.transferred;
+                }
+            }
+            const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
+            if (f.gap > tol || beyond > 2.0 * tol) drop_[i] = 1, dropped_.push_back(i);
+        }
+    }
+
+    // 3. Broad phase from the active pieces; the grid is rebuilt first if one of
+    // them has left its stored box (with a quarter tolerance to spare: a block is
+    // checked again before it has moved that far).
+    bool stale = !grid_valid_;
+    for (int k = 0; k < nb && !stale; ++k) {
+        if (!is_active(k) || block_piece_.empty()) continue;
+        for (int p = block_piece_[k]; p < block_piece_[k + 1] && !stale; ++p) {
+            const Box2 box = current_box(pieces_[p], b, 1.25 * tol);
+            const Box2& s = stored_[p];
+            stale = box.lo.x < s.lo.x || box.lo.y < s.lo.y || box.hi.x > s.hi.x || box.hi.y > s.hi.y;
+        }
+    }
+    if (stale) build_grid(in);
+    candidates_.clear();
+    for (int k = 0; k < nb; ++k) {
+        if (!is_active(k)) continue;
+        for (int p = block_piece_[k]; p < block_piece_[k + 1]; ++p) {
+            const Box2 box = current_box(pieces_[p], b, tol);
+            const int i0 = std::clamp(int((box.lo.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
+            const int i1 = std::clamp(int((box.hi.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
+            const int j0 = std::clamp(int((box.lo.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
+            const int j1 = std::clamp(int((box.hi.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
+            near_.clear();
+            for (int j = j0; j <= j1; ++j)
+                for (int i = i0; i <= i1; ++i) {
+                    const std::size_t cell = std::size_t(j) * nx_ + i;
+                    for (int e = cell_first_[cell]; e < cell_first_[cell + 1]; ++e) {
+                        const int q = cell_piece_[e];
+                        const int other = pieces_[q].block;
+                        // A pair of active pieces is handled from its lower piece.
+                        if (other != k && !(is_active(other) && q < p)) near_.push_back(q);
+                    }
+                }
+            std::sort(near_.begin(), near_.end());
+            near_.erase(std::unique(near_.begin(), near_.end()), near_.end());
+            for (int q : near_) {
+                const Box2 q_box = current_box(pieces_[q], b, tol);
+                if (box.hi.x < q_box.lo.x || q_box.hi.x < box.lo.x || box.hi.y < q_box.lo.y || q_box.hi.y < box.lo.y)
+                    continue;
+                const Piece &P = pieces_[p], &Q = pieces_[q];
+                if (P.block < Q.block) {
+                    add_candidates(P, Q, q_box, in);
+                    add_candidates(Q, P, box, in);
+                } else {
+                    add_candidates(Q, P, box, in);
+                    add_candidates(P, Q, q_box, in);
+                }
+            }
+        }
+    }
+
+    // 4. Acceptance, pair by pair in the order the candidates came.
+    order_.resize(candidates_.size());
+    std::iota(order_.begin(), order_.end(), 0);
+    // By pair, then in the order they came (a total order: std::sort gives the same
+    // result as a stable sort, without the buffer std::stable_sort allocates).
+    std::sort(order_.begin(), order_.end(), [&](int x, int y) {
+        return candidates_[x].pair < candidates_[y].pair || (candidates_[x].pair == candidates_[y].pair && x < y);
+    });
+    accepted_.clear();
+    for (std::size_t k = 0; k < order_.size(); ++k) {
+        const Candidate& cand = candidates_[order_[k]];
+        if (k == 0 || candidates_[order_[k - 1]].pair != cand.pair) accepted_.clear();
+        if (known(c, cand.vertex_block, cand.vertex, cand.edge_block, in)) continue;
+        const Vec2 x = b.vertex[cand.vertex];
+        bool duplicate = false;
+        for (int a : accepted_) duplicate = duplicate || norm(b.vertex[candidates_[a].vertex] - x) <= tol;
+        if (duplicate) continue;
+        accepted_.push_back(order_[k]);
+        JointHistory h;
+        h.bonded = false;
+        h.un = cand.un;
+        c.add(cand.vertex_block, cand.vertex, cand.edge_block, cand.edge, cand.edge_end, cand.length,
+              in.new_contact_property, h);
+        drop_.push_back(0);
+        ++res.created;
+    }
+
+    for (int i : dropped_) {
         ++res.removed;
         res.removed_tensile += c.history[i].broken == JointState::broken_tension;
         res.removed_shear += c.history[i].broken == JointState::broken_shear;
     }
-    if (res.removed > 0) c.remove_if_flagged(drop);
-
-    // Existing contact points per block pair (either way round).
-    std::unordered_map<std::uint64_t, std::vector<Vec2>> existing;
-    for (int i = 0; i < c.size(); ++i)
-        if (is_active(c.vertex_block[i]) || is_active(c.edge_block[i]))
-            existing[block_pair_key(c.vertex_block[i], c.edge_block[i])].push_back(b.vertex[c.vertex_id[i]]);
-
-    // 3. Broad phase: inflated boxes in a uniform grid. A block with many vertices
-    // (a deformable block's boundary, hundreds of nodes) enters as chunks of at
-    // most `chunk` consecutive vertices, each with its own box: otherwise its one
-    // box, as large as the model, would pair it with every block and the narrow
-    // phase would test every vertex against all its edges.
-    constexpr std::uint32_t chunk = 16;
-    struct Piece {
-        int block;
-        std::uint32_t v0, v1; ///< vertices [v0, v1) and the edges they start
-        Box2 box;
-    };
-    const int nb = in.block_count;
-    std::vector<Piece> pieces;
-    Box2 all;
-    double mean_size = 0.0;
-    int active = 0;
-    for (int k = 0; k < nb; ++k) {
-        if (in.removed && in.removed[k]) continue;
-        const std::uint32_t first = b.first[k], last = b.first[k + 1];
-        for (std::uint32_t v0 = first; v0 < last; v0 += chunk) {
-            Piece pc{k, v0, std::min(last, v0 + chunk), {}};
-            // An edge's box holds both its ends: the next vertex closes it.
-            for (std::uint32_t v = pc.v0; v < pc.v1; ++v) {
-                pc.box.add(b.vertex[v]);
-                pc.box.add(b.vertex[next_vertex(b.first, k, int(v))]);
-            }
-            pc.box.lo -= Vec2{tol, tol};
-            pc.box.hi += Vec2{tol, tol};
-            all.add(pc.box.lo);
-            all.add(pc.box.hi);
-            mean_size += pc.box.width() + pc.box.height();
-            pieces.push_back(pc);
-        }
-        ++active;
+    if (res.removed > 0) {
+        c.remove_if_flagged(drop_);
+        drop_.resize(c.size());
+        std::fill(drop_.begin(), drop_.end(), 0);
     }
-    if (active < 2) return res;
-    const double cell = mean_size / double(pieces.size());
-    const int nx = std::clamp(int(all.width() / cell) + 1, 1, 1 << 14);
-    const int ny = std::clamp(int(all.height() / cell) + 1, 1, 1 << 14);
-    auto cx = [&](double x) { return std::clamp(int((x - all.lo.x) / cell), 0, nx - 1); };
-    auto cy = [&](double y) { return std::clamp(int((y - all.lo.y) / cell), 0, ny - 1); };
-    std::vector<std::vector<int>> grid(std::size_t(nx) * ny);
-    for (int k = 0; k < int(pieces.size()); ++k) {
-        const Box2& bx = pieces[k].box;
-        for (int j = cy(bx.lo.y); j <= cy(bx.hi.y); ++j)
-            for (int i = cx(bx.lo.x); i <= cx(bx.hi.x); ++i) grid[std::size_t(j) * nx + i].push_back(k);
-    }
-
-    // Narrow phase for one ordered pair of pieces: vertices of P against edges of Q.
-    auto try_vertices = [&](const Piece& P, const Piece& Q) {
-        const int A = P.block, B = Q.block;
-        for (std::uint32_t v = P.v0; v < P.v1; ++v) {
-            const Vec2 x = b.vertex[v];
-            if (x.x < Q.box.lo.x || x.x > Q.box.hi.x || x.y < Q.box.lo.y || x.y > Q.box.hi.y) continue;
-            int best = -1;
-            double best_gap = INFINITY;
-            for (std::uint32_t e = Q.v0; e < Q.v1; ++e) {
-                const int e1 = next_vertex(b.first, B, int(e));
-                const EdgeFrame f = frame(x, b.vertex[e], b.vertex[e1]);
-                const double len = 1.0 / b.inv_edge_length[e];
-                const double beyond = std::max({0.0, -f.s, f.s - 1.0}) * len;
-                if (f.gap > tol || f.gap < -tol || beyond > tol) continue;
-                const double dist = std::abs(f.gap) + beyond;
-                if (dist < best_gap) best_gap = dist, best = int(e);
-            }
-            if (best < 0) continue;
-            if (in.junctions) {
-                // Still on the point it touched in the tessellation?
-                const auto& J = *in.junctions;
-                const auto it = std::lower_bound(J.begin(), J.end(), Junction{int(v), B, 0, 0, 0.0});
-                if (it != J.end() && it->vertex == int(v) && it->block == B) {
-                    const Vec2 touched = b.vertex[it->e0] + it->s * (b.vertex[it->e1] - b.vertex[it->e0]);
-                    if (norm(x - touched) <= tol) continue;
-                }
-            }
-            auto& points = existing[block_pair_key(A, B)];
-            bool known = false;
-            for (Vec2 p : points) known = known || norm(p - x) <= tol;
-            if (known) continue;
-            const int e1 = next_vertex(b.first, B, best);
-            const Vec2 tb = b.inv_edge_length[best] * (b.vertex[e1] - b.vertex[best]);
-            // The vertex's share: half of its adjacent edge that lies most along B's edge.
-            const int vp = prev_vertex(b.first, A, int(v)), vn = next_vertex(b.first, A, int(v));
-            const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
-            const double l = 0.5 * (std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? norm(ep) : norm(en));
-            JointHistory h;
-            h.bonded = false;
-            const Vec2 n{tb.y, -tb.x};
-            const double s_on = dot(x - b.vertex[best], tb) * b.inv_edge_length[best];
-            const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
-            h.un = frame(x, b.vertex[best], b.vertex[e1]).gap - dot(vr, n) * in.dt;
-            c.add(A, int(v), B, best, e1, l, in.new_contact_property, h);
-            points.push_back(x);
-            ++res.created;
-        }
-    };
-    for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-            const auto& list = grid[std::size_t(j) * nx + i];
-            for (std::size_t p = 0; p < list.size(); ++p)
-                for (std::size_t q = p + 1; q < list.size(); ++q) {
-                    const Piece *P = &pieces[list[p]], *Q = &pieces[list[q]];
-                    if (P->block == Q->block) continue;
-                    if (P->block > Q->block) std::swap(P, Q);
-                    if (!is_active(P->block) && !is_active(Q->block)) continue;
-                    const Box2 &ba = P->box, &bb = Q->box;
-                    if (ba.hi.x < bb.lo.x || bb.hi.x < ba.lo.x || ba.hi.y < bb.lo.y || bb.hi.y < ba.lo.y) continue;
-                    // Handle the pair once: in the cell holding the low corner of the overlap.
-                    if (cx(std::max(ba.lo.x, bb.lo.x)) != i || cy(std::max(ba.lo.y, bb.lo.y)) != j) continue;
-                    try_vertices(*P, *Q);
-                    try_vertices(*Q, *P);
-                }
-        }
     return res;
 }
 

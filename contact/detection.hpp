@@ -10,14 +10,24 @@
 //      neighbouring edge of the same block if the vertex now projects onto it;
 //   2. an unbonded (or broken) contact whose vertex is farther than the tolerance
 //      from the edge, or beyond its ends, is removed — bonded ones never are;
-//   3. broad phase: block boxes inflated by the tolerance in a uniform grid
-//      (O(N)); narrow phase: each vertex of one block within the tolerance of an
-//      edge of the other (projecting onto it, or near its end: corner contact)
-//      becomes a new unbonded contact, unless the two blocks already have a
-//      contact at that point (either way round).
+//   3. broad phase: every block is in a uniform grid as pieces (runs of at most
+//      16 consecutive vertices, each with a box), and only the pieces of active
+//      blocks query it; narrow phase: each vertex of one block within the
+//      tolerance of an edge of the other (projecting onto it, or near its end:
+//      corner contact) becomes a candidate;
+//   4. a candidate becomes a new unbonded contact unless the two blocks already
+//      have a contact at that point (either way round), found among the contacts
+//      of one of the two blocks (Contacts::block_first), or among the candidates
+//      of the same pair accepted before it.
+// Steps 1, 3 and 4 visit the contacts and neighbours of active blocks only, so a
+// pass costs in proportion to what moved, not to the model (the grid itself is
+// rebuilt, O(N), only when a piece has left the margin it was stored with).
 // A new contact gets the unbonded property set, its current gap as un, and as
 // length half of the vertex's adjacent edge that lies most nearly along the
-// other block's edge (that edge's share at this end).
+// other block's edge (that edge's share at this end). Candidates are produced and
+// accepted in an order fixed by block and vertex numbers, so a pass gives the same
+// contacts in the same order every time. The Detector keeps its scratch arrays
+// between passes: once their sizes have settled, a pass allocates nothing.
 #pragma once
 
 #include "contact/contacts.hpp"
@@ -78,6 +88,53 @@ struct DetectionResult {
     int removed_tensile = 0, removed_shear = 0;
 };
 
-DetectionResult update_contacts(Contacts& c, const DetectionInput& in);
+class Detector {
+public:
+    /// One pass (steps 1–4 above). Needs `c`'s index (Contacts::rebuild_index) to
+    /// be current; leaves it stale if contacts were created or removed (the
+    /// result says so), for the caller to rebuild once.
+    DetectionResult update(Contacts& c, const DetectionInput& in);
+    /// Blocks were removed (or the state replaced): the grid is rebuilt next pass.
+    void invalidate() { grid_valid_ = false; }
+    /// How many times the broad-phase grid has been built (for statistics).
+    long grid_builds() const { return grid_builds_; }
+
+private:
+    /// A run of at most 16 consecutive vertices of a block and the edges they start.
+    struct Piece {
+        int block;
+        std::uint32_t v0, v1;
+    };
+    Box2 current_box(const Piece& pc, const BlockView& b, double inflate) const;
+    void build_grid(const DetectionInput& in);
+    void add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in);
+    bool known(const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) const;
+
+    // Broad phase. Pieces enter the grid with their box at the build inflated by
+    // the tolerance and a margin; while every piece stays inside its stored box
+    // (checked for the active ones, which are the ones that moved), the grid
+    // still finds every pair within the tolerance, and only needs rebuilding
+    // when one leaves it — not at every pass.
+    std::vector<Piece> pieces_;
+    std::vector<int> block_piece_; ///< per block, its first piece (CSR)
+    std::vector<Box2> stored_;     ///< per piece, its box at the last build (inflated)
+    Box2 grid_box_;
+    double cell_ = 0.0, margin_ = 0.0;
+    int nx_ = 0, ny_ = 0;
+    std::vector<int> cell_first_, cell_piece_;
+    bool grid_valid_ = false;
+    long grid_builds_ = 0;
+
+    // Scratch kept between passes.
+    std::vector<std::uint8_t> drop_; ///< per contact; all zero between passes
+    std::vector<int> dropped_, near_;
+    struct Candidate {
+        std::uint64_t pair;
+        int vertex_block, vertex, edge_block, edge, edge_end;
+        double length, un;
+    };
+    std::vector<Candidate> candidates_;
+    std::vector<int> order_, accepted_;
+};
 
 } // namespace bbm::contact

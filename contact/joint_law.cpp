@@ -47,25 +47,25 @@ double SofteningCurve::plastic_increment(double excess, double k, double peak, d
                                          double extra) const {
     auto cap = [&](double d) { return peak * std::min((*this)(up + d), other) + extra; };
     if (brittle()) return std::max(0.0, (excess - cap(1e300)) / k);
-    // Walk the breakpoints ahead of `up` (plus where the curve crosses `other`):
-    // h(δ) = excess − kδ − cap(δ) is linear between them, so its root is exact.
-    std::vector<double> ahead;
-    for (std::size_t i = 0; i < up_.size(); ++i) {
-        if (up_[i] > up) ahead.push_back(up_[i] - up);
-        if (i + 1 < up_.size()) {
-            const double s0 = s_[i] - other, s1 = s_[i + 1] - other;
-            if (s0 * s1 < 0) {
-                const double x = up_[i] + (up_[i + 1] - up_[i]) * s0 / (s0 - s1);
-                if (x > up) ahead.push_back(x - up);
-            }
-        }
-    }
-    std::sort(ahead.begin(), ahead.end());
+    // Walk the breakpoints ahead of `up` — each segment's crossing of `other`
+    // (inside it), then its end, which is their increasing order: h(δ) = excess −
+    // kδ − cap(δ) is linear between them, so its root is exact. No allocation:
+    // this runs inside the contact loop.
     double d0 = 0.0, h0 = excess - cap(0.0);
-    for (const double d1 : ahead) {
-        const double h1 = excess - k * d1 - cap(d1);
-        if (h1 <= 0.0) return d0 + h0 * (d1 - d0) / (h0 - h1);
-        d0 = d1, h0 = h1;
+    for (std::size_t i = 0; i + 1 < up_.size(); ++i) {
+        double ahead[2];
+        int count = 0;
+        const double s0 = s_[i] - other, s1 = s_[i + 1] - other;
+        if (s0 * s1 < 0) {
+            const double x = up_[i] + (up_[i + 1] - up_[i]) * s0 / (s0 - s1);
+            if (x > up) ahead[count++] = x - up;
+        }
+        if (up_[i + 1] > up) ahead[count++] = up_[i + 1] - up;
+        for (int j = 0; j < count; ++j) {
+            const double d1 = ahead[j], h1 = excess - k * d1 - cap(d1);
+            if (h1 <= 0.0) return d0 + h0 * (d1 - d0) / (h0 - h1);
+            d0 = d1, h0 = h1;
+        }
     }
     return d0 + h0 / k; // beyond the last point the strength is constant
 }
@@ -164,6 +164,27 @@ bool starts_bonded(const JointLaw& law) {
     if (std::holds_alternative<ElasticLaw>(law)) return true;
     if (const auto* c = std::get_if<CoulombLaw>(&law)) return c->tensile > 0 || c->cohesion > 0;
     return true;
+}
+
+double elastic_limit(const JointLaw& law, const JointHistory& before, const JointHistory& trial, double cap) {
+    double tensile = INFINITY, cohesion = INFINITY, tan_phi = 0.0;
+    if (const auto* c = std::get_if<CoulombLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, tan_phi = c->tan_phi;
+    if (const auto* c = std::get_if<SofteningLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, tan_phi = c->tan_phi;
+    if (!std::isfinite(tensile) || !before.bonded) return cap;
+    auto within = [&](double lambda) {
+        const double sn = before.sn + lambda * (trial.sn - before.sn);
+        const double tau = before.tau + lambda * (trial.tau - before.tau);
+        return -sn <= tensile && std::abs(tau) <= cohesion + std::max(sn, 0.0) * tan_phi;
+    };
+    if (within(cap)) return cap;
+    if (!within(0.0)) return 0.0;
+    // Each condition holds on an interval of λ that contains 0: bisect its end.
+    double lo = 0.0, hi = cap;
+    for (int k = 0; k < 100 && hi - lo > 1e-12 * hi; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (within(mid) ? lo : hi) = mid;
+    }
+    return lo;
 }
 
 JointState state_of(const JointHistory& h) {

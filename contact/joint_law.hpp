@@ -142,4 +142,12 @@ bool starts_bonded(const JointLaw& law);
 /// Output state of a contact.
 JointState state_of(const JointHistory& h);
 
+/// The largest λ ≥ 0 (at most `cap`) for which the stresses before + λ (trial −
+/// before) stay within the intact strength of the law — tension cut-off and
+/// Coulomb cap with the full tensile strength and cohesion; unbounded (`cap`) for
+/// an elastic law or an unloaded contact. With elastic joints the state of a
+/// model scales with its load, so the smallest λ over the contacts is how far a
+/// load can go before the first joint yields (a lab test's elastic preload).
+double elastic_limit(const JointLaw& law, const JointHistory& before, const JointHistory& trial, double cap);
+
 } // namespace bbm::contact

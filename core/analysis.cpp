@@ -139,13 +139,12 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
         Vec2 u{};
         for (int i = 0; i < b.count(); ++i) {
             if (b.removed[i] || b.deformable[i]) continue;
-            const double c = std::cos(b.theta[i]), sn = std::sin(b.theta[i]);
+            const Rotation rot = rotation(b.theta[i]);
             for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
                 const Vec2 x0 = b.centroid0[i] + b.local[v];
                 if (norm(x0 - p) >= best) continue;
                 best = norm(x0 - p);
-                const Vec2 r = b.local[v];
-                u = b.centroid[i] + Vec2{c * r.x - sn * r.y, sn * r.x + c * r.y} - x0;
+                u = b.centroid[i] + rot(b.local[v]) - x0;
             }
         }
         for (int k = 0; k < n.count(); ++k)

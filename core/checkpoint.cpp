@@ -18,7 +18,7 @@
 namespace bbm {
 
 namespace {
-constexpr std::uint64_t magic = 0x62626d2d63687031ull; // "bbm-chp1"
+constexpr std::uint64_t magic = 0x62626d2d63687032ull; // "bbm-chp2"
 
 template <class T>
 void put(std::ostream& o, const T& v) {
@@ -75,10 +75,10 @@ void Solver::visit_state(Self& s, Visit&& v) {
     v(s.n_.position), v(s.n_.velocity), v(s.n_.mass);
     v(s.z_.stress), v(s.z_.strain);
     v(s.c_.vertex_block), v(s.c_.vertex_id), v(s.c_.edge_block), v(s.c_.edge_id), v(s.c_.edge_end);
-    v(s.c_.length), v(s.c_.property), v(s.c_.history), v(s.c_.normal);
-    v(s.relaxing_), v(s.relax_total_), v(s.relax_left_);
+    v(s.c_.length), v(s.c_.property), v(s.c_.history);
+    v(s.relax_block_force_), v(s.relax_block_moment_), v(s.relax_node_force_), v(s.relax_total_), v(s.relax_left_);
     v(s.dt_), v(s.time_), v(s.ratio_), v(s.work_), v(s.steps_);
-    v(s.contact_force_sum_), v(s.zone_force_sum_), v(s.boundary_force_);
+    v(s.boundary_force_);
     v(s.detected_at_), v(s.detected_theta_), v(s.detected_vertex_), v(s.active_);
     v(s.detection_totals_);
 }
@@ -111,7 +111,10 @@ void Solver::load_state(std::istream& i) {
     visit_state(*this, [&](auto& x) { get(i, x); });
     std::uint64_t hash = 0;
     get(i, hash);
-    c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
+    c_.normal.resize(c_.size());
+    normals_stale_ = true;
+    rebuild_contact_index();
+    detector_.invalidate();
     update_vertices();
     if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
 }

@@ -59,9 +59,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
     std::fill(n_.velocity.begin(), n_.velocity.end(), Vec2{});
     auto evaluate = [&] {
         update_vertices();
-        update_contact_forces();
-        update_zone_forces();
-        add_external_forces();
+        compute_forces();
         double worst = 0.0;
         for (int i = 0; i < nb; ++i)
             for (int c = 0; c < 2; ++c)
@@ -111,6 +109,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
             int dof;
             Vec2 g;
         };
+        refresh_normals();
         for (int i = 0; i < c_.size(); ++i) {
             const auto& h = c_.history[i];
             if (!h.bonded && h.sn <= 0.0) continue; // an open crack or unbonded contact carries nothing
@@ -190,8 +189,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
             if (node_dof[k][1] >= 0) n_.velocity[k].y = du[node_dof[k][1]] / dt;
         }
         update_vertices();
-        update_contact_forces();
-        update_zone_forces();
+        compute_forces();
         for (int i = 0; i < nb; ++i) {
             if (b_.removed[i] || b_.deformable[i]) continue;
             b_.centroid[i] += dt * b_.velocity[i];
@@ -205,8 +203,41 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
         ++report.iterations;
         if (report.ratio_after < 1e-8) break;
     }
+    sum_boundary_forces();
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return report;
+}
+
+void Solver::move_supports(double time) {
+    std::vector<Vec2> du(b_.count()), dn(n_.count());
+    std::vector<double> dtheta(b_.count());
+    for (int i = 0; i < b_.count(); ++i) {
+        const std::uint8_t fx = b_.fixed[i];
+        du[i] = {(fx & 1) ? time * b_.fixed_velocity[i].x : 0.0, (fx & 2) ? time * b_.fixed_velocity[i].y : 0.0};
+        dtheta[i] = (fx & 4) ? time * b_.fixed_omega[i] : 0.0;
+    }
+    for (int k = 0; k < n_.count(); ++k) {
+        const std::uint8_t fx = n_.fixed[k];
+        dn[k] = {(fx & 1) ? time * n_.fixed_velocity[k].x : 0.0, (fx & 2) ? time * n_.fixed_velocity[k].y : 0.0};
+    }
+    move_bodies(du, dtheta, dn);
+}
+
+void Solver::move_bodies(const std::vector<Vec2>& du, const std::vector<double>& dtheta, const std::vector<Vec2>& dn) {
+    for (int i = 0; i < b_.count(); ++i) b_.velocity[i] = du[i] / dt_, b_.omega[i] = dtheta[i] / dt_;
+    for (int k = 0; k < n_.count(); ++k) n_.velocity[k] = dn[k] / dt_;
+    update_vertices();
+    compute_forces(); // the increments through the contact laws and zones
+    for (int i = 0; i < b_.count(); ++i) {
+        if (b_.removed[i] || b_.deformable[i]) continue;
+        b_.centroid[i] += du[i];
+        b_.theta[i] += dtheta[i];
+    }
+    for (int k = 0; k < n_.count(); ++k) n_.position[k] += dn[k];
+    std::fill(b_.velocity.begin(), b_.velocity.end(), Vec2{});
+    std::fill(b_.omega.begin(), b_.omega.end(), 0.0);
+    std::fill(n_.velocity.begin(), n_.velocity.end(), Vec2{});
+    update_vertices();
 }
 
 } // namespace bbm

@@ -130,6 +130,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         for (int i : t) n_.real_mass[i] += m->density * g.area / 3.0;
     }
     n_.mass = n_.real_mass;
+    z_.index_nodes(nn);
 
     // Property sets; the last, built in, serves contacts formed unbonded if the
     // model names none: Coulomb, φ 30°, stiffness of the stiffest set.
@@ -203,6 +204,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         add_end(j.p1, false);
     }
     if (!a.joints.empty()) mean_edge /= double(a.joints.size());
+    c_.sort_by_blocks();
     corner_radius_ = 0.05 * mean_edge;
 
     // Contacts formed during the run: the named set, or a built-in frictional one
@@ -254,7 +256,9 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         junctions_ = contact::find_junctions(a.points, a.first, joined, 1e-9 * std::max(all.width(), all.height()));
     }
     active_.assign(nb, 0);
-    c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
+    body_.resize(nb);
+    chunk_sums_.resize((nb + sum_chunk - 1) / sum_chunk + (nn + sum_chunk - 1) / sum_chunk);
+    rebuild_contact_index();
 
     apply_boundaries(an, a);
     update_vertices();
@@ -370,33 +374,41 @@ void Solver::apply_boundaries(const AnalysisSpec& an, const meshing::BlockAssemb
 }
 
 contact::BlockView Solver::view() const {
-    return {b_.centroid.data(),        b_.velocity.data(),   b_.omega.data(),
+    return {body_.data(),
+            b_.centroid.data(),        b_.velocity.data(),   b_.omega.data(),
             b_.vertex.data(),          b_.first.data(),      b_.inv_edge_length.data(),
             b_.deformable.data(),      b_.vertex_node.data(), n_.velocity.data()};
 }
 
+void Solver::place_rigid_block(int i) {
+    const Rotation rot = rotation(b_.theta[i]);
+    const Vec2 c = b_.centroid[i];
+    body_[i] = {c, b_.velocity[i], b_.omega[i]};
+    for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) b_.vertex[v] = c + rot(b_.local[v]);
+}
+
+void Solver::place_deformable_block(int i) {
+    // The polygon follows the boundary nodes; edge lengths change.
+    const std::uint32_t v0 = b_.first[i], v1 = b_.first[i + 1];
+    for (std::uint32_t v = v0; v < v1; ++v) b_.vertex[v] = n_.position[b_.vertex_node[v]];
+    for (std::uint32_t v = v0; v < v1; ++v)
+        b_.inv_edge_length[v] = 1.0 / norm(b_.vertex[v + 1 == v1 ? v0 : v + 1] - b_.vertex[v]);
+}
+
 void Solver::update_vertices() {
-    for (int i = 0; i < b_.count(); ++i) {
-        if (b_.deformable[i]) {
-            // The polygon follows the boundary nodes; edge lengths change.
-            const std::uint32_t v0 = b_.first[i], v1 = b_.first[i + 1];
-            for (std::uint32_t v = v0; v < v1; ++v) b_.vertex[v] = n_.position[b_.vertex_node[v]];
-            for (std::uint32_t v = v0; v < v1; ++v)
-                b_.inv_edge_length[v] = 1.0 / norm(b_.vertex[v + 1 == v1 ? v0 : v + 1] - b_.vertex[v]);
-            continue;
-        }
-        const double cs = std::cos(b_.theta[i]), sn = std::sin(b_.theta[i]);
-        const Vec2 c = b_.centroid[i];
-        for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) {
-            const Vec2 r = b_.local[v];
-            b_.vertex[v] = {c.x + cs * r.x - sn * r.y, c.y + sn * r.x + cs * r.y};
-        }
+    const int nb = b_.count();
+#pragma omp for schedule(static)
+    for (int i = 0; i < nb; ++i) {
+        if (b_.deformable[i]) place_deformable_block(i);
+        else if (!b_.removed[i]) place_rigid_block(i);
     }
 }
 
 void Solver::update_timestep() {
     const int nb = b_.count(), nn = n_.count();
-    std::vector<double> k(nb, 0.0), kr(nb, 0.0), kn(nn, 0.0);
+    // Scratch kept between calls: detection calls this inside a step.
+    auto& k = stiffness_scratch_.block, & kr = stiffness_scratch_.rotation, & kn = stiffness_scratch_.node;
+    k.assign(nb, 0.0), kr.assign(nb, 0.0), kn.assign(nn, 0.0);
     for (int i = 0; i < c_.size(); ++i) {
         const auto& law = laws_[c_.property[i]];
         const double kk = (contact::normal_stiffness(law) + contact::shear_stiffness(law)) * c_.length[i];
@@ -483,7 +495,12 @@ void Solver::initialize_stress(const StressFieldSpec& field) {
 void Solver::excavate(const std::vector<std::string>& regions, long relax_steps) {
     for (int i = 0; i < b_.count(); ++i)
         if (selected(regions, region_names_[b_.region[i]]) && !regions.empty()) b_.removed[i] = 1;
-    // Forces the removed blocks exert on the others become relaxing loads.
+    refresh_normals();
+    // Forces the removed blocks exert on the others become relaxing loads, summed
+    // per block and node in contact order.
+    relax_block_force_.assign(relax_steps > 0 ? b_.count() : 0, {});
+    relax_block_moment_.assign(relax_steps > 0 ? b_.count() : 0, 0.0);
+    relax_node_force_.assign(relax_steps > 0 ? n_.count() : 0, {});
     std::vector<std::uint8_t> drop(c_.size(), 0);
     for (int i = 0; i < c_.size(); ++i) {
         const int A = c_.vertex_block[i], B = c_.edge_block[i];
@@ -496,18 +513,20 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps)
         const int kept = b_.removed[A] ? B : A;
         const Vec2 fk = b_.removed[A] ? -1.0 * f : f;
         if (!b_.deformable[kept]) {
-            relaxing_.push_back({kept, -1, fk, cross(x - b_.centroid[kept], fk)});
+            relax_block_force_[kept] += fk;
+            relax_block_moment_[kept] += cross(x - b_.centroid[kept], fk);
         } else if (kept == A) {
-            relaxing_.push_back({kept, b_.vertex_node[c_.vertex_id[i]], fk, 0.0});
+            relax_node_force_[b_.vertex_node[c_.vertex_id[i]]] += fk;
         } else {
             const Vec2 p = b_.vertex[c_.edge_id[i]], q = b_.vertex[c_.edge_end[i]];
             const double w = std::clamp(dot(x - p, q - p) / norm2(q - p), 0.0, 1.0);
-            relaxing_.push_back({kept, b_.vertex_node[c_.edge_id[i]], (1.0 - w) * fk, 0.0});
-            relaxing_.push_back({kept, b_.vertex_node[c_.edge_end[i]], w * fk, 0.0});
+            relax_node_force_[b_.vertex_node[c_.edge_id[i]]] += (1.0 - w) * fk;
+            relax_node_force_[b_.vertex_node[c_.edge_end[i]]] += w * fk;
         }
     }
     c_.remove_if_flagged(drop);
-    c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
+    rebuild_contact_index();
+    detector_.invalidate();
     for (int i = 0; i < b_.count(); ++i)
         if (b_.removed[i]) b_.velocity[i] = {}, b_.omega[i] = 0.0;
     for (int k = 0; k < n_.count(); ++k)
@@ -516,60 +535,67 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps)
     update_timestep();
 }
 
-void Solver::update_contact_forces() {
-    std::fill(b_.force.begin(), b_.force.end(), Vec2{});
-    std::fill(b_.moment.begin(), b_.moment.end(), 0.0);
-    std::fill(n_.force.begin(), n_.force.end(), Vec2{});
-    const contact::ForceTargets out{b_.force.data(), b_.moment.data(), b_.count(), n_.force.data(), n_.count()};
-    contact_force_sum_ =
-        contact::step_contacts(c_, laws_, view(), dt_, corner_radius_, out, settings_.threads, thread_forces_);
+void Solver::rebuild_contact_index() {
+    c_.rebuild_index(int(laws_.size()), b_.count(), b_.deformable.data(), n_.count(), b_.vertex_node.data());
 }
 
-void Solver::update_zone_forces() {
-    if (z_.size() == 0) return;
-    zone_force_sum_ = fem::step_zones(z_, n_.position.data(), n_.velocity.data(), dt_, b_.removed.data(), n_.force.data());
+void Solver::refresh_normals() const {
+    if (!normals_stale_) return;
+    contact::update_normals(c_, view(), corner_radius_);
+    normals_stale_ = false;
 }
 
-void Solver::add_external_forces() {
+void Solver::compute_forces() {
+    // First passes (contacts, then zones: independent of each other, no barrier
+    // between them), then one gather per block and node: its contacts' and zones'
+    // forces in a fixed order, plus gravity, boundary loads and relaxing supports.
+    contact::contact_pass(c_, laws_, view(), dt_, corner_radius_);
+    normals_stale_ = true;
+    if (z_.size() > 0) fem::zone_pass(z_, n_.position.data(), n_.velocity.data(), dt_, b_.removed.data());
+#pragma omp barrier
     const Vec2 g = settings_.gravity;
-    for (int i = 0; i < b_.count(); ++i) {
-        b_.force[i] += b_.applied[i] + b_.real_mass[i] * g;
-        b_.moment[i] += b_.applied_moment[i];
+    const double relax = relax_left_ > 0 ? double(relax_left_) / double(relax_total_ + 1) : 0.0;
+    const int nb = b_.count(), nn = n_.count();
+#pragma omp for schedule(static) nowait
+    for (int i = 0; i < nb; ++i) {
+        Vec2 f{};
+        double m = 0.0;
+        if (!b_.deformable[i]) contact::block_contact_force(c_, i, f, m); // deformable: through its nodes
+        f += b_.applied[i] + b_.real_mass[i] * g;
+        m += b_.applied_moment[i];
+        if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
+        b_.force[i] = f;
+        b_.moment[i] = m;
     }
-    for (int k = 0; k < n_.count(); ++k) n_.force[k] += n_.applied[k] + n_.real_mass[k] * g;
-    if (relax_left_ > 0) {
-        const double f = double(relax_left_) / double(relax_total_ + 1);
-        for (const auto& r : relaxing_) {
-            if (r.node >= 0) {
-                n_.force[r.node] += f * r.force;
-            } else {
-                b_.force[r.block] += f * r.force;
-                b_.moment[r.block] += f * r.moment;
-            }
-        }
+#pragma omp for schedule(static)
+    for (int k = 0; k < nn; ++k) {
+        Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
+        if (relax > 0.0) f += relax * relax_node_force_[k];
+        n_.force[k] = f;
     }
 }
 
 void Solver::release_relaxation() {
-    if (relax_left_ > 0 && --relax_left_ == 0) relaxing_.clear();
+    if (relax_left_ > 0 && --relax_left_ == 0) {
+        relax_block_force_.clear();
+        relax_block_moment_.clear();
+        relax_node_force_.clear();
+    }
 }
 
 void Solver::integrate() {
     const double alpha = settings_.damping, dt = dt_;
-    double max_unbalanced = 0.0;
-    auto damped = [alpha](double f, double v) { return v != 0.0 ? f - alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : f; };
-    for (std::size_t k = 0; k < boundary_blocks_.size(); ++k) {
-        Vec2 sum{};
-        for (int i : boundary_blocks_[k].second) sum += b_.force[i] - b_.applied[i] - b_.real_mass[i] * settings_.gravity;
-        for (int i : boundary_nodes_[k]) sum += n_.force[i] - n_.applied[i] - n_.real_mass[i] * settings_.gravity;
-        boundary_force_[k] = sum;
-    }
+    const Vec2 gravity = settings_.gravity;
+    // Local damping against the velocity, branch-free (the sign of v is as good as
+    // random to the branch predictor): sign(v) is 0 at rest.
+    auto damped = [alpha](double f, double v) { return f - alpha * std::abs(f) * double((v > 0.0) - (v < 0.0)); };
     // Translation of one body (rigid block or node): damped central difference with
     // its prescribed components held; returns the work of its loads and of the
-    // supports on the prescribed components (reaction −F) over the step.
-    auto translate = [&](std::uint8_t fx, Vec2& v, Vec2 f, Vec2 fixed_v, double mass, Vec2 load) {
-        if (!(fx & 1)) max_unbalanced = std::max(max_unbalanced, std::abs(f.x));
-        if (!(fx & 2)) max_unbalanced = std::max(max_unbalanced, std::abs(f.y));
+    // supports on the prescribed components (reaction −F) over the step, and
+    // raises `unbalanced` to its largest free force component.
+    auto translate = [&](std::uint8_t fx, Vec2& v, Vec2 f, Vec2 fixed_v, double mass, Vec2 load, double& unbalanced) {
+        if (!(fx & 1)) unbalanced = std::max(unbalanced, std::abs(f.x));
+        if (!(fx & 2)) unbalanced = std::max(unbalanced, std::abs(f.y));
         v.x = (fx & 1) ? fixed_v.x : v.x + damped(f.x, v.x) / mass * dt;
         v.y = (fx & 2) ? fixed_v.y : v.y + damped(f.y, v.y) / mass * dt;
         double w = dot(load, v) * dt;
@@ -577,36 +603,70 @@ void Solver::integrate() {
         if (fx & 2) w -= f.y * v.y * dt;
         return w;
     };
-    double work = 0.0;
-    for (int i = 0; i < b_.count(); ++i) {
-        if (b_.removed[i] || b_.deformable[i]) continue;
+    auto block_work = [&](int i, double& unbalanced) {
+        if (b_.removed[i] || b_.deformable[i]) return 0.0;
         const std::uint8_t fx = b_.fixed[i];
         Vec2& v = b_.velocity[i];
-        work += translate(fx, v, b_.force[i], b_.fixed_velocity[i], b_.mass[i],
-                          b_.applied[i] + b_.real_mass[i] * settings_.gravity);
-        b_.omega[i] = (fx & 4) ? b_.fixed_omega[i]
-                               : b_.omega[i] + damped(b_.moment[i], b_.omega[i]) / b_.inertia[i] * dt;
-        work += (b_.applied_moment[i] - ((fx & 4) ? b_.moment[i] : 0.0)) * b_.omega[i] * dt;
+        double w = translate(fx, v, b_.force[i], b_.fixed_velocity[i], b_.mass[i],
+                             b_.applied[i] + b_.real_mass[i] * gravity, unbalanced);
+        b_.omega[i] = (fx & 4) ? b_.fixed_omega[i] : b_.omega[i] + damped(b_.moment[i], b_.omega[i]) / b_.inertia[i] * dt;
+        w += (b_.applied_moment[i] - ((fx & 4) ? b_.moment[i] : 0.0)) * b_.omega[i] * dt;
         b_.centroid[i] += dt * v;
         b_.theta[i] += dt * b_.omega[i];
-    }
-    for (int i = 0; i < n_.count(); ++i) {
-        if (b_.removed[n_.block[i]]) continue;
+        return w;
+    };
+    auto node_work = [&](int i, double& unbalanced) {
+        if (b_.removed[n_.block[i]]) return 0.0;
         Vec2& v = n_.velocity[i];
-        work += translate(n_.fixed[i], v, n_.force[i], n_.fixed_velocity[i], n_.mass[i],
-                          n_.applied[i] + n_.real_mass[i] * settings_.gravity);
+        const double w = translate(n_.fixed[i], v, n_.force[i], n_.fixed_velocity[i], n_.mass[i],
+                                   n_.applied[i] + n_.real_mass[i] * gravity, unbalanced);
         n_.position[i] += dt * v;
+        return w;
+    };
+    // The work and the largest unbalanced force per fixed chunk of bodies, then
+    // over the chunks in order: the same bits on any thread count.
+    const int nb = b_.count(), nn = n_.count();
+    const int block_chunks = (nb + sum_chunk - 1) / sum_chunk, chunks = block_chunks + (nn + sum_chunk - 1) / sum_chunk;
+#pragma omp for schedule(dynamic, 1)
+    for (int chunk = 0; chunk < chunks; ++chunk) {
+        double w = 0.0, unbalanced = 0.0;
+        if (chunk < block_chunks) {
+            for (int i = chunk * sum_chunk; i < std::min(nb, (chunk + 1) * sum_chunk); ++i) w += block_work(i, unbalanced);
+        } else {
+            const int c = chunk - block_chunks;
+            for (int i = c * sum_chunk; i < std::min(nn, (c + 1) * sum_chunk); ++i) w += node_work(i, unbalanced);
+        }
+        chunk_sums_[chunk] = {w, unbalanced};
     }
-    work_ += work;
-    const double scale = force_scale();
-    ratio_ = scale > 0.0 ? max_unbalanced / scale : 0.0;
+#pragma omp single
+    {
+        sum_boundary_forces();
+        double max_unbalanced = 0.0;
+        for (int chunk = 0; chunk < chunks; ++chunk) {
+            work_ += chunk_sums_[chunk].work;
+            max_unbalanced = std::max(max_unbalanced, chunk_sums_[chunk].unbalanced);
+        }
+        const double scale = force_scale();
+        ratio_ = scale > 0.0 ? max_unbalanced / scale : 0.0;
+    }
+}
+
+void Solver::sum_boundary_forces() {
+    const Vec2 g = settings_.gravity;
+    for (std::size_t k = 0; k < boundary_blocks_.size(); ++k) {
+        Vec2 sum{};
+        for (int i : boundary_blocks_[k].second) sum += b_.force[i] - b_.applied[i] - b_.real_mass[i] * g;
+        for (int i : boundary_nodes_[k]) sum += n_.force[i] - n_.applied[i] - n_.real_mass[i] * g;
+        boundary_force_[k] = sum;
+    }
 }
 
 double Solver::force_scale() const {
     // The root-mean-square contact (and zone nodal) force. SPEC §5 says "mean
     // contact force magnitude"; RMS >= mean, and it needs no square root per contact.
     const double terms = double(c_.size()) + 3.0 * double(z_.size());
-    double mean_force = terms > 0 ? std::sqrt((contact_force_sum_ + zone_force_sum_) / terms) : 0.0;
+    const double squares = contact::contact_force_squares(c_) + (z_.size() > 0 ? fem::zone_force_squares(z_) : 0.0);
+    double mean_force = terms > 0 ? std::sqrt(squares / terms) : 0.0;
     if (mean_force <= 0.0) {
         for (int i = 0; i < b_.count(); ++i) mean_force += norm(b_.applied[i] + b_.real_mass[i] * settings_.gravity);
         for (int i = 0; i < n_.count(); ++i) mean_force += norm(n_.applied[i] + n_.real_mass[i] * settings_.gravity);
@@ -618,11 +678,13 @@ double Solver::force_scale() const {
 void Solver::detect_if_due() {
     // Every few steps: which blocks have moved a quarter of the tolerance since
     // their last pass? Only they (and their neighbours) are examined. A deformable
-    // block counts as moved when any of its boundary vertices has.
+    // block counts as moved when any of its boundary vertices has. Called by every
+    // thread of the step's team: the scan is shared, the pass itself is serial.
     if (steps_ % 4 != 0) return;
-    bool any = false;
     const double limit = 0.25 * tolerance_;
-    for (int i = 0; i < b_.count(); ++i) {
+    const int nb = b_.count();
+#pragma omp for schedule(static)
+    for (int i = 0; i < nb; ++i) {
         bool moved = false;
         if (b_.removed[i]) {
         } else if (b_.deformable[i]) {
@@ -632,12 +694,15 @@ void Solver::detect_if_due() {
             moved = norm(b_.centroid[i] - detected_at_[i]) + std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i] >= limit;
         }
         active_[i] = moved;
-        any = any || moved;
     }
-    if (!any) return;
+#pragma omp single
+    if (std::find(active_.begin(), active_.end(), 1) != active_.end()) detection_pass();
+}
+
+void Solver::detection_pass() {
     contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
                                new_contact_property_, dt_, &junctions_};
-    const auto r = contact::update_contacts(c_, in);
+    const auto r = detector_.update(c_, in);
     for (int i = 0; i < b_.count(); ++i) {
         if (!active_[i]) continue;
         detected_at_[i] = b_.centroid[i], detected_theta_[i] = b_.theta[i];
@@ -650,21 +715,37 @@ void Solver::detect_if_due() {
     detection_totals_.removed_tensile += r.removed_tensile;
     detection_totals_.removed_shear += r.removed_shear;
     if (r.created > 0 || r.removed > 0) {
-        c_.rebuild_batches(int(laws_.size()), b_.deformable.data());
+        // New contacts are appended; once they are more than a sixteenth of all,
+        // renumber the contacts by block again (the loop's locality) — rarely
+        // enough that the renumbering costs little.
+        unsorted_contacts_ += r.created;
+        if (16 * unsorted_contacts_ > c_.size()) {
+            c_.sort_by_blocks();
+            unsorted_contacts_ = 0;
+        }
+        rebuild_contact_index();
         update_timestep();
     }
 }
 
 void Solver::step() {
-    update_vertices();
-    detect_if_due();
-    update_contact_forces();
-    update_zone_forces();
-    add_external_forces();
-    release_relaxation();
-    integrate();
-    time_ += dt_;
-    ++steps_;
+    // One parallel region per step: each stage is a work-sharing loop of the team
+    // (or a `single` for the serial parts), with the barriers between them that
+    // the data flow needs. One thread, or a call from outside a region (the
+    // implicit stage), runs the same code serially.
+#pragma omp parallel num_threads(settings_.threads) if (settings_.threads > 1)
+    {
+        update_vertices();
+        detect_if_due();
+        compute_forces();
+        integrate();
+#pragma omp single
+        {
+            release_relaxation();
+            time_ += dt_;
+            ++steps_;
+        }
+    }
 }
 
 double Solver::kinetic_energy() const {
@@ -728,6 +809,7 @@ Vec2 Solver::boundary_force(const std::string& name) const {
 }
 
 std::vector<std::array<double, 3>> Solver::block_stresses() const {
+    refresh_normals();
     std::vector<std::array<double, 3>> m(b_.count(), {0.0, 0.0, 0.0});
     auto add = [&](int blk, Vec2 r, Vec2 f) {
         if (b_.deformable[blk]) return;
@@ -744,8 +826,7 @@ std::vector<std::array<double, 3>> Solver::block_stresses() const {
     // Boundary tractions are surface forces too (at their points, rotating with the
     // block); gravity, uniform over the block, has no first moment about the centroid.
     for (const auto& t : tractions_) {
-        const double cs = std::cos(b_.theta[t.block]), sn = std::sin(b_.theta[t.block]);
-        add(t.block, {cs * t.offset.x - sn * t.offset.y, sn * t.offset.x + cs * t.offset.y}, t.force);
+        add(t.block, rotation(b_.theta[t.block])(t.offset), t.force);
     }
     // Supports (reaction = minus the force on the prescribed components), where a
     // `touching` boundary holds the block: without them a block on a symmetry
@@ -753,8 +834,7 @@ std::vector<std::array<double, 3>> Solver::block_stresses() const {
     for (const auto& sp : supports_) {
         const int i = sp.block;
         const Vec2 reaction{(b_.fixed[i] & 1) ? -b_.force[i].x : 0.0, (b_.fixed[i] & 2) ? -b_.force[i].y : 0.0};
-        const double cs = std::cos(b_.theta[i]), sn = std::sin(b_.theta[i]);
-        add(i, {cs * sp.offset.x - sn * sp.offset.y, sn * sp.offset.x + cs * sp.offset.y}, reaction);
+        add(i, rotation(b_.theta[i])(sp.offset), reaction);
     }
     // Deformable blocks: area-weighted mean of their zone stresses.
     for (int z = 0; z < z_.size(); ++z) {
@@ -775,6 +855,27 @@ int Solver::block_at(Vec2 p) const {
         if (d < dmin) dmin = d, best = i;
     }
     return best;
+}
+
+Solver::Memory Solver::memory() const {
+    auto bytes = [](const auto&... v) { return ((v.capacity() * sizeof(v[0])) + ... + std::size_t(0)); };
+    Memory m;
+    m.blocks = bytes(b_.centroid, b_.centroid0, b_.velocity, b_.force, b_.applied, b_.theta, b_.omega, b_.moment,
+                     b_.applied_moment, b_.mass, b_.inertia, b_.real_mass, b_.real_inertia, b_.area, b_.fixed,
+                     b_.fixed_velocity, b_.fixed_omega, b_.removed, b_.deformable, b_.region, b_.material, b_.first,
+                     body_, radius_, detected_at_, detected_theta_, active_, relax_block_force_, relax_block_moment_,
+                     stiffness_scratch_.block, stiffness_scratch_.rotation, c_.block_first);
+    m.vertices = bytes(b_.local, b_.vertex, b_.inv_edge_length, b_.vertex_node, detected_vertex_);
+    m.nodes = bytes(n_.position, n_.position0, n_.velocity, n_.force, n_.applied, n_.mass, n_.real_mass, n_.fixed,
+                    n_.fixed_velocity, n_.block, relax_node_force_, stiffness_scratch_.node, c_.node_first,
+                    z_.node_first);
+    m.zones = bytes(z_.node, z_.elasticity, z_.stress, z_.strain, z_.block, z_.density, z_.node_entry, z_.nodal_force,
+                    z_.partial_sum);
+    m.contacts = bytes(c_.vertex_block, c_.vertex_id, c_.edge_block, c_.edge_id, c_.edge_end, c_.length, c_.property,
+                       c_.history, c_.normal, c_.force, c_.block_entry, c_.node_entry, c_.fill_);
+    for (const auto& batch : c_.batches) m.contacts += bytes(batch);
+    m.other = bytes(junctions_, chunk_sums_);
+    return m;
 }
 
 std::uint64_t Solver::state_hash() const {

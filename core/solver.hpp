@@ -2,16 +2,24 @@
 //
 // One step is the list of stages of SPEC §5:
 //   1. (when due) contact detection update          — detect_if_due()
-//   2. contact forces from displacement increments   — update_contact_forces()
-//   3. zone stresses of deformable blocks            — update_zone_forces() (fem/cst.hpp)
-//   4. gravity, boundary tractions, applied loads    — add_external_forces()
+//   2. contact forces from displacement increments   — compute_forces(): contact pass
+//   3. zone stresses of deformable blocks            —   zone pass (fem/cst.hpp)
+//   4. gravity, boundary tractions, applied loads    —   the gather per block and node
 //   5. damping and integration, prescribed velocities — integrate()
 //   6. convergence measure                           — the unbalanced-force ratio
+//
+// Threads: a step is one OpenMP parallel region; each stage is a work-sharing
+// loop of the team over flat arrays (the serial bookkeeping in `single`s), so the
+// thread count is a scheduling decision, not a different code path. Every sum —
+// a block's force over its contacts, a node's over its zones and contacts, the
+// work of the loads, the force scale — runs in an order fixed by the numbering of
+// contacts, zones and bodies, never by the partition of the work: a model gives
+// the same bits on 1 or 64 threads (tests/test_determinism.cpp).
 //
 // State is flat arrays indexed by block id (structure of arrays); vertices are
 // stored once in body coordinates (relative to the centroid, at zero rotation)
 // and their world positions recomputed at the start of each step. Nothing is
-// allocated inside step().
+// allocated inside step() once the scratch arrays have their sizes.
 //
 // Time step and masses: for one degree of freedom of mass m on springs of total
 // stiffness K, central differences are stable for Δt < 2√(m/K). K of a block sums
@@ -75,6 +83,17 @@ public:
         double relative_residual = 0, seconds = 0, ratio_before = 0, ratio_after = 0;
     };
     ElasticSolveReport solve_elastic();
+    /// Moves the prescribed velocity components by fixed velocity × `time` through
+    /// the contact laws and zones, every free component held (one kinematic step,
+    /// no dynamics); velocities are zero after it. Followed by solve_elastic(): the
+    /// static state at that support displacement (a lab test's elastic preload).
+    void move_supports(double time);
+    /// Moves every block and node by the given displacement and rotation increments
+    /// (per block, per node) through the contact laws and zones, as one kinematic
+    /// step; velocities are zero after it. Scaling a linear-elastic solution: add
+    /// (λ − 1) times its displacements to reach λ times its state.
+    void move_bodies(const std::vector<Vec2>& block_displacement, const std::vector<double>& block_rotation,
+                     const std::vector<Vec2>& node_displacement);
 
     // --- checkpoints (core/checkpoint.cpp) -----------------------------------
     /// Writes the evolving state (binary). A solver built from the same model
@@ -138,14 +157,27 @@ public:
     const fem::Zones& zones() const { return z_; }
     const Blocks& blocks() const { return b_; }
     Blocks& blocks() { return b_; }
-    const contact::Contacts& contacts() const { return c_; }
-    contact::Contacts& contacts() { return c_; }
+    /// The contacts, their normals brought up to date (refresh_normals()).
+    const contact::Contacts& contacts() const {
+        refresh_normals();
+        return c_;
+    }
+    contact::Contacts& contacts() {
+        refresh_normals();
+        return c_;
+    }
     const std::vector<contact::JointLaw>& laws() const { return laws_; }
     const std::vector<std::string>& property_names() const { return property_names_; }
     const std::vector<std::string>& region_names() const { return region_names_; }
     /// Block lists by boundary name.
     const std::vector<std::pair<std::string, std::vector<int>>>& boundary_blocks() const { return boundary_blocks_; }
     std::uint64_t state_hash() const;
+    /// Bytes the solver holds (capacity of its arrays), by what they are indexed by.
+    struct Memory {
+        std::size_t blocks = 0, vertices = 0, nodes = 0, zones = 0, contacts = 0, other = 0;
+        std::size_t total() const { return blocks + vertices + nodes + zones + contacts + other; }
+    };
+    Memory memory() const;
     /// Contacts created, removed and transferred by detection so far.
     const contact::DetectionResult& detection_totals() const { return detection_totals_; }
     double detection_tolerance() const { return tolerance_; }
@@ -153,10 +185,18 @@ public:
 private:
     contact::BlockView view() const;
     void detect_if_due();
+    void detection_pass();
     void update_vertices();
-    void update_contact_forces();
-    void update_zone_forces();
-    void add_external_forces();
+    void place_rigid_block(int i);      ///< world vertices and packed state from centroid and θ
+    void place_deformable_block(int i); ///< vertices from the block's boundary nodes
+    void rebuild_contact_index();
+    void compute_forces();
+    /// The contact loop does not store normals (a write of every contact every
+    /// step, for readers outside the loop): they are computed on demand from the
+    /// vertex positions the last step used, which gives the same values.
+    void refresh_normals() const;
+    /// Boundary reactions (boundary_force) from the forces of the last evaluation.
+    void sum_boundary_forces();
     void release_relaxation();
     double force_scale() const;
     template <class Self, class Visit>
@@ -168,7 +208,8 @@ private:
     Blocks b_;
     Nodes n_;
     fem::Zones z_;
-    contact::Contacts c_;
+    mutable contact::Contacts c_; ///< mutable: its normals are a cache (refresh_normals)
+    mutable bool normals_stale_ = true;
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
     std::vector<std::string> region_names_;
@@ -182,12 +223,20 @@ private:
     /// mean midpoint of their edges in the box, body frame), for block stresses.
     struct Support { int block; Vec2 offset; };
     std::vector<Support> supports_;
-    double contact_force_sum_ = 0.0; ///< Σ|F|² of the last step
-    double zone_force_sum_ = 0.0;    ///< Σ|f|² of zone nodal forces, last step
-    contact::ThreadForces thread_forces_;
-    /// A support force being relaxed: on a block (node < 0) or on a node.
-    struct Relaxing { int block; int node; Vec2 force; double moment; };
-    std::vector<Relaxing> relaxing_;
+    /// Work of the loads and largest unbalanced force of a step per fixed chunk of
+    /// bodies (integrate()).
+    static constexpr int sum_chunk = 512;
+    struct ChunkSums { double work, unbalanced; };
+    std::vector<ChunkSums> chunk_sums_;
+    /// The blocks' position and velocity packed for the contact loop, refreshed by
+    /// update_vertices() at the start of every step (contact/contacts.hpp).
+    std::vector<contact::BodyState> body_;
+    /// Translational and rotational stiffness per block, and per node (update_timestep()).
+    struct { std::vector<double> block, rotation, node; } stiffness_scratch_;
+    /// Support forces being relaxed after an excavation, per block and per node
+    /// (empty when none).
+    std::vector<Vec2> relax_block_force_, relax_node_force_;
+    std::vector<double> relax_block_moment_;
     long relax_total_ = 0, relax_left_ = 0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
     // Detection: tolerance, property of new contacts, motion since the last pass.
@@ -200,6 +249,8 @@ private:
     std::vector<std::uint8_t> active_; ///< moved enough since its last detection pass
     std::vector<contact::Junction> junctions_; ///< vertices touching a block they have no joint with (detection.hpp)
     contact::DetectionResult detection_totals_;
+    contact::Detector detector_;
+    int unsorted_contacts_ = 0; ///< created since the contacts were last sorted by block
     long steps_ = 0;
 };
 

@@ -39,6 +39,41 @@ constexpr double norm2(Vec2 a) { return a.x * a.x + a.y * a.y; }
 /// Rotates a by +90 degrees (counter-clockwise).
 constexpr Vec2 perp(Vec2 a) { return {-a.y, a.x}; }
 
+/// cos θ and sin θ of a block's rotation. Every block's vertices are placed from
+/// them every step, and a libm sincos was a tenth of a failing tunnel's run time:
+/// for |θ| ≤ π/4 (block rotations almost always are) the Taylor series to x¹⁷ and
+/// x¹⁸ — truncation below 1e-19 there, so the result is within an ulp or two of
+/// libm's (tests/test_geometry.cpp) — and libm beyond.
+struct Rotation {
+    double c, s;
+    Vec2 operator()(Vec2 r) const { return {c * r.x - s * r.y, s * r.x + c * r.y}; }
+};
+namespace detail {
+/// ±1/k! for the Taylor terms of sin (k odd, 3..17) and cos (k even, 2..18), with
+/// their signs; 18! < 2⁵³ is exact in a double, so each is correctly rounded.
+constexpr double signed_inv_factorial(int k) {
+    double f = 1.0;
+    for (int j = 2; j <= k; ++j) f *= j;
+    return ((k / 2) % 2 ? -1.0 : 1.0) / f;
+}
+} // namespace detail
+
+inline Rotation rotation(double theta) {
+    using detail::signed_inv_factorial;
+    if (!(std::abs(theta) <= 0.7853981633974483)) return {std::cos(theta), std::sin(theta)};
+    const double z = theta * theta;
+    // sin θ = θ (1 + z P(z)), cos θ = 1 + z Q(z), by Horner from the highest term.
+    constexpr double s17 = signed_inv_factorial(17), s15 = signed_inv_factorial(15), s13 = signed_inv_factorial(13),
+                     s11 = signed_inv_factorial(11), s9 = signed_inv_factorial(9), s7 = signed_inv_factorial(7),
+                     s5 = signed_inv_factorial(5), s3 = signed_inv_factorial(3);
+    constexpr double c18 = signed_inv_factorial(18), c16 = signed_inv_factorial(16), c14 = signed_inv_factorial(14),
+                     c12 = signed_inv_factorial(12), c10 = signed_inv_factorial(10), c8 = signed_inv_factorial(8),
+                     c6 = signed_inv_factorial(6), c4 = signed_inv_factorial(4), c2 = signed_inv_factorial(2);
+    const double p = s3 + z * (s5 + z * (s7 + z * (s9 + z * (s11 + z * (s13 + z * (s15 + z * s17))))));
+    const double q = c2 + z * (c4 + z * (c6 + z * (c8 + z * (c10 + z * (c12 + z * (c14 + z * (c16 + z * c18)))))));
+    return {1.0 + z * q, theta + theta * (z * p)};
+}
+
 /// Signed area; positive for a counter-clockwise polygon.
 inline double signed_area(std::span<const Vec2> p) {
     double a2 = 0.0;

@@ -1,5 +1,6 @@
 #include "fem/cst.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 namespace bbm::fem {
@@ -20,58 +21,76 @@ std::array<double, 36> element_stiffness(const TriangleGradients& g, const Elast
     return k;
 }
 
+void Zones::index_nodes(int nodes) {
+    node_first.assign(nodes + 1, 0);
+    for (const auto& t : node)
+        for (int k : t) ++node_first[k + 1];
+    for (int k = 0; k < nodes; ++k) node_first[k + 1] += node_first[k];
+    node_entry.resize(node_first[nodes]);
+    std::vector<int> fill(node_first.begin(), node_first.end() - 1);
+    for (int z = 0; z < size(); ++z)
+        for (int c = 0; c < 3; ++c) node_entry[fill[node[z][c]]++] = 3 * z + c;
+    nodal_force.resize(size());
+    partial_sum.resize((size() + work_item_size - 1) / work_item_size);
+}
+
 namespace {
-inline double add_forces(const TriangleGradients& g, const std::array<double, 3>& s, const std::array<int, 3>& n,
-                         Vec2* force) {
+/// One zone's update: its stress from the step's velocity gradient, and the
+/// nodal forces of that stress; returns Σ|f|² over its three nodes.
+inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double dt) {
+    const auto& n = z.node[k];
+    const auto g = gradients(x[n[0]], x[n[1]], x[n[2]]);
+    // Velocity gradient × Δt: the step's displacement gradient.
+    const double f = dt / (2.0 * g.area);
+    double uxx = 0, uxy = 0, uyx = 0, uyy = 0; // ∂u_x/∂x, ∂u_x/∂y, ∂u_y/∂x, ∂u_y/∂y
+    for (int i = 0; i < 3; ++i) {
+        const Vec2 vi = v[n[i]];
+        uxx += vi.x * g.b[i], uxy += vi.x * g.c[i];
+        uyx += vi.y * g.b[i], uyy += vi.y * g.c[i];
+    }
+    uxx *= f, uxy *= f, uyx *= f, uyy *= f;
+    const double exx = uxx, eyy = uyy, exy = 0.5 * (uxy + uyx), w = 0.5 * (uyx - uxy);
+    auto& s = z.stress[k];
+    const Elasticity& e = z.elasticity[k];
+    // Jaumann rotation of the stress by the step's spin w.
+    const double rot_xx = -2.0 * w * s[2], rot_xy = w * (s[0] - s[1]);
+    const double tr = e.lambda * (exx + eyy);
+    s[0] += rot_xx + tr + 2.0 * e.shear * exx;
+    s[1] += -rot_xx + tr + 2.0 * e.shear * eyy;
+    s[2] += rot_xy + 2.0 * e.shear * exy;
+    auto& eps = z.strain[k];
+    eps[0] += exx, eps[1] += eyy, eps[2] += exy;
     // f_i = −A σ ∇N_i = −½ σ (b_i, c_i).
     double sum = 0.0;
     for (int i = 0; i < 3; ++i) {
-        const Vec2 f{-0.5 * (s[0] * g.b[i] + s[2] * g.c[i]), -0.5 * (s[2] * g.b[i] + s[1] * g.c[i])};
-        force[n[i]] += f;
-        sum += norm2(f);
+        const Vec2 fi{-0.5 * (s[0] * g.b[i] + s[2] * g.c[i]), -0.5 * (s[2] * g.b[i] + s[1] * g.c[i])};
+        z.nodal_force[k][i] = fi;
+        sum += norm2(fi);
     }
     return sum;
 }
 } // namespace
 
-double step_zones(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip, Vec2* force) {
-    double sum = 0.0;
-    const int count = z.size();
-    for (int k = 0; k < count; ++k) {
-        if (skip[z.block[k]]) continue;
-        const auto& n = z.node[k];
-        const auto g = gradients(x[n[0]], x[n[1]], x[n[2]]);
-        // Velocity gradient × Δt: the step's displacement gradient.
-        const double f = dt / (2.0 * g.area);
-        double uxx = 0, uxy = 0, uyx = 0, uyy = 0; // ∂u_x/∂x, ∂u_x/∂y, ∂u_y/∂x, ∂u_y/∂y
-        for (int i = 0; i < 3; ++i) {
-            const Vec2 vi = v[n[i]];
-            uxx += vi.x * g.b[i], uxy += vi.x * g.c[i];
-            uyx += vi.y * g.b[i], uyy += vi.y * g.c[i];
+void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip) {
+    const int count = z.size(), items = int(z.partial_sum.size());
+#pragma omp for schedule(dynamic, 1) nowait
+    for (int w = 0; w < items; ++w) {
+        double sum = 0.0;
+        for (int k = w * Zones::work_item_size; k < std::min(count, (w + 1) * Zones::work_item_size); ++k) {
+            if (skip[z.block[k]]) {
+                z.nodal_force[k] = {};
+                continue;
+            }
+            sum += zone_update(z, k, x, v, dt);
         }
-        uxx *= f, uxy *= f, uyx *= f, uyy *= f;
-        const double exx = uxx, eyy = uyy, exy = 0.5 * (uxy + uyx), w = 0.5 * (uyx - uxy);
-        auto& s = z.stress[k];
-        const Elasticity& e = z.elasticity[k];
-        // Jaumann rotation of the stress by the step's spin w.
-        const double rot_xx = -2.0 * w * s[2], rot_xy = w * (s[0] - s[1]);
-        const double tr = e.lambda * (exx + eyy);
-        s[0] += rot_xx + tr + 2.0 * e.shear * exx;
-        s[1] += -rot_xx + tr + 2.0 * e.shear * eyy;
-        s[2] += rot_xy + 2.0 * e.shear * exy;
-        auto& eps = z.strain[k];
-        eps[0] += exx, eps[1] += eyy, eps[2] += exy;
-        sum += add_forces(g, s, n, force);
+        z.partial_sum[w] = sum;
     }
-    return sum;
 }
 
-void zone_forces(const Zones& z, const Vec2* x, const std::uint8_t* skip, Vec2* force) {
-    for (int k = 0; k < z.size(); ++k) {
-        if (skip[z.block[k]]) continue;
-        const auto& n = z.node[k];
-        add_forces(gradients(x[n[0]], x[n[1]], x[n[2]]), z.stress[k], n, force);
-    }
+double zone_force_squares(const Zones& z) {
+    double sum = 0.0;
+    for (double s : z.partial_sum) sum += s;
+    return sum;
 }
 
 } // namespace bbm::fem

@@ -62,16 +62,39 @@ struct Zones {
     std::vector<int> block;
     std::vector<double> density;
     int size() const { return static_cast<int>(node.size()); }
+
+    // Derived by index_nodes() once the zones are complete.
+    /// Per node, its zone corners (entry 3·zone + corner) in zone order (CSR).
+    std::vector<int> node_first, node_entry;
+    static constexpr int work_item_size = 256; ///< zones per partial sum of Σ|f|²
+    // Per-step scratch of zone_pass.
+    std::vector<std::array<Vec2, 3>> nodal_force;
+    std::vector<double> partial_sum;
+    /// Builds the per-node index and sizes the scratch; `nodes` = number of FE nodes.
+    void index_nodes(int nodes);
 };
 
-/// Stage 3 of a step: zone stresses from the node velocities of the step and the
-/// internal forces they put on the nodes (added to `force`). Zones of removed
-/// blocks are skipped (`skip[block]` non-zero). Returns Σ|f|² of the nodal forces
-/// (the force scale of the unbalanced-force ratio).
-double step_zones(Zones& z, const Vec2* position, const Vec2* velocity, double dt, const std::uint8_t* skip,
-                  Vec2* force);
+/// Stage 3 of a step, first pass: zone stresses from the node velocities of the
+/// step, and each zone's nodal forces into `z.nodal_force`. As the contact pass
+/// (contact/contacts.hpp): an OpenMP work-sharing loop without a region of its
+/// own and without a barrier at its end; the team meets at a barrier before
+/// gathering with node_zone_force(). Zones of removed blocks are skipped
+/// (`skip[block]` non-zero) and contribute nothing. Needs index_nodes().
+void zone_pass(Zones& z, const Vec2* position, const Vec2* velocity, double dt, const std::uint8_t* skip);
 
-/// Internal nodal forces of the current stresses only (no update).
-void zone_forces(const Zones& z, const Vec2* position, const std::uint8_t* skip, Vec2* force);
+/// Second pass, per node: the forces of its zones in zone order (the same sum on
+/// any number of threads).
+inline Vec2 node_zone_force(const Zones& z, int node) {
+    Vec2 f{};
+    for (int e = z.node_first[node]; e < z.node_first[node + 1]; ++e) {
+        const int entry = z.node_entry[e];
+        f += z.nodal_force[entry / 3][entry % 3];
+    }
+    return f;
+}
+
+/// Σ|f|² of the nodal forces of the last pass (the force scale of the
+/// unbalanced-force ratio), per fixed group of zones, then over the groups in order.
+double zone_force_squares(const Zones& z);
 
 } // namespace bbm::fem

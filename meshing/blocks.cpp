@@ -275,17 +275,25 @@ void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& danglin
     }
 }
 
-/// Z-order (Morton) key of a point in a box, 16 bits per axis.
-std::uint32_t morton(Vec2 p, const Box2& box) {
-    auto spread = [](std::uint32_t v) {
-        v &= 0xffff;
-        v = (v | (v << 8)) & 0x00ff00ff;
-        v = (v | (v << 4)) & 0x0f0f0f0f;
-        v = (v | (v << 2)) & 0x33333333;
-        return (v | (v << 1)) & 0x55555555;
+/// Index of a point along a Hilbert curve over a box, 16 bits per axis. Unlike a
+/// Z-order curve, consecutive indices are always adjacent cells, so blocks that
+/// are neighbours in space are nearer in number (no long jumps at the seams).
+std::uint32_t hilbert_index(Vec2 p, const Box2& box) {
+    constexpr std::uint32_t side = 1u << 16;
+    auto cell = [&](double v, double lo, double extent) {
+        const double t = (v - lo) / std::max(extent, 1e-300) * double(side - 1);
+        return std::uint32_t(std::clamp(t, 0.0, double(side - 1)));
     };
-    const double sx = 65535.0 / std::max(box.width(), 1e-300), sy = 65535.0 / std::max(box.height(), 1e-300);
-    return spread(std::uint32_t((p.x - box.lo.x) * sx)) | (spread(std::uint32_t((p.y - box.lo.y) * sy)) << 1);
+    std::uint32_t x = cell(p.x, box.lo.x, box.width()), y = cell(p.y, box.lo.y, box.height()), d = 0;
+    for (std::uint32_t s = side / 2; s > 0; s /= 2) {
+        const std::uint32_t rx = (x & s) ? 1 : 0, ry = (y & s) ? 1 : 0;
+        d += s * s * ((3 * rx) ^ ry);
+        if (ry == 0) { // rotate the quadrant so the curve stays continuous
+            if (rx == 1) x = side - 1 - x, y = side - 1 - y;
+            std::swap(x, y);
+        }
+    }
+    return d;
 }
 
 /// Blocks in space-filling-curve order, so that neighbours have nearby ids: the
@@ -295,7 +303,7 @@ void order_along_curve(RegionBlocks& rb) {
     std::vector<Vec2> c;
     for (const auto& p : rb.polygons) c.push_back(centroid(p)), box.add(c.back());
     std::vector<std::pair<std::uint32_t, int>> keys;
-    for (int k = 0; k < int(c.size()); ++k) keys.push_back({morton(c[k], box), k});
+    for (int k = 0; k < int(c.size()); ++k) keys.push_back({hilbert_index(c[k], box), k});
     std::stable_sort(keys.begin(), keys.end());
     RegionBlocks sorted;
     for (const auto& [key, k] : keys) {

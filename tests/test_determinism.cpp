@@ -1,0 +1,151 @@
+// Determinism across thread counts (core/solver.hpp, "Threads"): every shipped
+// example and every lab test ends in the same state — state hash, step count and
+// crack counts — on 1, 2, 3 and 4 threads. Failure is chaotic (a one-ulp change
+// gives another crack pattern), so anything short of bit-identical would show up
+// here as different counts. The process runs with OMP_WAIT_POLICY=passive (set
+// by CTest) so that 3 and 4 threads on a 2-core machine wait for a core instead
+// of spinning against each other.
+#include "apps/model_input.hpp"
+#include "core/analysis.hpp"
+#include "core/labtest.hpp"
+#include "core/solver.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+using namespace bbm;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Silent : StageObserver {};
+
+struct Outcome {
+    std::uint64_t hash;
+    long steps;
+    int tensile, shear;
+    bool operator==(const Outcome&) const = default;
+};
+
+doctest::String outcome_text(const Outcome& o) {
+    return (std::to_string(o.hash) + " after " + std::to_string(o.steps) + " steps, cracks " +
+            std::to_string(o.tensile) + " / " + std::to_string(o.shear))
+        .c_str();
+}
+
+/// Runs a model file's stages on `threads` threads; stages longer than
+/// `max_stage_steps` (> 0) are cut there, to keep the slow examples short.
+Outcome run_model(const io::ModelFile& model, const meshing::BlockAssembly& blocks, int threads,
+                  long max_stage_steps = 0) {
+    AnalysisSpec analysis = model.analysis;
+    analysis.solver.threads = threads;
+    if (max_stage_steps > 0)
+        for (auto& stage : analysis.stages) {
+            stage.steps = std::min(stage.steps, max_stage_steps);
+            stage.max_steps = std::min(stage.max_steps, max_stage_steps);
+            stage.relax_steps = std::min(stage.relax_steps, max_stage_steps);
+        }
+    Solver s(blocks, analysis);
+    Silent quiet;
+    run_stages(s, analysis.stages, quiet);
+    return {s.state_hash(), s.steps(), s.cracks(contact::JointState::broken_tension),
+            s.cracks(contact::JointState::broken_shear)};
+}
+
+/// The example model files with stages (a model without is a mesh only).
+std::vector<fs::path> examples() {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(BBM_SOURCE_DIR) / "examples"))
+        if (e.path().extension() == ".toml") out.push_back(e.path());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("every shipped example ends in the same state on 1, 2 and 3 threads") {
+    int compared = 0;
+    for (const auto& path : examples()) {
+        if (path.filename() == "tunnel_trigon.toml") continue; // the next test, to its end
+        const auto model = io::read_model(path.string());
+        if (model.analysis.stages.empty()) continue;
+        const auto blocks = meshing::generate_blocks(model.geometry);
+        // At most 3000 steps a stage: enough to pass excavation, relaxation and the
+        // first cracks of every tunnel (the next test runs one to its end).
+        const long cut = 3000;
+        const Outcome one = run_model(model, blocks, 1, cut);
+        for (int threads : {2, 3}) {
+            const Outcome other = run_model(model, blocks, threads, cut);
+            INFO(path.filename().string() << " on " << threads << " threads: " << outcome_text(other)
+                                          << ", on 1: " << outcome_text(one));
+            CHECK(other == one);
+        }
+        ++compared;
+    }
+    CHECK(compared >= 20);
+}
+
+TEST_CASE("the trigon tunnel, past its first 1,000 cracks, is the same on 1, 2, 3 and 4 threads") {
+    const auto model = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/tunnel_trigon.toml");
+    const auto blocks = meshing::generate_blocks(model.geometry);
+    const Outcome one = run_model(model, blocks, 1);
+    INFO("1 thread: " << outcome_text(one));
+    REQUIRE(one.tensile + one.shear > 1000);
+    for (int threads : {2, 3, 4}) {
+        const Outcome other = run_model(model, blocks, threads);
+        INFO(threads << " threads: " << outcome_text(other));
+        CHECK(other == one);
+    }
+}
+
+TEST_CASE("lab tests give the same curve and cracks on 1, 2, 3 and 4 threads") {
+    using Kind = LabTestOptions::Kind;
+    auto small = [](Kind kind) {
+        auto o = LabTestOptions::paper_ucs();
+        o.kind = kind;
+        o.width = 2.0, o.height = 4.0;
+        if (kind == Kind::brazilian) o.width = 2.0;
+        if (kind == Kind::biaxial) o.confinement = 2e6;
+        o.frame_every = 0;
+        return o;
+    };
+    std::vector<std::pair<std::string, LabTestOptions>> tests = {
+        {"ucs", small(Kind::ucs)},     {"tension", small(Kind::tension)},
+        {"biaxial", small(Kind::biaxial)}, {"brazilian", small(Kind::brazilian)}};
+    auto deformable = small(Kind::ucs);
+    deformable.deformable_fraction = 0.5;
+    tests.push_back({"ucs, deformable blocks f = 0.5", deformable});
+    auto trigon = small(Kind::ucs);
+    trigon.pattern = meshing::PatternSpec::Kind::trigon;
+    trigon.joint.kn = 162e9, trigon.joint.ks = 68e9;
+    tests.push_back({"ucs, trigon", trigon});
+    for (auto& [name, options] : tests) {
+        std::vector<LabTestResult> results;
+        for (int threads : {1, 2, 3, 4}) {
+            options.threads = threads;
+            results.push_back(run_labtest(options));
+        }
+        const auto& one = results[0];
+        REQUIRE(one.cracks_tensile + one.cracks_shear > 0);
+        for (std::size_t k = 1; k < results.size(); ++k) {
+            const auto& r = results[k];
+            INFO(name << " on " << k + 1 << " threads: peak " << r.peak_stress << " vs " << one.peak_stress
+                      << ", steps " << r.steps << " vs " << one.steps);
+            CHECK(r.steps == one.steps);
+            CHECK(r.peak_stress == one.peak_stress);
+            CHECK(r.E == one.E);
+            CHECK(r.cracks_tensile == one.cracks_tensile);
+            CHECK(r.cracks_shear == one.cracks_shear);
+            REQUIRE(r.curve.size() == one.curve.size());
+            bool same_curve = true;
+            for (std::size_t p = 0; p < r.curve.size(); ++p)
+                same_curve = same_curve && r.curve[p].axial_stress == one.curve[p].axial_stress &&
+                             r.curve[p].lateral_strain == one.curve[p].lateral_strain;
+            CHECK(same_curve);
+        }
+    }
+}
