@@ -168,8 +168,23 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
         ->check(CLI::Range(0.0, 0.49))->capture_default_str();
     sub->add_option("--mesh-size", o.mesh_size, "With --deformable-fraction: triangle size (m; default size / 2)")
         ->check(CLI::NonNegativeNumber);
-    sub->add_option("--strain-rate", o.strain_per_step, "Platen velocity over specimen height, per step")
+    sub->add_option("--strain-rate", o.strain_per_step,
+                    "Platen velocity over specimen height, per step (with the servo: the unit of its rates)")
         ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--servo", o.servo,
+                    "Servo-controlled platens: slower while cracks form, faster after failure (docs/calibration.md)")
+        ->capture_default_str();
+    sub->add_option("--servo-cracks", o.servo_cracks, "Servo: new cracks per record (20 steps) per 5,000 contacts it aims at")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--servo-min", o.servo_min_factor, "Servo: slowest platen speed, times --strain-rate")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--servo-max", o.servo_max_factor, "Servo: fastest platen speed before failure, times --strain-rate")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--servo-post-peak", o.servo_post_peak_factor, "Servo: platen speed after failure, times --strain-rate")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--preload", o.elastic_preload,
+                    "The linear part by one implicit solve, up to just below the first joint's yield")
+        ->capture_default_str();
     sub->add_option("--platens", c.platens, "rough: the face blocks are held horizontally; smooth: free to slide")
         ->check(CLI::IsMember({"rough", "smooth"}))->capture_default_str();
     sub->add_option("--platen-friction", o.platen_friction,
@@ -195,14 +210,18 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
 }
 
 nlohmann::json labtest_json(const LabTestResult& r) {
-    return {{"E", r.E}, {"nu", r.nu}, {"peak_stress", r.peak_stress}, {"strain_at_peak", r.strain_at_peak},
+    return {{"E", r.E}, {"nu", r.nu}, {"E50", r.E50}, {"linear_limit_stress", r.linear_limit_stress},
+            {"peak_stress", r.peak_stress}, {"strain_at_peak", r.strain_at_peak},
+            {"crack_initiation_stress", r.crack_initiation_stress}, {"crack_damage_stress", r.crack_damage_stress},
             {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
             {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
             {"post_peak_locking", r.post_peak_locking},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
                                    {"within_30_of_vertical", r.cracks_near_vertical},
-                                   {"within_30_of_horizontal", r.cracks_near_horizontal}}}};
+                                   {"within_30_of_horizontal", r.cracks_near_horizontal},
+                                   {"within_30_of_vertical_at_peak", r.cracks_near_vertical_at_peak},
+                                   {"within_30_of_horizontal_at_peak", r.cracks_near_horizontal_at_peak}}}};
 }
 
 /// The failure series: one frame of blocks and contacts every `frame_every` steps,
@@ -222,19 +241,35 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
                          std::vector<std::pair<double, std::string>> frames) {
     fs::create_directories(dir / "vtk");
     std::ostringstream csv;
-    csv << "step,axial_strain,axial_stress_Pa,lateral_strain,cracks_tensile,cracks_shear\n";
+    csv << "step,axial_strain,axial_stress_Pa,lateral_strain,cracks_tensile,cracks_shear,unbalanced_ratio,"
+           "strain_per_step\n";
     csv.precision(10);
-    io::Series curve{"stress", {}, {}};
+    // Stress against the axial, lateral (expansion negative) and volumetric strains,
+    // as Martin & Chandler draw them, with σci and σcd marked.
+    io::Series axial{"axial", {}, {}}, lateral{"lateral", {}, {}}, volumetric{"volumetric", {}, {}};
     for (const auto& p : r.curve) {
         csv << p.step << ',' << p.axial_strain << ',' << p.axial_stress << ',' << p.lateral_strain << ','
-            << p.cracks_tensile << ',' << p.cracks_shear << '\n';
-        curve.x.push_back(1e3 * p.axial_strain);
-        curve.y.push_back(1e-6 * p.axial_stress);
+            << p.cracks_tensile << ',' << p.cracks_shear << ',' << p.unbalanced_ratio << ',' << p.strain_per_step
+            << '\n';
+        const double sigma = 1e-6 * p.axial_stress;
+        axial.x.push_back(1e3 * p.axial_strain), axial.y.push_back(sigma);
+        lateral.x.push_back(-1e3 * p.lateral_strain), lateral.y.push_back(sigma);
+        volumetric.x.push_back(1e3 * (p.axial_strain - p.lateral_strain)), volumetric.y.push_back(sigma);
     }
     io::write_text_atomically(dir / "stress_strain.csv", csv.str());
+    std::vector<io::Series> curves{axial};
+    if (r.crack_initiation_stress > 0.0) {
+        curves.push_back(lateral), curves.push_back(volumetric);
+        double x0 = 0.0, x1 = 0.0;
+        for (const auto& c : curves) x0 = std::min(x0, *std::min_element(c.x.begin(), c.x.end())), x1 = std::max(x1, *std::max_element(c.x.begin(), c.x.end()));
+        for (const auto& [name, stress] : {std::pair{"sigma_ci", r.crack_initiation_stress}, std::pair{"sigma_cd", r.crack_damage_stress}})
+            curves.push_back({name, {x0, x1}, {1e-6 * stress, 1e-6 * stress}});
+    }
     char label[200];
-    std::snprintf(label, sizeof label, "%s: E = %.2f GPa, peak = %.2f MPa", title.c_str(), r.E / 1e9, r.peak_stress / 1e6);
-    io::draw_curves({curve}, "axial strain (1e-3)", "axial stress (MPa)", dir / "stress_strain.png", label);
+    std::snprintf(label, sizeof label, "%s: E = %.2f GPa, peak = %.2f MPa, sigma_ci %.1f, sigma_cd %.1f MPa", title.c_str(),
+                  r.E / 1e9, r.peak_stress / 1e6, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6);
+    io::draw_curves(curves, "strain (1e-3): axial, lateral, volumetric", "axial stress (MPa)", dir / "stress_strain.png",
+                    label);
     io::FailurePlotOptions fo;
     fo.title = title;
     io::draw_failure(s, dir / "failure.png", fo);
@@ -323,9 +358,11 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
             results[k] = r;
             if (!quiet) {
                 std::lock_guard lock(print);
-                std::fprintf(stderr, "\r  seed %llu: E %.2f GPa  nu %.3f  peak %.2f MPa at strain %.3e  cracks %d T %d S  %ld steps  %.1f s\n",
-                             static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.nu, r.peak_stress / 1e6,
-                             r.strain_at_peak, r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
+                std::fprintf(stderr, "\r  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
+                                     "sigma_ci %.2f  sigma_cd %.2f MPa  cracks %d T %d S  %ld steps  %.1f s\n",
+                             static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.E50 / 1e9, r.nu, r.peak_stress / 1e6,
+                             r.strain_at_peak, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6,
+                             r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
                 if (r.post_peak_locking)
                     std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",
@@ -350,8 +387,11 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                                      {"realizations", n},
                                      {"E", stats([](const LabTestResult& r) { return r.E; })},
                                      {"nu", stats([](const LabTestResult& r) { return r.nu; })},
+                                     {"E50", stats([](const LabTestResult& r) { return r.E50; })},
                                      {"peak_stress", stats([](const LabTestResult& r) { return r.peak_stress; })},
                                      {"strain_at_peak", stats([](const LabTestResult& r) { return r.strain_at_peak; })},
+                                     {"crack_initiation_stress", stats([](const LabTestResult& r) { return r.crack_initiation_stress; })},
+                                     {"crack_damage_stress", stats([](const LabTestResult& r) { return r.crack_damage_stress; })},
                                      {"per_realization", per}};
         io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
         if (!quiet)
@@ -544,7 +584,7 @@ int main(int argc, char** argv) {
     run->add_option("-o,--out", run_out, "Output directory (created if missing)")->capture_default_str();
     run->add_flag("-q,--quiet", quiet, "No progress, only errors");
     run->add_option("--threads", run_options.threads,
-                    "Threads of the contact loop (results are deterministic per thread count)")
+                    "Threads of the loop (the result is the same, bit for bit, on any number)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     run->add_option("--checkpoint-every", run_options.checkpoint_every,

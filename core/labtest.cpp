@@ -2,6 +2,7 @@
 
 #include "core/solver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -166,23 +167,39 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
 }
 
 namespace {
+/// The moving platen: the blocks and nodes with a prescribed, non-zero vertical
+/// velocity (the top face), whose speed the loading sets.
+class MovingPlaten {
+public:
+    explicit MovingPlaten(Solver& s) : s_(s) {
+        auto& b = s.blocks();
+        auto& n = s.nodes();
+        for (int i = 0; i < b.count(); ++i)
+            if ((b.fixed[i] & 2) && b.fixed_velocity[i].y != 0.0) blocks_.push_back(i), sign_ = b.fixed_velocity[i].y > 0 ? 1 : -1;
+        for (int k = 0; k < n.count(); ++k)
+            if ((n.fixed[k] & 2) && n.fixed_velocity[k].y != 0.0) nodes_.push_back(k), sign_ = n.fixed_velocity[k].y > 0 ? 1 : -1;
+    }
+    /// Vertical speed (m per step), in the loading direction.
+    void set_speed(double v) {
+        for (int i : blocks_) s_.blocks().fixed_velocity[i].y = sign_ * v;
+        for (int k : nodes_) s_.nodes().fixed_velocity[k].y = sign_ * v;
+    }
+
+private:
+    Solver& s_;
+    std::vector<int> blocks_, nodes_;
+    double sign_ = -1.0;
+};
+
 /// Applies the biaxial confinement gradually with the platens held still, then lets
 /// the specimen settle; returns the step at which axial loading starts.
-long confine(Solver& s) {
+long confine(Solver& s, MovingPlaten& platen) {
     auto& b = s.blocks();
     auto& n = s.nodes();
     const auto block_load = b.applied;
     const auto block_moment = b.applied_moment;
     const auto node_load = n.applied;
-    // The moving platen: what has a prescribed, non-zero vertical velocity.
-    std::vector<int> moving_blocks, moving_nodes;
-    std::vector<double> vy_blocks, vy_nodes;
-    for (int i = 0; i < b.count(); ++i)
-        if ((b.fixed[i] & 2) && b.fixed_velocity[i].y != 0.0)
-            moving_blocks.push_back(i), vy_blocks.push_back(b.fixed_velocity[i].y), b.fixed_velocity[i].y = 0.0;
-    for (int k = 0; k < n.count(); ++k)
-        if ((n.fixed[k] & 2) && n.fixed_velocity[k].y != 0.0)
-            moving_nodes.push_back(k), vy_nodes.push_back(n.fixed_velocity[k].y), n.fixed_velocity[k].y = 0.0;
+    platen.set_speed(0.0);
     auto scale = [&](double f) {
         for (int i = 0; i < b.count(); ++i) b.applied[i] = f * block_load[i], b.applied_moment[i] = f * block_moment[i];
         for (int k = 0; k < n.count(); ++k) n.applied[k] = f * node_load[k];
@@ -193,11 +210,76 @@ long confine(Solver& s) {
         s.step();
     }
     for (long k = 0; k < settle_max && !(k > 200 && s.unbalanced_ratio() < 1e-5); ++k) s.step();
-    for (std::size_t j = 0; j < moving_blocks.size(); ++j) b.fixed_velocity[moving_blocks[j]].y = vy_blocks[j];
-    for (std::size_t j = 0; j < moving_nodes.size(); ++j) n.fixed_velocity[moving_nodes[j]].y = vy_nodes[j];
     return s.steps();
 }
 } // namespace
+
+void measure_rock_mechanics(LabTestResult& r, std::size_t preload_points, bool tension, long peak_step) {
+    const auto& c = r.curve;
+    if (c.size() < 2 || r.peak_stress <= 0.0) return;
+    const double peak = r.peak_stress, nu_sign = tension ? -1.0 : 1.0;
+    std::size_t last = 0; // the last pre-peak point
+    while (last + 1 < c.size() && c[last + 1].step <= peak_step) ++last;
+    // The linear part: the implicit preload's line (exact), else the pre-peak
+    // points from 10% of the peak to the first broken bond or 50% of the peak,
+    // whichever comes first — never past crack initiation.
+    std::vector<double> eps, sig, lat;
+    if (preload_points >= 2) {
+        const auto &a = c.front(), &b = c[preload_points - 1];
+        r.E = (b.axial_stress - a.axial_stress) / (b.axial_strain - a.axial_strain);
+        r.nu = nu_sign * (b.lateral_strain - a.lateral_strain) / (b.axial_strain - a.axial_strain);
+        r.linear_limit_stress = b.axial_stress;
+    } else {
+        const int cracks0 = c.front().cracks_tensile + c.front().cracks_shear;
+        for (std::size_t k = 0; k <= last; ++k) {
+            const auto& p = c[k];
+            if (p.cracks_tensile + p.cracks_shear > cracks0 || p.axial_stress > 0.5 * peak) break;
+            if (p.axial_stress >= 0.1 * peak)
+                eps.push_back(p.axial_strain), sig.push_back(p.axial_stress), lat.push_back(p.lateral_strain);
+        }
+        r.E = fit_slope(eps, sig);
+        r.nu = nu_sign * fit_slope(eps, lat);
+        r.linear_limit_stress = sig.empty() ? 0.0 : sig.back();
+    }
+    // ISRM tangent modulus at 50% of the peak: pre-peak points within ±5% of it.
+    eps.clear(), sig.clear();
+    for (std::size_t k = 0; k <= last; ++k)
+        if (std::abs(c[k].axial_stress - 0.5 * peak) <= 0.05 * peak)
+            eps.push_back(c[k].axial_strain), sig.push_back(c[k].axial_stress);
+    r.E50 = eps.size() >= 2 ? fit_slope(eps, sig) : 0.0;
+    if (tension || !(r.E > 0.0)) return;
+    // Crack initiation and damage (Martin & Chandler 1994), from the loading's start:
+    // volumetric strain εv = εa + εl (plane strain, εl = −lateral expansion), its
+    // elastic part (1 − ν) Δσ / E, the crack volumetric strain εcv = εv − that.
+    // σci: where εcv leaves zero for good — the last pre-peak point (5-point mean)
+    // with |εcv| within 0.5% of the elastic volumetric strain at the peak; σcd:
+    // where εv reverses (its largest pre-peak value; the peak if it never does).
+    const auto& o = c.front();
+    auto volumetric = [&](std::size_t k) {
+        return (c[k].axial_strain - o.axial_strain) - (c[k].lateral_strain - o.lateral_strain);
+    };
+    auto mean5 = [&](auto f, std::size_t k) {
+        const std::size_t a = k >= 2 ? k - 2 : 0, b = std::min(last, k + 2);
+        double m = 0.0;
+        for (std::size_t j = a; j <= b; ++j) m += f(j);
+        return m / double(b - a + 1);
+    };
+    auto crack_volumetric = [&](std::size_t k) {
+        return volumetric(k) - (1.0 - r.nu) * (c[k].axial_stress - o.axial_stress) / r.E;
+    };
+    const double tolerance = 0.005 * (1.0 - r.nu) * (peak - o.axial_stress) / r.E;
+    std::size_t initiation = last, damage = 0;
+    for (std::size_t k = last + 1; k-- > 0;)
+        if (std::abs(mean5(crack_volumetric, k)) <= tolerance) {
+            initiation = k;
+            break;
+        }
+    double best = -INFINITY;
+    for (std::size_t k = 0; k <= last; ++k)
+        if (const double v = mean5(volumetric, k); v > best) best = v, damage = k;
+    r.crack_initiation_stress = c[initiation].axial_stress;
+    r.crack_damage_stress = c[damage].axial_stress;
+}
 
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y) {
     const std::size_t n = x.size();
@@ -264,30 +346,112 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             if (angle <= 30.0 || angle >= 150.0) ++r.cracks_near_horizontal;
         }
     };
-    const double v = o.strain_per_step * h;
     // Biaxial: the confinement first, ramped with the platens held, then settled
     // (applied at once it is a shock that cracks the specimen before any axial load).
-    const long start = o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0 ? confine(s) : 0;
-    double peak = 0.0;
+    MovingPlaten platen(s);
+    const long start = o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0 ? confine(s, platen) : 0;
+    double peak = 0.0, strain = 0.0, strain_at_peak = 0.0;
     long peak_step = 0;
     bool failed = false; ///< the stress has dropped by failure_drop from the peak, or stalled
     const int cracks_at_start = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
-    // A stall: no net rise of the stress over this many records (2e-4 of strain).
-    const std::size_t stall_records =
-        std::max<std::size_t>(5, std::size_t(std::lround(2e-4 / (o.strain_per_step * o.record_every))));
-    while (s.steps() - start < o.max_steps) {
-        s.step();
-        if ((s.steps() - start) % o.record_every != 0) continue;
-        record_new_cracks();
+    // Loading rate: fixed, or (servo) adapted at every record to the cracking.
+    const double rate_max = o.strain_per_step * o.servo_max_factor;
+    const double rate_min = o.strain_per_step * o.servo_min_factor;
+    auto measure = [&](double at_strain, double at_rate) {
         const double force = sign * s.boundary_force("top").y;
         StressStrainPoint p;
         p.step = s.steps();
-        p.axial_strain = v * double(s.steps() - start) / h;
+        p.axial_strain = at_strain;
         p.axial_stress = brazilian ? 2.0 * force / (std::numbers::pi * o.width) : force / o.width;
         p.lateral_strain = (mean_ux(right) - mean_ux(left)) / o.width;
         p.cracks_tensile = s.cracks(contact::JointState::broken_tension);
         p.cracks_shear = s.cracks(contact::JointState::broken_shear);
+        p.unbalanced_ratio = s.unbalanced_ratio();
+        p.strain_per_step = at_rate;
+        return p;
+    };
+    // Elastic preload: until the first joint yields the specimen is linear, and its
+    // quasi-static response is one implicit solve — not thousands of damped steps
+    // whose start-up transient would bias E. A trial platen displacement gives the
+    // response per unit of load; the first joint to reach its strength gives how
+    // far it can go; the specimen is set there (preload_fraction of it) exactly,
+    // and the explicit loading takes over just before cracking starts.
+    std::size_t preload_points = 0; ///< leading curve points that are the implicit line
+    if (o.elastic_preload && !uses_platen_blocks(o)) {
+        const auto& c = s.contacts();
+        const auto& nd = s.nodes();
+        const std::vector<contact::JointHistory> before = c.history;
+        const auto centroid0 = b.centroid, position0 = nd.position;
+        const auto theta0 = b.theta;
+        const StressStrainPoint origin = measure(0.0, 0.0);
+        const double trial = 1e-6;
+        platen.set_speed(trial * h);
+        s.move_supports(s.timestep());
+        s.solve_elastic();
+        double lambda = 1e6;
+        for (int i = 0; i < c.size(); ++i)
+            lambda = std::min(lambda, contact::elastic_limit(s.laws()[c.property[i]], before[i], c.history[i], 1e6));
+        const double reach = o.preload_fraction * lambda;
+        strain = trial;
+        if (reach > 1.0 && lambda < 1e6) {
+            // Every body on by (reach − 1) times its trial displacement: each joint
+            // takes the same multiple of its trial increment (no row of joints next
+            // to the platen takes the whole of it), then one more solve for the
+            // geometric nonlinearity.
+            std::vector<Vec2> du(b.count()), dn(nd.count());
+            std::vector<double> dtheta(b.count());
+            for (int i = 0; i < b.count(); ++i)
+                du[i] = (reach - 1.0) * (b.centroid[i] - centroid0[i]), dtheta[i] = (reach - 1.0) * (b.theta[i] - theta0[i]);
+            for (int k = 0; k < nd.count(); ++k) dn[k] = (reach - 1.0) * (nd.position[k] - position0[k]);
+            s.move_bodies(du, dtheta, dn);
+            s.solve_elastic();
+            strain = reach * trial;
+        }
+        const StressStrainPoint end = measure(strain, 0.0);
+        // The straight line between them, exact for the linear response.
+        for (int k = 1; k <= 20; ++k) {
+            const double f = k / 20.0;
+            StressStrainPoint p = end;
+            p.axial_strain = origin.axial_strain + f * (end.axial_strain - origin.axial_strain);
+            p.axial_stress = origin.axial_stress + f * (end.axial_stress - origin.axial_stress);
+            p.lateral_strain = origin.lateral_strain + f * (end.lateral_strain - origin.lateral_strain);
+            r.curve.push_back(p);
+            if (progress) progress(p);
+        }
+        r.curve.insert(r.curve.begin(), origin);
+        preload_points = r.curve.size();
+    }
+    // The platens start from rest: slowly, then the servo speeds up.
+    double rate = o.servo ? rate_min : o.strain_per_step;
+    const double target_cracks = o.servo_cracks * std::max(1.0, r.contacts / 5000.0);
+    int cracks_last_record = cracks_at_start;
+    platen.set_speed(rate * h);
+    double ratio_max = 0.0;
+    std::size_t stall_from = 0; ///< first record within 2e-4 of strain of the last
+    while (s.steps() - start < o.max_steps) {
+        s.step();
+        strain += rate;
+        ratio_max = std::max(ratio_max, s.unbalanced_ratio());
+        if ((s.steps() - start) % o.record_every != 0) continue;
+        record_new_cracks();
+        StressStrainPoint p = measure(strain, rate);
+        p.unbalanced_ratio = ratio_max;
         r.curve.push_back(p);
+        if (o.servo) {
+            const int cracks_now = p.cracks_tensile + p.cracks_shear;
+            const double made = cracks_now - cracks_last_record;
+            cracks_last_record = cracks_now;
+            // Never faster than ×1.1 a record: a change of rate is a change of the
+            // specimen's lag behind the platen, which shows in the curve.
+            if (failed) {
+                rate = std::min(1.1 * rate, o.strain_per_step * o.servo_post_peak_factor);
+            } else {
+                const double f = made <= 0 ? 1.1 : std::clamp(target_cracks / made, 0.5, 1.1);
+                rate = std::clamp(rate * f, rate_min, rate_max);
+            }
+            platen.set_speed(rate * h);
+        }
+        ratio_max = 0.0;
         if (progress) progress(p);
         if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
         // After a failure drop the peak is the strength: rigid fragments cannot
@@ -298,21 +462,28 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             r.peak_passed = true;
             break;
         }
-        if (p.axial_stress > peak) peak = p.axial_stress, peak_step = p.step;
+        if (p.axial_stress > peak) {
+            peak = p.axial_stress, peak_step = p.step, strain_at_peak = p.axial_strain;
+            r.cracks_near_vertical_at_peak = r.cracks_near_vertical;
+            r.cracks_near_horizontal_at_peak = r.cracks_near_horizontal;
+        }
         // Failure: a drop by failure_drop from the peak, or (confined specimens, whose
         // fragments lock without a drop) a stall — the stress no higher than
         // 2e-4 of strain ago, with the peak inside that stretch. Only with bonds broken
         // under the axial load: the start-up transient of the platens is no failure.
         const bool cracking = p.cracks_tensile + p.cracks_shear > cracks_at_start;
         const bool dropped = peak > 0 && p.axial_stress < (1.0 - o.failure_drop) * peak;
+        while (stall_from + 1 < r.curve.size() && r.curve[stall_from + 1].axial_strain <= p.axial_strain - 2e-4)
+            ++stall_from;
         bool stalled = false;
-        if (r.curve.size() > stall_records) {
-            const auto& back = r.curve[r.curve.size() - 1 - stall_records];
+        if (r.curve[stall_from].axial_strain <= p.axial_strain - 2e-4 && r.curve.size() - stall_from > 5) {
+            const auto& back = r.curve[stall_from];
             stalled = p.axial_stress <= back.axial_stress && peak_step >= back.step;
         }
         failed = failed || (cracking && (dropped || stalled));
-        // Past the peak once the stress is clearly down from it.
-        if (peak > 0 && p.step > peak_step && p.axial_stress < o.stop_fraction * peak) {
+        // Past the peak once the stress is clearly down from it (after cracking: not
+        // in the start-up transient of the platens).
+        if (cracking && peak > 0 && p.step > peak_step && p.axial_stress < o.stop_fraction * peak) {
             r.peak_passed = true;
             break;
         }
@@ -320,22 +491,9 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     }
     r.steps = s.steps();
     r.peak_stress = peak;
-    r.strain_at_peak = v * double(peak_step - start) / h;
+    r.strain_at_peak = strain_at_peak;
     if (brazilian) r.tensile_strength = peak;
-    // E and ν on the initial linear part: pre-peak points between 10% and 50% of the peak.
-    std::vector<double> eps, sig, lat;
-    for (const auto& p : r.curve) {
-        if (p.step > peak_step) break;
-        if (p.axial_stress >= 0.1 * peak && p.axial_stress <= 0.5 * peak) {
-            eps.push_back(p.axial_strain), sig.push_back(p.axial_stress), lat.push_back(p.lateral_strain);
-        }
-    }
-    if (!brazilian) {
-        r.E = fit_slope(eps, sig);
-        // Compression: the sides move out as the specimen shortens (both strains
-        // positive); tension: they move in as it lengthens.
-        r.nu = fit_slope(eps, lat) * (o.kind == LabTestOptions::Kind::tension ? -1.0 : 1.0);
-    }
+    if (!brazilian) measure_rock_mechanics(r, preload_points, o.kind == LabTestOptions::Kind::tension, peak_step);
     record_new_cracks();
     r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
     r.cracks_shear = s.cracks(contact::JointState::broken_shear);

@@ -55,7 +55,24 @@ struct LabTestOptions {
     JointPropertySpec joint;            ///< the bond (law softening by default: paper values)
     double density = 2700.0;
     double confinement = 0.0;           ///< biaxial: lateral stress, Pa (positive = compression)
-    double strain_per_step = 5e-8;      ///< platen velocity over height, per step
+    /// Platen velocity over height, per step: the loading rate without the servo,
+    /// the unit of its rates with it.
+    double strain_per_step = 5e-8;
+    /// Servo-controlled platens: at every record the platen speed is multiplied by
+    /// servo_cracks / (new cracks of the record), per 5,000 contacts, within
+    /// [0.5, 1.1] (×1.1 without new cracks) and kept within [min, max] ×
+    /// strain_per_step — slow while cracks redistribute load; once the specimen
+    /// has failed (failure_drop) it rises to post_peak × strain_per_step. The
+    /// elastic part needs no speed: the implicit preload below does it at once.
+    /// Measured on the paper's specimen: docs/calibration.md, "Loading rate".
+    bool servo = true;
+    double servo_cracks = 2.0;
+    double servo_min_factor = 0.25, servo_max_factor = 1.5, servo_post_peak_factor = 3.0;
+    /// The linear part by one implicit solve (run_labtest), up to this fraction of
+    /// the load at which the first joint yields; not with platen blocks (their
+    /// frictional contacts are not linear).
+    bool elastic_preload = true;
+    double preload_fraction = 0.9;
     bool rough_platens = true;
     /// ≥ 0: instead of prescribing the face blocks, rigid platen blocks (one block
     /// size thick, as wide as the specimen) press on the faces through Coulomb
@@ -87,10 +104,18 @@ struct StressStrainPoint {
     long step;
     double axial_strain, axial_stress, lateral_strain;
     int cracks_tensile, cracks_shear;
+    double unbalanced_ratio;  ///< largest over the steps since the last point
+    double strain_per_step;   ///< the platens' loading rate over those steps
 };
 
 struct LabTestResult {
-    double E = 0.0, nu = 0.0, peak_stress = 0.0, strain_at_peak = 0.0;
+    /// E and ν of the linear part of the pre-peak curve (measure_rock_mechanics);
+    /// E50 the ISRM tangent modulus at 50% of the peak.
+    double E = 0.0, nu = 0.0, E50 = 0.0, peak_stress = 0.0, strain_at_peak = 0.0;
+    /// The stress at which the linear part used for E ends.
+    double linear_limit_stress = 0.0;
+    /// σci and σcd (compression tests): onset of sustained cracking, and of dilation.
+    double crack_initiation_stress = 0.0, crack_damage_stress = 0.0;
     double tensile_strength = 0.0; ///< brazilian: 2P/(πD)
     int blocks = 0, contacts = 0;
     long steps = 0;
@@ -100,6 +125,7 @@ struct LabTestResult {
     /// horizontal, 0–180°), 12 bins of 15°; cracks removed by detection included.
     std::array<int, 12> crack_orientation{};
     int cracks_near_vertical = 0, cracks_near_horizontal = 0; ///< within 30° of each
+    int cracks_near_vertical_at_peak = 0, cracks_near_horizontal_at_peak = 0; ///< the same, up to the peak
     bool peak_passed = false;
     /// After failure the stress climbed back above the peak (a jammed rubble core):
     /// the run stopped there and peak_stress is the peak before failure.
@@ -123,6 +149,15 @@ LabTestResult run_labtest(const LabTestOptions& o,
                           const std::function<void(const StressStrainPoint&)>& progress = {},
                           const std::function<void(const Solver&, const LabTestResult&)>& on_finish = {},
                           const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame = {});
+
+/// The measures of rock mechanics (ISRM; Martin & Chandler 1994; SPEC §8) from a
+/// finished curve (peak_stress set): E and ν as the slopes of the linear part —
+/// the implicit preload's line (its first `preload_points` points) or, without
+/// one, the pre-peak points from 10% of the peak up to the first broken bond or
+/// 50% of the peak; E50 the tangent at 50% of the peak; for compression, σci
+/// where the crack volumetric strain leaves zero for good and σcd where the
+/// volumetric strain reverses.
+void measure_rock_mechanics(LabTestResult& r, std::size_t preload_points, bool tension, long peak_step);
 
 /// Least-squares slope of y on x.
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y);
