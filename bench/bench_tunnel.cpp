@@ -1,7 +1,7 @@
 // Benchmark of the hybrid loop and of the paper's tunnel (issues 4 and 6).
 //   1. hybrid_scene.toml (~10k rigid blocks, ~20k zones): steps/s of the whole
 //      explicit loop, contact-updates/s and zone-updates/s over it, and the zone
-//      kernel alone (fem::step_zones) — 1 and 2 threads of the contact loop;
+//      kernel alone (fem::zone_pass) — 1 and 2 threads of the contact loop;
 //   2. examples/tunnel_voronoi.toml end to end (mesh, in-situ, implicit elastic
 //      stage, excavation, failure stage): wall time per stage, on 2 threads.
 // Prints a table and writes JSON. Usage: bench_tunnel [out.json] (run from the
@@ -64,12 +64,11 @@ int main(int argc, char** argv) {
         }
         // The zone kernel alone, on a copy of the model's zones and nodes.
         fem::Zones z = s.zones();
-        std::vector<Vec2> force(s.nodes().count());
         std::vector<std::uint8_t> keep(s.blocks().count(), 0);
         const long kernel_steps = 300;
         t0 = clock_type::now();
         for (long k = 0; k < kernel_steps; ++k)
-            fem::step_zones(z, s.nodes().position.data(), s.nodes().velocity.data(), 1.0, keep.data(), force.data());
+            fem::zone_pass(z, s.nodes().position.data(), s.nodes().velocity.data(), 1.0, keep.data());
         const double kernel_s = seconds_since(t0);
         const double cups = double(s.contacts().size()) * steps / best, zups = double(s.zones().size()) * steps / best;
         const double kernel = double(z.size()) * kernel_steps / kernel_s;
