@@ -67,7 +67,7 @@ struct LabTestOptions {
     /// Measured on the paper's specimen: docs/calibration.md, "Loading rate".
     bool servo = true;
     double servo_cracks = 2.0;
-    double servo_min_factor = 0.25, servo_max_factor = 1.5, servo_post_peak_factor = 3.0;
+    double servo_min_factor = 0.25, servo_max_factor = 1.5, servo_post_peak_factor = 1.5;
     /// The linear part by one implicit solve (run_labtest), up to this fraction of
     /// the load at which the first joint yields; not with platen blocks (their
     /// frictional contacts are not linear).
@@ -88,6 +88,7 @@ struct LabTestOptions {
     int record_every = 20;              ///< steps between stress-strain samples
     long frame_every = 4000;            ///< steps between frames of the failure series (0: none)
     int threads = 1;                    ///< threads of the contact loop
+    double max_elements = 0;            ///< limit on blocks + triangles (0: half the machine's memory)
     /// Deformable blocks (SPEC §6): with 0 < f < 1 every block is meshed (triangles
     /// of mesh_size, default size / 2) and takes the fraction f of the deformation:
     /// blocks get young / f, joints kn / (1 − f) and ks / (1 − f). 0 = rigid blocks.

@@ -18,11 +18,14 @@ std::vector<double> solve_sparse(const SparseTriplets& k, const std::vector<doub
     const Eigen::Map<const Eigen::VectorXd> rhs(f.data(), Eigen::Index(f.size()));
     Eigen::VectorXd x;
     std::string method;
-    Eigen::CholmodSupernodalLLT<Matrix, Eigen::Lower> chol;
+    // Simplicial, not supernodal: the supernodal factorisation calls the BLAS, and
+    // the BLAS installed (reference, OpenBLAS with its per-CPU kernels) changes the
+    // last bits of the answer, which a failing model turns into other cracks.
+    Eigen::CholmodSimplicialLLT<Matrix, Eigen::Lower> chol;
     chol.compute(m);
     if (chol.info() == Eigen::Success) {
         x = chol.solve(rhs);
-        method = "cholmod-supernodal-cholesky";
+        method = "cholmod-simplicial-cholesky";
     }
     const double fnorm = rhs.norm() > 0 ? rhs.norm() : 1.0;
     auto residual = [&] { return (m * x - rhs).norm() / fnorm; };

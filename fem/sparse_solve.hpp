@@ -2,8 +2,9 @@
 //
 // The stiffness of an elastic block model (rigid blocks, FE nodes, joints) is
 // symmetric and, once the supports remove every rigid-body mode, positive
-// definite: CHOLMOD's supernodal Cholesky factorises it (through Eigen's
-// wrapper). If Cholesky fails — an indefinite matrix, e.g. from joints in
+// definite: CHOLMOD's simplicial Cholesky factorises it (through Eigen's
+// wrapper; simplicial because it does not call the BLAS, so the answer is the
+// same bits whichever BLAS the machine has). If Cholesky fails — an indefinite matrix, e.g. from joints in
 // compression with large geometric terms — a sparse LU (Eigen) is tried. A
 // singular system (a floating block, a model without supports) cannot be solved
 // either way; the caller gets the residual so it can say so.
@@ -27,7 +28,7 @@ struct SparseTriplets {
 };
 
 struct SolveReport {
-    std::string method;           ///< "cholmod-supernodal-cholesky" or "sparse-lu"
+    std::string method;           ///< "cholmod-simplicial-cholesky" or "sparse-lu"
     double relative_residual = 0; ///< |K x − f| / |f|
 };
 
