@@ -4,6 +4,7 @@
 //   bbm ucs | tension | biaxial | brazilian [flags]   numerical lab tests (SPEC §8)
 // Exit status: 0 success, 2 bad input (the message names file, line and key),
 // 1 any other failure. Earlier output in DIR is only replaced by complete files.
+#include "apps/cli_checks.hpp"
 #include "apps/model_input.hpp"
 #include "apps/picture.hpp"
 #include "apps/run_model.hpp"
@@ -85,9 +86,10 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
 }
 
 int run_mesh(const std::string& model_path, const fs::path& out, const io::PictureOptions& picture,
-             bool quiet) {
+             double max_elements, bool quiet) {
     const auto t0 = std::chrono::steady_clock::now();
-    const io::ModelFile model = io::read_model(model_path);
+    io::ModelFile model = io::read_model(model_path);
+    if (max_elements > 0) model.geometry.max_elements = max_elements;
     meshing::GenerationStats stats;
     meshing::BlockAssembly blocks;
     try {
@@ -129,59 +131,63 @@ struct LabTestCli {
     std::string out = "out";
 };
 
+constexpr const char* max_elements_help =
+    "Largest number of blocks plus triangles the model may ask for (estimated before generating; default: what "
+    "fits in half of this machine's memory)";
+
 void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     auto& o = c.o;
     sub->add_option("--pattern", c.pattern, "Inner-block pattern")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
         ->capture_default_str();
     sub->add_option("--size", o.size, "Mean block size d (m), measured as --size-measure says")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--size-measure", c.size_measure,
                     "feret: the blocks' mean Feret (caliper) diameter, perimeter / pi (for trigon, of the triangles); "
                     "area: the diameter of the circle of the mean area of the Voronoi cells (trigon: before "
                     "splitting) or Delaunay triangles")
         ->check(CLI::IsMember({"feret", "area"}))->capture_default_str();
-    sub->add_option("--width", o.width, "Specimen width (m); brazilian: disc diameter")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--height", o.height, "Specimen height (m)")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--seed", o.seed, "Random seed of the block pattern")->capture_default_str();
+    sub->add_option("--width", o.width, "Specimen width (m); brazilian: disc diameter")->check(cli::positive())->capture_default_str();
+    sub->add_option("--height", o.height, "Specimen height (m)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--seed", o.seed, "Random seed of the block pattern")->check(cli::whole_at_least(0))->capture_default_str();
     sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations (0: cells of random points; more: more regular cells)")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
-    sub->add_option("--kn", o.joint.kn, "Joint normal stiffness (Pa/m)")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--ks", o.joint.ks, "Joint shear stiffness (Pa/m)")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--tensile", o.joint.tensile, "Joint tensile strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--cohesion", o.joint.cohesion, "Joint cohesion (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(CLI::Range(0.0, 89.9))->capture_default_str();
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--kn", o.joint.kn, "Joint normal stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--ks", o.joint.ks, "Joint shear stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--tensile", o.joint.tensile, "Joint tensile strength (Pa)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--cohesion", o.joint.cohesion, "Joint cohesion (Pa)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
     sub->add_option("--residual-friction", o.joint.residual_friction, "Friction after failure (degrees; default: --friction)")
-        ->check(CLI::Range(0.0, 89.9));
+        ->check(cli::in_range(0.0, 89.9));
     sub->add_option("--tension-softening", c.tension_softening, "Tension softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
-    sub->add_option("--density", o.density, "Block density (kg/m³)")->check(CLI::PositiveNumber)->capture_default_str();
+    sub->add_option("--density", o.density, "Block density (kg/m³)")->check(cli::positive())->capture_default_str();
     sub->add_option("--deformable-fraction", o.deformable_fraction,
                     "Deformable blocks (meshed into triangles) taking this fraction f of the deformation: blocks "
                     "get --young / f, joints --kn, --ks / (1 - f) (SPEC §6); 0 = rigid blocks")
-        ->check(CLI::Range(0.0, 0.99));
+        ->check(cli::in_range(0.0, 0.99));
     sub->add_option("--young", o.young, "With --deformable-fraction: target modulus E of the rock mass (Pa)")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--poisson", o.poisson, "With --deformable-fraction: Poisson's ratio of the blocks")
-        ->check(CLI::Range(0.0, 0.49))->capture_default_str();
+        ->check(cli::in_range(0.0, 0.49))->capture_default_str();
     sub->add_option("--mesh-size", o.mesh_size, "With --deformable-fraction: triangle size (m; default size / 2)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::non_negative());
     sub->add_option("--strain-rate", o.strain_per_step,
                     "Platen velocity over specimen height, per step (with the servo: the unit of its rates)")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--servo", o.servo,
                     "Servo-controlled platens: slower while cracks form, faster after failure (docs/calibration.md)")
         ->capture_default_str();
     sub->add_option("--servo-cracks", o.servo_cracks, "Servo: new cracks per record (20 steps) per 5,000 contacts it aims at")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--servo-min", o.servo_min_factor, "Servo: slowest platen speed, times --strain-rate")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--servo-max", o.servo_max_factor, "Servo: fastest platen speed before failure, times --strain-rate")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--servo-post-peak", o.servo_post_peak_factor, "Servo: platen speed after failure, times --strain-rate")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--preload", o.elastic_preload,
                     "The linear part by one implicit solve, up to just below the first joint's yield")
         ->capture_default_str();
@@ -190,21 +196,22 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--platen-friction", o.platen_friction,
                     "Rigid platen blocks pressing on the faces through contacts of this friction angle (degrees), "
                     "instead of prescribed face blocks (--platens); ucs and biaxial")
-        ->check(CLI::Range(0.0, 89.9));
+        ->check(cli::in_range(0.0, 89.9));
     sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
-        ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+        ->check(cli::in_range(0.0, 1.0))->capture_default_str();
     sub->add_option("--failure-drop", o.failure_drop,
                     "A drop by this fraction from the peak marks failure; the run stops if the stress then climbs back above the peak")
-        ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+        ->check(cli::in_range(0.0, 1.0))->capture_default_str();
     sub->add_option("--frame-every", o.frame_every,
                     "Steps between frames of the failure series in result.pvd (0: the final state only)")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
-    sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(cli::positive())->capture_default_str();
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive())->capture_default_str();
     sub->add_option("--threads", c.threads,
                     "Threads (0 = all cores): realizations run in parallel; a single one uses them in its contact loop")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::non_negative());
+    sub->add_option("--max-elements", o.max_elements, max_elements_help)->check(cli::positive());
     sub->add_option("-o,--out", c.out, "Output directory")->capture_default_str();
     sub->add_flag("-q,--quiet", quiet, "No progress, only errors");
 }
@@ -307,6 +314,45 @@ void apply_softening_flags(LabTestCli& c) {
     c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
 }
 
+std::string fmt_number(double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.6g", v);
+    return b;
+}
+
+/// The flag behind a key of the specimen's region (GeometryError from the generator).
+std::string labtest_flag(const std::string& key) {
+    if (key == "pattern.size") return "--size";
+    if (key == "mesh.size") return "--mesh-size";
+    return "--width/--height";
+}
+
+/// Refuses, before anything is generated, a specimen narrower than a few blocks or
+/// asking for more blocks and triangles than the limit.
+void check_specimen_size(const LabTestCli& c) {
+    const auto& o = c.o;
+    const bool disc = o.kind == LabTestOptions::Kind::brazilian;
+    const double width = o.width, height = disc ? o.width : o.height;
+    if (std::min(width, height) < 3.0 * o.size)
+        throw InputError("--size", 0, "",
+                         "blocks of " + fmt_number(o.size) + " m do not fit a specimen " + fmt_number(width) + " m x " +
+                             fmt_number(height) + " m: give at least 3 blocks across (--size <= " +
+                             fmt_number(std::min(width, height) / 3.0) + ")");
+    const auto geometry = labtest_geometry(o);
+    const double area = disc ? std::numbers::pi / 4.0 * width * width : width * height;
+    const auto e = meshing::estimate_region(geometry.regions.front(), area, 0.0);
+    const double limit = o.max_elements > 0 ? o.max_elements : meshing::default_max_elements();
+    if (!(e.blocks + e.zones <= limit)) {
+        const bool zones = e.zones > e.blocks;
+        throw InputError(zones ? "--mesh-size" : "--size", 0, "",
+                         "the specimen asks for about " + fmt_number(std::round(e.blocks)) + " blocks and " +
+                             fmt_number(std::round(e.zones)) + " triangles (about " + fmt_number(std::round(e.bytes() / 1e8) / 10) +
+                             " GB), over the limit of " + fmt_number(std::round(limit)) +
+                             (o.max_elements > 0 ? " (--max-elements)" : " (half of this machine's memory)") +
+                             ": give a larger size, or raise --max-elements if the machine has the memory");
+    }
+}
+
 int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* name, bool quiet) {
     auto& o = c.o;
     o.kind = kind;
@@ -317,6 +363,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
         throw InputError("--platen-friction", 0, "",
                          std::string("applies to ucs and biaxial only: ") + name +
                              " needs platens that hold the specimen (use --platens rough or smooth)");
+    check_specimen_size(c);
     const fs::path out = c.out;
     fs::create_directories(out);
     const int n = c.realizations;
@@ -330,8 +377,9 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                      c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
                      n > 1 ? "s" : "", n > 1 ? threads : threads_for_loop, (n > 1 ? threads : threads_for_loop) > 1 ? "s" : "");
     std::atomic<int> next{0};
+    std::exception_ptr failure;
     auto worker = [&] {
-        for (int k = next++; k < n; k = next++) {
+        for (int k = next++; k < n; k = next++) try {
             LabTestOptions ok = o;
             ok.seed = o.seed + k;
             // One realization: its threads go to the contact loop; several: one each.
@@ -368,11 +416,23 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",
                                  static_cast<unsigned long long>(ok.seed));
             }
+        } catch (...) {
+            // The first failure is reported; the other realizations stop.
+            std::lock_guard lock(print);
+            if (!failure) failure = std::current_exception();
+            next = n;
         }
     };
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
     for (auto& t : pool) t.join();
+    if (failure) {
+        try {
+            std::rethrow_exception(failure);
+        } catch (const GeometryError& e) {
+            throw InputError(labtest_flag(e.key()), 0, "", e.what());
+        }
+    }
     if (n > 1) {
         auto stats = [&](auto get) {
             double m = 0, v = 0;
@@ -400,11 +460,6 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                          summary["peak_stress"]["mean"].get<double>() / 1e6, out.string().c_str());
     }
     return 0;
-}
-std::string fmt_number(double v) {
-    char b[64];
-    std::snprintf(b, sizeof b, "%.6g", v);
-    return b;
 }
 
 /// `bbm calibrate`: iterates the micro-properties and writes the joint property
@@ -569,6 +624,8 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     mesh->add_option("-o,--out", out_dir, "Output directory (created if missing)")->capture_default_str();
     mesh->add_flag("-q,--quiet", quiet, "Print nothing but errors");
+    double mesh_max_elements = 0;
+    mesh->add_option("--max-elements", mesh_max_elements, max_elements_help)->check(cli::positive());
     std::vector<double> window;
     mesh->add_option("--window", window, "Part of the model drawn in blocks.png: XMIN YMIN XMAX YMAX (m)")
         ->expected(4);
@@ -585,13 +642,14 @@ int main(int argc, char** argv) {
     run->add_flag("-q,--quiet", quiet, "No progress, only errors");
     run->add_option("--threads", run_options.threads,
                     "Threads of the loop (the result is the same, bit for bit, on any number)")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::positive())
         ->capture_default_str();
     run->add_option("--checkpoint-every", run_options.checkpoint_every,
                     "Write DIR/checkpoint.bin every N steps (0: only when interrupted)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(cli::non_negative())
         ->capture_default_str();
     run->add_flag("--resume", run_options.resume, "Continue the run whose checkpoint is in --out");
+    run->add_option("--max-elements", run_options.max_elements, max_elements_help)->check(cli::positive());
 
     std::vector<std::string> compare_models;
     std::string compare_out = "out/compare";
@@ -603,7 +661,7 @@ int main(int argc, char** argv) {
     compare->add_option("models", compare_models, "Model files")->required()->check(CLI::ExistingFile);
     compare->add_option("-o,--out", compare_out, "Output directory")->capture_default_str();
     compare->add_option("--threads", compare_threads, "Threads of each run's contact loop")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::positive())
         ->capture_default_str();
     compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
 
@@ -618,18 +676,18 @@ int main(int argc, char** argv) {
                      "writes DIR/joint_property.toml (a [[joint_property]] for a model file) and calibration.json. "
                      "Exit status 4 if not converged.");
     add_labtest_options(calibrate_cmd, calibrate_cli, quiet);
-    calibrate_cmd->add_option("--target-E", targets.E, "Target Young's modulus (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
-    calibrate_cmd->add_option("--target-nu", targets.nu, "Target Poisson's ratio")->check(CLI::Range(0.01, 0.33))->capture_default_str();
-    calibrate_cmd->add_option("--target-ucs", targets.ucs, "Target uniaxial compressive strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
-    calibrate_cmd->add_option("--target-tensile", targets.tensile, "Target direct tensile strength (Pa)")->check(CLI::PositiveNumber)->capture_default_str();
+    calibrate_cmd->add_option("--target-E", targets.E, "Target Young's modulus (Pa)")->check(cli::positive())->capture_default_str();
+    calibrate_cmd->add_option("--target-nu", targets.nu, "Target Poisson's ratio")->check(cli::in_range(0.01, 0.33))->capture_default_str();
+    calibrate_cmd->add_option("--target-ucs", targets.ucs, "Target uniaxial compressive strength (Pa)")->check(cli::positive())->capture_default_str();
+    calibrate_cmd->add_option("--target-tensile", targets.tensile, "Target direct tensile strength (Pa)")->check(cli::positive())->capture_default_str();
     calibrate_cmd->add_option("--target-biaxial", targets.biaxial,
                               "Optional: target strength sigma1 of a biaxial test at --target-confinement (Pa); "
                               "calibrates the friction angle too")
-        ->check(CLI::PositiveNumber);
+        ->check(cli::positive());
     calibrate_cmd->add_option("--target-confinement", targets.confinement,
                               "Lateral stress of the --target-biaxial test (Pa, compression positive)")
-        ->check(CLI::PositiveNumber);
-    calibrate_cmd->add_option("--iterations", calibrate_iterations, "Iteration limit")->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::positive());
+    calibrate_cmd->add_option("--iterations", calibrate_iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
 
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     LabTestCli ucs_cli, tension_cli, biaxial_cli, brazilian_cli;
@@ -646,7 +704,7 @@ int main(int argc, char** argv) {
     add_labtest_options(biaxial, biaxial_cli, quiet);
     biaxial->add_option("--confinement", biaxial_cli.o.confinement, "Lateral stress (Pa, compression positive)")
         ->required()
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::non_negative());
     auto* brazilian = app.add_subcommand("brazilian", "Brazilian test: a disc of diameter --width loaded across a "
                                                       "diameter; reports the indirect tensile strength 2P/(pi D).");
     brazilian_cli.o.width = 4.0;
@@ -690,11 +748,14 @@ int main(int argc, char** argv) {
                 picture.window.add({window[0], window[1]});
                 picture.window.add({window[2], window[3]});
             }
-            return run_mesh(model_path, out_dir, picture, quiet);
+            return run_mesh(model_path, out_dir, picture, mesh_max_elements, quiet);
         }
     } catch (const InputError& e) {
         std::fprintf(stderr, "bbm: error: %s\n", e.what());
         return 2;
+    } catch (const NumericalError& e) {
+        std::fprintf(stderr, "bbm: stopped: %s\n", e.what());
+        return 3;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bbm: error: %s\n", e.what());
         return 1;

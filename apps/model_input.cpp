@@ -1310,11 +1310,12 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     if (const toml::node* n = find(c, doc, root, "model")) {
         const Path p = root.key("model");
         const toml::table& t = to_table(c, *n, p, "a [model] table");
-        static constexpr std::array<std::string_view, 2> keys{"title", "max_segment"};
+        static constexpr std::array<std::string_view, 3> keys{"title", "max_segment", "max_elements"};
         check_keys(c, t, p, keys);
         if (const toml::node* title = find(c, t, p, "title"))
             mf.title = to_str(c, *title, p.key("title"));
         mf.geometry.max_segment = number(c, t, p, "max_segment", above(0, metres)).value_or(0.1);
+        mf.geometry.max_elements = number(c, t, p, "max_elements", above(0, "")).value_or(0.0);
     }
 
     const toml::node* rn = find(c, doc, root, "region");

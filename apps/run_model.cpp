@@ -292,6 +292,7 @@ int run_model(const RunOptions& opt) {
     }
     io::ModelFile model = io::read_model(model_path);
     model.analysis.solver.threads = opt.threads;
+    if (opt.max_elements > 0) model.geometry.max_elements = opt.max_elements;
     if (model.analysis.stages.empty())
         throw InputError(model_path, 0, "stage", "the model has no [[stage]] to run (bbm mesh only generates blocks)");
     meshing::BlockAssembly blocks;
@@ -333,6 +334,8 @@ int run_model(const RunOptions& opt) {
         reports = run_stages(*solver, model.analysis.stages, output, start);
     } catch (const HealthError& e) {
         health = e.what();
+    } catch (const NumericalError& e) {
+        health = e.what();
     }
     if (interrupted) {
         output.write_checkpoint(*solver);
@@ -367,6 +370,9 @@ int run_model(const RunOptions& opt) {
                     {"dissipated", solver->dissipated_energy()}, {"external_work", solver->external_work()}}},
         {"state_hash", std::to_string(solver->state_hash())},
         {"interrupted", interrupted.load()},
+        // false: stopped by a health check or interrupted; the fields describe the
+        // last good state, not the end of the model's stages.
+        {"complete", health.empty() && !interrupted.load()},
         {"stages", stages}};
     const auto& rep = model.analysis.report;
     FailurePlotOptions fo;

@@ -45,6 +45,14 @@ private:
     std::string message_;
 };
 
+/// A numerical failure whose cause is known (a load beyond what the stiffnesses
+/// carry, a collapsing time step): the programs exit with status 3 and keep the
+/// output written so far, marked incomplete.
+class NumericalError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 /// A geometric defect in one region's description (self-intersection, hole outside,
 /// overlap). `region` indexes the region list; `key` is the key inside that region.
 class GeometryError : public std::runtime_error {

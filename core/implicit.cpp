@@ -30,6 +30,11 @@ std::string where(Vec2 p) {
     std::snprintf(buf, sizeof buf, "(%.3g, %.3g)", p.x, p.y);
     return buf;
 }
+std::string fmt_value(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return buf;
+}
 } // namespace
 
 Solver::ElasticSolveReport Solver::solve_elastic() {
@@ -163,6 +168,31 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
                 if (node_dof[k][c] >= 0 && !(diagonal[node_dof[k][c]] > 0.0))
                     throw std::runtime_error("elastic solve: node " + std::to_string(k) + " at " + where(n_.position[k]) +
                                              " has no stiffness in " + component[c] + " (a zone-less node)");
+
+        // Loads beyond what the stiffnesses carry (a stress of 1e300 Pa, a load in the
+        // wrong unit): even the stiffest single spring would move by more than the
+        // model's size, and the solve would overflow into a "singular" matrix.
+        {
+            double load = 0.0, stiffest = 0.0;
+            Box2 extent;
+            auto translational = [&](int dof) {
+                if (dof < 0) return;
+                load = std::isfinite(r[dof]) && std::isfinite(load) ? std::max(load, std::abs(r[dof])) : INFINITY;
+                stiffest = std::max(stiffest, diagonal[dof]);
+            };
+            for (int i = 0; i < nb; ++i)
+                if (!b_.removed[i] && !b_.deformable[i]) translational(block_dof[i][0]), translational(block_dof[i][1]);
+            for (int k = 0; k < nn; ++k)
+                if (!b_.removed[n_.block[k]]) translational(node_dof[k][0]), translational(node_dof[k][1]);
+            for (Vec2 v : b_.vertex) extent.add(v);
+            const double size = std::max(extent.width(), extent.height());
+            if (!(load <= stiffest * size))
+                throw NumericalError(
+                    "elastic solve: an unbalanced force of " + fmt_value(load) + " N/m against stiffnesses of at most " +
+                    fmt_value(stiffest) + " N/m² would move the model by more than its size (" + fmt_value(size) +
+                    " m): the stresses or loads are beyond what the joints and zones can carry. Check the initial "
+                    "stresses and loads (Pa, N/m) and the stiffnesses (Pa/m, Pa) for wrong units or magnitudes.");
+        }
 
         std::vector<double> du;
         try {

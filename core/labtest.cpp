@@ -30,13 +30,16 @@ bool uses_platen_blocks(const LabTestOptions& o) {
 
 meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
     meshing::ModelGeometrySpec g;
+    g.max_elements = o.max_elements;
     meshing::RegionSpec r;
     r.name = "specimen";
     if (o.kind == LabTestOptions::Kind::brazilian) {
         r.outline.kind = meshing::OutlineSpec::Kind::circle;
         r.outline.center = {0.5 * o.width, 0.5 * o.width};
         r.outline.radius = 0.5 * o.width;
-        r.outline.max_segment = 0.25 * o.size;
+        // Not finer than a thousandth of the diameter: the estimate of the model's
+        // size comes after the outline is made.
+        r.outline.max_segment = std::max(0.25 * o.size, 1e-3 * o.width);
     } else {
         r.outline.min = {0.0, 0.0};
         r.outline.max = {o.width, o.height};

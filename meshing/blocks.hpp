@@ -108,7 +108,23 @@ struct GenerationStats {
     double seconds_meshing = 0;
 };
 
-/// The whole pipeline above. Throws GeometryError for an invalid description.
+/// What a region will generate, estimated from its area and sizes before anything
+/// is generated (within a factor of about 2 for the random patterns; an upper
+/// bound for graded meshes), and the memory that takes.
+struct SizeEstimate {
+    double blocks = 0, zones = 0;
+    double bytes() const;
+};
+/// Blocks and triangles one region of `area` m² asks for; `toward_perimeter` is the
+/// length of the boundaries its mesh is refined toward (graded meshes).
+SizeEstimate estimate_region(const RegionSpec& region, double area, double toward_perimeter);
+/// The limit on blocks + triangles when the model sets none: what fits in half of
+/// the machine's physical memory.
+double default_max_elements();
+
+/// The whole pipeline above. Throws GeometryError for an invalid description, for
+/// a model that asks for more than spec.max_elements blocks and triangles, and for
+/// a patterned region that generates no blocks or far fewer than its size implies.
 BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats = nullptr);
 
 /// Polygon (counter-clockwise) of an outline, with arcs as polylines.

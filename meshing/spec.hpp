@@ -132,6 +132,10 @@ struct ModelGeometrySpec {
     std::vector<RegionSpec> regions;
     /// Default longest polyline segment for circles and arcs (m).
     double max_segment = 0.1;
+    /// Largest number of blocks plus triangles a model may ask for (estimated from
+    /// the regions' areas and sizes before anything is generated); 0 = what fits
+    /// in half of this machine's memory (default_max_elements()).
+    double max_elements = 0;
 };
 
 } // namespace bbm::meshing

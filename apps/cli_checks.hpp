@@ -1,0 +1,80 @@
+// Validators for numeric command-line options that a person can read.
+//
+// CLI11's PositiveNumber and Range let NaN through (every comparison with NaN is
+// false) and print their bounds as 300-digit numbers; an unsigned option takes
+// "-3" as 2^64 - 3. These refuse NaN, infinities and signs that do not belong, and
+// say what the option must be in the option's own terms: "--ks: must be a finite
+// number > 0, got nan". CLI11 prefixes the option name; main() exits with status 2.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace bbm::cli {
+
+namespace detail {
+/// The text as a finite double; false for NaN, infinities and what is not a number.
+inline bool parse_finite(const std::string& text, double& value) {
+    std::istringstream in(text);
+    in >> value;
+    std::string rest;
+    return !in.fail() && !(in >> rest) && std::isfinite(value);
+}
+
+inline std::string shortest(double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
+}
+
+/// A finite number for which `ok` holds, else "must be a finite number <what>, got <text>".
+template <class Ok>
+CLI::Validator finite_number(std::string what, Ok ok) {
+    return CLI::Validator(
+        [what, ok](std::string& text) -> std::string {
+            double v = 0;
+            if (parse_finite(text, v) && ok(v)) return {};
+            return "must be a finite number " + what + ", got " + text;
+        },
+        what);
+}
+} // namespace detail
+
+/// A finite number > 0.
+inline CLI::Validator positive() {
+    return detail::finite_number("> 0", [](double v) { return v > 0; });
+}
+
+/// A finite number >= 0.
+inline CLI::Validator non_negative() {
+    return detail::finite_number(">= 0", [](double v) { return v >= 0; });
+}
+
+/// A finite number in [lo, hi].
+inline CLI::Validator in_range(double lo, double hi) {
+    return detail::finite_number("in [" + detail::shortest(lo) + ", " + detail::shortest(hi) + "]",
+                                 [lo, hi](double v) { return v >= lo && v <= hi; });
+}
+
+/// A whole number >= lo (for counts and seeds held in unsigned or int options:
+/// refuses "-3" before an unsigned parse wraps it around).
+inline CLI::Validator whole_at_least(long long lo) {
+    return CLI::Validator(
+        [lo](std::string& text) -> std::string {
+            std::size_t used = 0;
+            long long v = 0;
+            try {
+                v = std::stoll(text, &used);
+            } catch (const std::exception&) {
+                return "must be a whole number >= " + std::to_string(lo) + ", got " + text;
+            }
+            if (used != text.size() || v < lo) return "must be a whole number >= " + std::to_string(lo) + ", got " + text;
+            return {};
+        },
+        ">= " + std::to_string(lo));
+}
+
+} // namespace bbm::cli
