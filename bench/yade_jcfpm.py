@@ -1,5 +1,5 @@
 # Peer measurement for bench_bbm: Yade's bonded-particle model JCFpm (Scholtès &
-# Donzé), about 3,000 spheres bonded into a block and compressed, stepped for a
+# Donzé), 8,352 spheres (radius 0.02 m, 0.6 x 0.6 x 1.2 m) bonded into a block and compressed, stepped for a
 # fixed number of steps; prints contact-updates per second (real interactions x
 # steps / wall seconds), the figure bbm's bench_bbm reports for its loop.
 # Run by bench/yade_peer.sh: yade -j THREADS -n -x bench/yade_jcfpm.py
