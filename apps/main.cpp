@@ -37,6 +37,10 @@ namespace {
 using namespace bbm;
 namespace fs = std::filesystem;
 
+/// --check: validate the options (and model files) and stop before any work.
+bool check_only = false;
+
+
 nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::GenerationStats& st,
                             double seconds) {
     using nlohmann::json;
@@ -97,7 +101,8 @@ int run_mesh(const std::string& model_path, const fs::path& out, const io::Pictu
     } catch (const GeometryError& e) {
         throw io::to_input_error(model.source, e);
     }
-    fs::create_directories(out);
+    if (check_only) return 0;
+    io::make_output_directory(out);
     io::write_blocks_vtu(blocks, out / "blocks.vtu");
     io::write_joints_vtu(blocks, out / "joints.vtu");
     io::draw_blocks(blocks, out / "blocks.png", picture);
@@ -364,8 +369,9 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, const char* na
                          std::string("applies to ucs and biaxial only: ") + name +
                              " needs platens that hold the specimen (use --platens rough or smooth)");
     check_specimen_size(c);
+    if (check_only) return 0;
     const fs::path out = c.out;
-    fs::create_directories(out);
+    io::make_output_directory(out);
     const int n = c.realizations;
     const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     const int threads = std::max(1, std::min(n, available));
@@ -487,11 +493,13 @@ int run_calibrate(LabTestCli& c, const CalibrationTargets& targets, int iteratio
     o.realizations = c.realizations;
     o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     o.max_iterations = iterations;
+    check_specimen_size(c);
+    if (check_only) return 0;
     // SPEC §8's first estimates, kn = E/d and ks = G/d, for reference; the iteration
     // starts from the lattice inversion on the generated blocks (calibrate.hpp).
     const double first_kn = targets.E / o.base.size, first_ks = targets.E / (2.0 * (1.0 + targets.nu)) / o.base.size;
     const JointPropertySpec start = calibration_start(targets, o);
-    fs::create_directories(out);
+    io::make_output_directory(out);
     const bool with_phi = targets.biaxial > 0.0;
     if (!quiet) {
         std::fprintf(stderr,
@@ -611,6 +619,9 @@ int main(int argc, char** argv) {
     app.allow_config_extras(CLI::config_extras_mode::error);
     bool quiet = false;
     app.add_flag("-q,--quiet", quiet, "Print nothing but errors");
+    app.add_flag("--check", check_only,
+                 "Check the options and model files (read, and for mesh and run, generate the blocks) and stop: "
+                 "exit status 0 if they are valid, 2 with the mistake otherwise; nothing is written");
 
     std::string model_path;
     std::string out_dir = "out";
@@ -729,13 +740,20 @@ int main(int argc, char** argv) {
                 throw InputError("bbm run", 0, "", "give a model file, or --resume with the --out of a run to continue");
             run_options.out = run_out;
             run_options.quiet = quiet;
+            run_options.check_only = check_only;
             return io::run_model(run_options);
         }
         if (*calibrate_cmd) {
             apply_softening_flags(calibrate_cli);
             return run_calibrate(calibrate_cli, targets, calibrate_iterations, calibrate_cli.out, quiet, *calibrate_cmd);
         }
-        if (*compare) return io::compare_models(compare_models, compare_out, compare_threads, quiet);
+        if (*compare) {
+            if (check_only) {
+                for (const auto& m : compare_models) (void)io::read_model(m);
+                return 0;
+            }
+            return io::compare_models(compare_models, compare_out, compare_threads, quiet);
+        }
         if (*ucs) return run_labtest_command(ucs_cli, LabTestOptions::Kind::ucs, "ucs", quiet);
         if (*tension) return run_labtest_command(tension_cli, LabTestOptions::Kind::tension, "tension", quiet);
         if (*biaxial) return run_labtest_command(biaxial_cli, LabTestOptions::Kind::biaxial, "biaxial", quiet);

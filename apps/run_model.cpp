@@ -112,6 +112,7 @@ class RunOutput : public StageObserver {
 public:
     RunOutput(const fs::path& out, const AnalysisSpec& an, const Solver& s, const RunOptions& o, std::string model)
         : out_(out), settings_(an.solver), recorder_(s, an.histories), options_(o), model_(std::move(model)) {
+        make_output_directory(out_);
         fs::create_directories(out_ / "vtk");
     }
 
@@ -308,6 +309,7 @@ int run_model(const RunOptions& opt) {
     } catch (const InputError& e) {
         throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
     }
+    if (opt.check_only) return 0;
     int rigid = 0;
     for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver->blocks().deformable[i];
     if (!opt.quiet)
@@ -440,7 +442,7 @@ int run_model(const RunOptions& opt) {
 }
 
 int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet) {
-    fs::create_directories(out);
+    make_output_directory(out);
     std::ostringstream csv, md;
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"

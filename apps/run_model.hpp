@@ -24,6 +24,7 @@ struct RunOptions {
     long checkpoint_every = 0;      ///< steps between checkpoints; 0 = only on Ctrl-C
     bool resume = false;            ///< continue from out/checkpoint.bin
     double max_elements = 0;        ///< overrides [model] max_elements when > 0
+    bool check_only = false;        ///< read, generate and set up the model, then stop (--check)
 };
 
 /// Exit status: 0 done, 130 interrupted (a checkpoint was written), 3 stopped by a

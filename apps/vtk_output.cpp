@@ -1,6 +1,7 @@
 // bbm io: VTK output of a block assembly (see vtk_output.hpp).
 #include "apps/vtk_output.hpp"
 
+#include "core/error.hpp"
 #include "core/solver.hpp"
 
 // VTK 9.1's type macros end in a stray ';' that -Wpedantic reports in every file;
@@ -311,6 +312,19 @@ void write_pvd(const fs::path& file, const std::vector<std::pair<double, std::st
     }
     xml += "  </Collection>\n</VTKFile>\n";
     write_text_atomically(file, xml);
+}
+
+void make_output_directory(const fs::path& dir) {
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+        throw InputError("--out", 0, "", dir.string() + " is a file, not a directory");
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError("--out", 0, "", "cannot create the directory " + dir.string() + ": " + ec.message());
+    const fs::path probe = dir / ".bbm-write-probe";
+    std::FILE* f = std::fopen(probe.c_str(), "wb");
+    if (!f) throw InputError("--out", 0, "", "cannot write in " + dir.string());
+    std::fclose(f);
+    fs::remove(probe, ec);
 }
 
 void write_text_atomically(const fs::path& file, std::string_view text) {

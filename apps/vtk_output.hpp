@@ -46,6 +46,11 @@ void write_joints_vtu(const meshing::BlockAssembly& a, const std::filesystem::pa
 void write_pvd(const std::filesystem::path& file,
                const std::vector<std::pair<double, std::string>>& steps);
 
+/// Creates the output directory `dir` (and its parents) and checks that files can
+/// be written in it; otherwise throws InputError naming --out and the reason (a
+/// file in the way, no permission), before any work is done.
+void make_output_directory(const std::filesystem::path& dir);
+
 /// Writes `text` to `file` atomically (summary.json, logs of a finished run).
 void write_text_atomically(const std::filesystem::path& file, std::string_view text);
 

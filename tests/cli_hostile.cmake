@@ -116,3 +116,51 @@ file(READ ${DIR}/huge_stress_out/summary.json summary)
 if(NOT summary MATCHES "\"complete\": false")
   message(FATAL_ERROR "syy = -1e300: summary.json not marked incomplete: ${summary}")
 endif()
+
+# Files that are no model at all: empty, binary garbage, 30 MB of comments.
+file(WRITE ${DIR}/empty.toml "")
+string(ASCII 255 254 1 2 3 200 201 128 129 10 91 91 255 93 garbage)
+string(REPEAT "${garbage}" 500 garbage)
+file(WRITE ${DIR}/garbage.toml "${garbage}")
+string(REPEAT "# a comment line of a huge file, and nothing else\n" 600000 huge)
+file(WRITE ${DIR}/huge.toml "${huge}")
+foreach(pair "empty.toml|empty.toml: region: a model needs at least one \\[\\[region\\]\\] table"
+             "garbage.toml|garbage.toml:1: TOML syntax error"
+             "huge.toml|huge.toml: region: a model needs at least one \\[\\[region\\]\\] table")
+  string(REPLACE "|" ";" parts "${pair}")
+  list(GET parts 0 name)
+  list(GET parts 1 expected)
+  foreach(command mesh run)
+    execute_process(COMMAND ${BBM} ${command} ${DIR}/${name} --quiet --out ${DIR}/out_${name}
+                    RESULT_VARIABLE status ERROR_VARIABLE err TIMEOUT 60)
+    if(NOT status EQUAL 2 OR NOT err MATCHES "${expected}")
+      message(FATAL_ERROR "bbm ${command} ${name}: expected status 2 and '${expected}', got ${status}: ${err}")
+    endif()
+    if(EXISTS ${DIR}/out_${name})
+      message(FATAL_ERROR "bbm ${command} ${name}: refused, but created output")
+    endif()
+  endforeach()
+endforeach()
+
+# An output path that is a file: status 2 naming --out, the file untouched.
+file(WRITE ${DIR}/a_file "not a directory\n")
+foreach(command "mesh;${MODEL}" "run;${MODEL}" "ucs;--max-strain;1e-5")
+  execute_process(COMMAND ${BBM} ${command} --quiet --out ${DIR}/a_file
+                  RESULT_VARIABLE status ERROR_VARIABLE err TIMEOUT 120)
+  if(NOT status EQUAL 2 OR NOT err MATCHES "--out: .*a_file is a file, not a directory")
+    message(FATAL_ERROR "bbm ${command} --out FILE: expected status 2 naming --out, got ${status}: ${err}")
+  endif()
+endforeach()
+file(READ ${DIR}/a_file kept)
+if(NOT kept STREQUAL "not a directory\n")
+  message(FATAL_ERROR "the file given as --out was changed")
+endif()
+
+# --check: a valid model and valid options pass (status 0) and write nothing.
+foreach(command "run;${MODEL}" "mesh;${MODEL}" "ucs;--pattern;trigon" "calibrate;--target-E;20e9")
+  execute_process(COMMAND ${BBM} --check ${command} --quiet --out ${DIR}/checked
+                  RESULT_VARIABLE status ERROR_VARIABLE err TIMEOUT 120)
+  if(NOT status EQUAL 0 OR EXISTS ${DIR}/checked)
+    message(FATAL_ERROR "bbm --check ${command}: expected status 0 and no output, got ${status}: ${err}")
+  endif()
+endforeach()
