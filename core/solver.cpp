@@ -45,8 +45,9 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     std::vector<const MaterialSpec*> region_spec(a.region_names.size(), nullptr);
     for (const auto& [region, mat] : an.region_material) {
         const auto r = std::find(region_names_.begin(), region_names_.end(), region);
+        const std::string& name = mat; // a structured binding is not captured by clang 14
         const auto m = std::find_if(an.materials.begin(), an.materials.end(),
-                                    [&](const MaterialSpec& s) { return s.name == mat; });
+                                    [&](const MaterialSpec& s) { return s.name == name; });
         if (r == region_names_.end() || m == an.materials.end())
             throw InputError("", 0, "region.material", "region '" + region + "' or material '" + mat + "' unknown");
         density[r - region_names_.begin()] = m->density;
