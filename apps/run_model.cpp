@@ -50,6 +50,12 @@ void check_health(const Solver& s) {
         "values are in SI units (Pa/m, Pa).";
     if (!std::isfinite(s.unbalanced_ratio()) || !std::isfinite(s.kinetic_energy()))
         throw HealthError("the solution became NaN or infinite at step " + std::to_string(s.steps()) + "." + advice);
+    if (!(s.timestep() >= 1e-3 * s.initial_timestep()))
+        throw HealthError(fmt("the time step collapsed at step %.0f, from %.3g s to %.3g s: ", double(s.steps()),
+                              s.initial_timestep(), s.timestep()) +
+                          "a contact far stiffer, or a block far lighter, than at the start (a sliver block left by a "
+                          "cut, or a runaway overlap). Look at the last output; raise the pattern's min_edge to remove "
+                          "slivers.");
     const auto& b = s.blocks();
     for (int i = 0; i < b.count(); ++i) {
         if (b.removed[i] || b.deformable[i]) continue;

@@ -468,6 +468,7 @@ void Solver::update_timestep() {
         b_.inertia = b_.real_inertia;
         n_.mass = n_.real_mass;
     }
+    if (first_dt_ == 0.0) first_dt_ = dt_;
 }
 
 void Solver::initialize_stress(const StressFieldSpec& field) {

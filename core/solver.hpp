@@ -110,6 +110,9 @@ public:
     double time() const { return time_; }
     long steps() const { return steps_; }
     double timestep() const { return dt_; }
+    /// The time step the model started with (the health checks compare: a step
+    /// that collapses means a sliver block or a runaway contact stiffness).
+    double initial_timestep() const { return first_dt_; }
     double kinetic_energy() const;
     double strain_energy() const;
     double dissipated_energy() const;
@@ -238,6 +241,7 @@ private:
     std::vector<Vec2> relax_block_force_, relax_node_force_;
     std::vector<double> relax_block_moment_;
     long relax_total_ = 0, relax_left_ = 0;
+    double first_dt_ = 0.0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
     // Detection: tolerance, property of new contacts, motion since the last pass.
     double tolerance_ = 0.0;
