@@ -67,7 +67,7 @@ struct LabTestOptions {
     /// Measured on the paper's specimen: docs/calibration.md, "Loading rate".
     bool servo = true;
     double servo_cracks = 2.0;
-    double servo_min_factor = 0.25, servo_max_factor = 1.5, servo_post_peak_factor = 1.5;
+    double servo_min_factor = 0.25, servo_max_factor = 1.5, servo_post_peak_factor = 0.5;
     /// The linear part by one implicit solve (run_labtest), up to this fraction of
     /// the load at which the first joint yields; not with platen blocks (their
     /// frictional contacts are not linear).
