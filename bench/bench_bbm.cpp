@@ -13,8 +13,8 @@
 // per second per core on this class of machine (bench/yade_peer.sh measures it).
 // Usage: bench_bbm [--out results.json] [--quick] (from the repository root, or
 // with BBM_SOURCE_DIR set). --quick: sizes up to 40,000 and no time to answer.
-#include "apps/run_model.hpp"
-#include "core/labtest.hpp"
+#include "studies/run_model.hpp"
+#include "studies/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <nlohmann/json.hpp>
@@ -163,11 +163,11 @@ int main(int argc, char** argv) {
             for (const auto& f : files) paths.push_back((root / f).string());
             const auto t0 = clock_type::now();
             if (paths.size() == 1) {
-                io::RunOptions o;
+                studies::RunOptions o;
                 o.model = paths[0], o.out = tmp / fs::path(files[0]).stem(), o.threads = 2, o.quiet = true;
-                io::run_model(o);
+                studies::run_model(o);
             } else {
-                io::compare_models(paths, tmp / "compare", 2, true);
+                studies::compare_models(paths, tmp / "compare", 2, true);
             }
             return Timed{seconds_since(t0), 0};
         };

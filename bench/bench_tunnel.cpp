@@ -6,8 +6,8 @@
 //      stage, excavation, failure stage): wall time per stage, on 2 threads.
 // Prints a table and writes JSON. Usage: bench_tunnel [out.json] (run from the
 // repository root, or set BBM_SOURCE_DIR).
-#include "apps/model_input.hpp"
-#include "core/analysis.hpp"
+#include "io/model_input.hpp"
+#include "core/stages.hpp"
 #include "core/solver.hpp"
 #include "fem/cst.hpp"
 

@@ -33,7 +33,7 @@
 #pragma once
 
 #include "contact/joint_law.hpp"
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 
 #include <cstdint>
 #include <vector>

@@ -22,7 +22,7 @@
 //   Unloading is elastic with the initial stiffness.
 #pragma once
 
-#include "core/model_spec.hpp"
+#include "contact/joint_property.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -14,7 +14,7 @@
 // Δu = K⁻¹ r is then applied as one step of velocity Δu/Δt through the contact
 // laws and zones (so joint histories and zone stresses stay consistent), and
 // velocities are zeroed.
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "core/solver.hpp"
 #include "fem/sparse_solve.hpp"
 

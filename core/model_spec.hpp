@@ -8,7 +8,8 @@
 // syy = -15e6), joint stiffness in Pa/m, angles in degrees.
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
+#include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
 
 #include <optional>
@@ -30,24 +31,6 @@ struct MaterialSpec {
     /// their stiffness scaled by 1 / (1 − f); 0 = not split (blocks get E, joints
     /// keep their stiffness).
     double deformable_fraction = 0;
-};
-
-/// One joint property set (SPEC §4). Which law is used follows `law`.
-struct JointPropertySpec {
-    enum class Law { elastic, coulomb, softening };
-    std::string name;
-    Law law = Law::softening;
-    double kn = 0.0;              ///< normal stiffness, Pa/m (> 0)
-    double ks = 0.0;              ///< shear stiffness, Pa/m (> 0)
-    double friction = 30.0;       ///< friction angle φ, degrees
-    double residual_friction = -1; ///< φr after failure, degrees; < 0 = friction
-    double cohesion = 0.0;        ///< c, Pa (coulomb: brittle bond; softening: peak cohesion)
-    double tensile = 0.0;         ///< σt, Pa
-    /// Post-peak points (α, β) of the softening curves, normalised as in SPEC §4
-    /// (α: displacement over the elastic displacement at peak, β: stress over peak),
-    /// in increasing α, the last with β = 0. Empty = brittle (drops to 0 at once).
-    std::vector<std::pair<double, double>> tension_softening;
-    std::vector<std::pair<double, double>> shear_softening;
 };
 
 /// Which property set the joints of given tags (and regions) get. Rules are applied
@@ -127,7 +110,7 @@ struct StageSpec {
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;
-/// core/analysis.hpp measure_opening()).
+/// core/stages.hpp measure_opening()).
 struct ReportSpec {
     bool opening = false;           ///< measure the opening (center, springline, crown given)
     Vec2 center{}, springline{}, crown{};

@@ -17,7 +17,7 @@
 // implicit solve and by mass scaling. Stress is tension positive (SPEC §2).
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 
 #include <array>
 #include <cstdint>

@@ -1,7 +1,7 @@
 // The geometry pipeline of blocks.hpp: regions, real joints, patterns, topology.
 #include "meshing/blocks.hpp"
 
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "meshing/detail.hpp"
 
 #include <algorithm>

@@ -26,7 +26,7 @@
 // contact code walks it for ~10^5 blocks.
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 #include "meshing/fe_mesh.hpp"
 #include "meshing/spec.hpp"
 

@@ -1,7 +1,7 @@
 // The one translation unit that instantiates CGAL (see cgal_ops.hpp).
 #include "meshing/cgal_ops.hpp"
 
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "meshing/detail.hpp"
 
 #include <CGAL/Arr_segment_traits_2.h>

@@ -8,7 +8,7 @@
 // crossing point, which is what lets the topology pass weld vertices exactly.
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 #include "meshing/spec.hpp"
 
 #include <array>

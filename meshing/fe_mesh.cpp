@@ -1,7 +1,7 @@
 // Boundary subdivision and gmsh triangle meshes of deformable blocks (fe_mesh.hpp).
 #include "meshing/fe_mesh.hpp"
 
-#include "core/error.hpp"
+#include "base/error.hpp"
 
 #include <gmsh.h>
 

@@ -15,7 +15,7 @@
 // global state, so calls are serialised and each uses (then removes) its own model.
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 
 #include <array>
 #include <functional>
@@ -47,7 +47,7 @@ struct TriangleMesh {
 /// boundary points are kept exactly (no node is added on the boundary) and the
 /// interior is graded between the sizes size(point) at the boundary points.
 /// Deterministic: the same boundary and sizes give the same mesh. Throws
-/// GeometryError (core/error.hpp; region -1, key "mesh") if gmsh fails, returns no
+/// GeometryError (base/error.hpp; region -1, key "mesh") if gmsh fails, returns no
 /// triangles, a node count inconsistent with the boundary, or triangles whose
 /// areas do not add up to the polygon's.
 TriangleMesh mesh_polygon(std::span<const Vec2> boundary, const SizeFunction& size,

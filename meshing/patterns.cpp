@@ -1,5 +1,5 @@
 // Inner-block patterns (paper §3.1): each fills one rock block exactly.
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "meshing/detail.hpp"
 
 #include <algorithm>

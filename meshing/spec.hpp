@@ -12,7 +12,7 @@
 // them, generate_blocks() in blocks.hpp turns them into blocks and joints.
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 
 #include <cstdint>
 #include <string>

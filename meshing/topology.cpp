@@ -1,5 +1,5 @@
 // Vertex welding, short-edge collapse and joint records (blocks.hpp, steps 4–5).
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "meshing/detail.hpp"
 
 #include <algorithm>

@@ -3,9 +3,9 @@
 // A bonded assembly must allocate nothing at all; a failing one, whose detection
 // creates and removes contacts, only when an array outgrows everything it held
 // before (amortised growth), not per step.
-#include "apps/model_input.hpp"
-#include "core/analysis.hpp"
-#include "core/labtest.hpp"
+#include "io/model_input.hpp"
+#include "core/stages.hpp"
+#include "studies/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <doctest/doctest.h>

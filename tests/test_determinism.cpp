@@ -5,9 +5,9 @@
 // here as different counts. The process runs with OMP_WAIT_POLICY=passive (set
 // by CTest) so that 3 and 4 threads on a 2-core machine wait for a core instead
 // of spinning against each other.
-#include "apps/model_input.hpp"
-#include "core/analysis.hpp"
-#include "core/labtest.hpp"
+#include "io/model_input.hpp"
+#include "core/stages.hpp"
+#include "studies/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <doctest/doctest.h>

@@ -1,9 +1,9 @@
 // Deformable blocks (issue 4): constant-strain triangles meshed by gmsh, in the
 // explicit loop beside rigid blocks, and the implicit elastic solve. Each test
 // compares with an analytic answer (examples/verification/*.toml hold the models).
-#include "apps/model_input.hpp"
-#include "apps/vtk_output.hpp"
-#include "core/analysis.hpp"
+#include "io/model_input.hpp"
+#include "io/vtk_output.hpp"
+#include "core/stages.hpp"
 #include "core/solver.hpp"
 #include "fem/cst.hpp"
 #include "fem/sparse_solve.hpp"

@@ -1,6 +1,6 @@
 // Geometry generation (meshing/): tiling, polygon validity, edge lengths, block
 // sizes, pattern invariants, real joints, topology and invalid geometry.
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "meshing/blocks.hpp"
 
 #include <doctest/doctest.h>

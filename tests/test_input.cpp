@@ -1,7 +1,7 @@
-// Tests of the model-file reader (apps/model_input): a complete file reads into the
+// Tests of the model-file reader (io/model_input): a complete file reads into the
 // right geometry description, and every kind of mistake is reported at the right
 // line and key.
-#include "apps/model_input.hpp"
+#include "io/model_input.hpp"
 
 #include <doctest/doctest.h>
 

@@ -2,7 +2,7 @@
 // through their points, fracture energies equal the areas under the curves,
 // unloading is elastic with the initial stiffness, damage persists.
 #include "contact/joint_law.hpp"
-#include "core/labtest.hpp"
+#include "studies/labtest.hpp"
 
 #include "tests/softening_reference.hpp"
 

@@ -1,8 +1,8 @@
-// Numerical lab tests (core/labtest.hpp) on the paper's 8 m × 16 m specimen of
+// Numerical lab tests (studies/labtest.hpp) on the paper's 8 m × 16 m specimen of
 // Voronoi blocks with its joint properties (SPEC §8). The runs of minutes (trigon,
 // calibration) are in test_long.cpp.
-#include "core/calibrate.hpp"
-#include "core/labtest.hpp"
+#include "studies/calibrate.hpp"
+#include "studies/labtest.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,7 +1,7 @@
 // The long validation runs (minutes each; CTest label `long`, so `ctest -LE long`
 // leaves them out): the paper's trigon specimen and the calibration of issue 5.
-#include "core/calibrate.hpp"
-#include "core/labtest.hpp"
+#include "studies/calibrate.hpp"
+#include "studies/labtest.hpp"
 
 #include <doctest/doctest.h>
 

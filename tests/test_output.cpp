@@ -1,7 +1,7 @@
-// Tests of apps/vtk_output: what is written is read back by VTK's own reader and
+// Tests of io/vtk_output: what is written is read back by VTK's own reader and
 // compared with the hand-built assembly, value by value; the atomic writers leave
 // either the new file or the old one, never a .tmp.
-#include "apps/vtk_output.hpp"
+#include "io/vtk_output.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,8 +1,9 @@
 // The paper's tunnel end to end (issue 6): the elastic reference against Kirsch,
 // the side-wall failure of the trigon model and of Voronoi blocks with joints
 // calibrated in bbm, and exact restart from a checkpoint.
-#include "apps/model_input.hpp"
-#include "core/analysis.hpp"
+#include "io/model_input.hpp"
+#include "core/stages.hpp"
+#include "studies/opening.hpp"
 #include "core/solver.hpp"
 
 #include <doctest/doctest.h>

@@ -1,8 +1,8 @@
 // Verification problems of the rigid-block engine (issue 3): the model files in
 // examples/verification/ run through the solver and compared with analytic answers.
-#include "apps/model_input.hpp"
-#include "core/analysis.hpp"
-#include "core/labtest.hpp"
+#include "io/model_input.hpp"
+#include "core/stages.hpp"
+#include "studies/labtest.hpp"
 #include "core/solver.hpp"
 
 #include "tests/softening_reference.hpp"

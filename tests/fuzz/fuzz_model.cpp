@@ -5,8 +5,8 @@
 // and triangles, and must either give blocks or throw GeometryError. Anything else
 // — another exception, a crash, a sanitizer report, a hang — is a bug. Build with
 // -DBBM_FUZZ=ON and clang (tests/fuzz/README.md).
-#include "apps/model_input.hpp"
-#include "core/error.hpp"
+#include "io/model_input.hpp"
+#include "base/error.hpp"
 #include "meshing/blocks.hpp"
 
 #include <cstddef>

@@ -18,7 +18,7 @@
 // layer needs to see it.
 #pragma once
 
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "core/model_spec.hpp"
 #include "meshing/spec.hpp"
 

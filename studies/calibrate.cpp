@@ -1,4 +1,4 @@
-#include "core/calibrate.hpp"
+#include "studies/calibrate.hpp"
 
 #include "core/solver.hpp"
 

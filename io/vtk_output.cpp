@@ -1,7 +1,7 @@
 // bbm io: VTK output of a block assembly (see vtk_output.hpp).
-#include "apps/vtk_output.hpp"
+#include "io/vtk_output.hpp"
 
-#include "core/error.hpp"
+#include "base/error.hpp"
 #include "core/solver.hpp"
 
 // VTK 9.1's type macros end in a stray ';' that -Wpedantic reports in every file;

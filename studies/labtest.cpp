@@ -1,4 +1,4 @@
-#include "core/labtest.hpp"
+#include "studies/labtest.hpp"
 
 #include "core/solver.hpp"
 

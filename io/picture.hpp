@@ -5,7 +5,7 @@
 // histories).
 #pragma once
 
-#include "core/vec2.hpp"
+#include "base/vec2.hpp"
 #include "meshing/blocks.hpp"
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-#include "apps/picture.hpp"
+#include "io/picture.hpp"
 
 #include "core/solver.hpp"
 

@@ -14,7 +14,8 @@
 #include <string>
 #include <vector>
 
-namespace bbm::io {
+namespace bbm::studies {
+
 
 struct RunOptions {
     std::string model;              ///< model file (ignored with resume)
@@ -40,4 +41,4 @@ int run_model(const RunOptions& options);
 int compare_models(const std::vector<std::string>& models, const std::filesystem::path& out, int threads,
                    bool quiet);
 
-} // namespace bbm::io
+} // namespace bbm::studies

@@ -5,7 +5,7 @@
 // ("pattern.size") under which its line is kept in ModelSource. Every table is
 // checked for unknown keys before its values are read, so a misspelt key is
 // reported as such (with a suggestion), not as the required key it failed to be.
-#include "apps/model_input.hpp"
+#include "io/model_input.hpp"
 
 #include <toml++/toml.h>
 

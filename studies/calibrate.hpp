@@ -28,7 +28,7 @@
 // (reported as the standard deviation).
 #pragma once
 
-#include "core/labtest.hpp"
+#include "studies/labtest.hpp"
 
 #include <functional>
 #include <vector>

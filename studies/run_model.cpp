@@ -1,10 +1,12 @@
-#include "apps/run_model.hpp"
+#include "studies/run_model.hpp"
 
-#include "apps/model_input.hpp"
-#include "apps/picture.hpp"
-#include "apps/vtk_output.hpp"
-#include "core/analysis.hpp"
-#include "core/error.hpp"
+#include "io/model_input.hpp"
+#include "io/picture.hpp"
+#include "io/vtk_output.hpp"
+#include "core/stages.hpp"
+#include "studies/model.hpp"
+#include "studies/opening.hpp"
+#include "base/error.hpp"
 #include "meshing/blocks.hpp"
 
 #include <nlohmann/json.hpp>
@@ -20,7 +22,8 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace bbm::io {
+namespace bbm::studies {
+using namespace bbm::io;
 
 namespace fs = std::filesystem;
 
@@ -352,64 +355,12 @@ int run_model(const RunOptions& opt) {
                          solver->steps(), (opt.out / "checkpoint.bin").string().c_str(), opt.out.string().c_str());
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    nlohmann::json stages = nlohmann::json::array();
-    for (const auto& r : reports) {
-        nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
-                         {"seconds", r.seconds}, {"converged", r.converged}};
-        if (!r.method.empty()) j["method"] = r.method;
-        stages.push_back(j);
-    }
-    nlohmann::json summary{
-        {"model", model_path},
-        {"blocks", rigid},
-        {"deformable_blocks", blocks.block_count() - rigid},
-        {"zones", solver->zones().size()},
-        {"nodes", solver->nodes().count()},
-        {"contacts", solver->contacts().size()},
-        {"steps", solver->steps()},
-        {"time", solver->time()},
-        {"timestep", solver->timestep()},
-        {"wall_seconds", seconds},
-        {"meshing_seconds", gen.seconds_regions + gen.seconds_patterns + gen.seconds_topology},
-        {"cracks", {{"tensile", solver->cracks(contact::JointState::broken_tension)},
-                    {"shear", solver->cracks(contact::JointState::broken_shear)}}},
-        {"unbalanced_ratio", solver->unbalanced_ratio()},
-        {"energy", {{"kinetic", solver->kinetic_energy()}, {"strain", solver->strain_energy()},
-                    {"dissipated", solver->dissipated_energy()}, {"external_work", solver->external_work()}}},
-        {"state_hash", std::to_string(solver->state_hash())},
-        {"interrupted", interrupted.load()},
-        // false: stopped by a health check or interrupted; the fields describe the
-        // last good state, not the end of the model's stages.
-        {"complete", health.empty() && !interrupted.load()},
-        {"stages", stages}};
+    nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, interrupted.load(),
+                                         health.empty() && !interrupted.load());
     const auto& rep = model.analysis.report;
     FailurePlotOptions fo;
     fo.title = model_path;
     if (rep.opening) {
-        const auto m = measure_opening(*solver, rep.center, rep.springline, rep.crown);
-        summary["opening"] = {
-            {"springline_displacement", {m.springline_displacement.x, m.springline_displacement.y}},
-            {"crown_displacement", {m.crown_displacement.x, m.crown_displacement.y}},
-            {"springline_convergence", m.springline_convergence},
-            {"crown_convergence", m.crown_convergence},
-            {"failed_depth_springline", m.failed_depth_springline},
-            {"failed_depth_crown", m.failed_depth_crown},
-            {"cracks_springline_sector", m.cracks_springline_sector},
-            {"cracks_crown_sector", m.cracks_crown_sector},
-            {"springline_sector_tensile", m.tensile_springline_sector},
-            {"springline_sector_shear", m.shear_springline_sector}};
-        // Hoop stress profiles from the wall outwards (compression positive, MPa).
-        const auto stress = solver->block_stresses();
-        const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
-        nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
-        for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
-            const double hs = hoop_stress_at(*solver, stress, rep.center, rep.springline, f * a_s, 0.3);
-            const double hc = hoop_stress_at(*solver, stress, rep.center, rep.crown, f * a_c, 0.3);
-            spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
-            crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
-        }
-        summary["opening"]["hoop_stress_springline"] = spring;
-        summary["opening"]["hoop_stress_crown"] = crown;
         const double r = std::max(norm(rep.springline - rep.center), norm(rep.crown - rep.center));
         Box2 all;
         for (Vec2 p : blocks.points) all.add(p);
@@ -521,4 +472,4 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
     return status;
 }
 
-} // namespace bbm::io
+} // namespace bbm::studies

@@ -1,0 +1,180 @@
+"""bbm: bonded-block models of rock failure (2D, plane strain), from Python.
+
+The same library as the ``bbm`` program (README "Python"):
+
+    import bbm
+    model = bbm.Model("examples/tunnel_voronoi.toml", threads=2)
+    model.run(callback=lambda m: print(m.steps, m.cracks), every=2000)
+    print(model.summary()["opening"]["failed_depth_springline"])
+    xy = model.blocks.centroid          # N x 2 numpy view of the solver's state
+    sxx, syy, sxy = model.blocks.stress.T
+
+    result = bbm.ucs(width=2, height=4, seed=3)   # the CLI's options as keywords
+    result["peak_stress"], result["curve"]["axial_stress"]
+
+A model file's errors raise ``bbm.InputError`` (a ValueError) with ``file``,
+``line``, ``key`` and ``message``; a numerical health stop raises
+``bbm.NumericalError``.
+"""
+
+import math as _math
+
+from ._bbm import (  # noqa: F401  (re-exported)
+    BlockArrays,
+    ContactArrays,
+    InputError,
+    Model,
+    NodeArrays,
+    NumericalError,
+    ZoneArrays,
+)
+from ._bbm import _calibrate, _labtest
+
+__all__ = [
+    "Model", "InputError", "NumericalError", "ucs", "tension", "biaxial", "brazilian", "calibrate", "to_toml",
+]
+
+
+# --- dict -> model text -------------------------------------------------------
+def _toml_key(key):
+    key = str(key)
+    if key and all(c.isalnum() or c in "_-" for c in key):
+        return key
+    return _toml_string(key)
+
+
+def _toml_string(s):
+    out = ['"']
+    for c in s:
+        if c == '"':
+            out.append('\\"')
+        elif c == "\\":
+            out.append("\\\\")
+        elif ord(c) < 0x20 or ord(c) == 0x7F:
+            out.append("\\u%04x" % ord(c))
+        else:
+            out.append(c)
+    out.append('"')
+    return "".join(out)
+
+
+def _toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if _math.isnan(v):
+            return "nan"
+        if _math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return _toml_string(v)
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    if hasattr(v, "tolist"):  # numpy arrays and scalars
+        return _toml_value(v.tolist())
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to a model file: {v!r}")
+
+
+def _is_table_array(v):
+    return isinstance(v, (list, tuple)) and len(v) > 0 and all(isinstance(x, dict) for x in v)
+
+
+def to_toml(model):
+    """The model-file text of a dict with the structure of a model file (as
+    ``tomllib.load`` returns it): top-level tables become ``[table]``, lists of
+    tables ``[[table]]``, deeper tables inline tables."""
+    if not isinstance(model, dict):
+        raise TypeError("a model is a dict of the model file's tables")
+    lines = []
+    for key, value in model.items():
+        if isinstance(value, dict):
+            lines.append(f"\n[{_toml_key(key)}]")
+            lines.extend(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items())
+        elif _is_table_array(value):
+            for item in value:
+                lines.append(f"\n[[{_toml_key(key)}]]")
+                lines.extend(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in item.items())
+        else:
+            lines.insert(0, f"{_toml_key(key)} = {_toml_value(value)}")
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def _from_dict(model, name="<dict>", threads=1, max_elements=0.0):
+    """A model from a dict with the structure of a model file (docs/input.md), as
+    ``tomllib.load(open(path, "rb"))`` gives it. Errors name the key."""
+    text = to_toml(model)
+    try:
+        return Model._from_text(text, name, threads, max_elements)
+    except InputError as e:
+        # The line would be one of the generated text: name the key only.
+        key = getattr(e, "key", "")
+        err = InputError(f"{name}: {key + ': ' if key else ''}{getattr(e, 'message', str(e))}")
+        err.file, err.line, err.key, err.message = name, 0, key, getattr(e, "message", str(e))
+        raise err from None
+
+
+Model.from_dict = staticmethod(_from_dict)
+
+
+# --- lab tests and calibration --------------------------------------------------
+def _option_args(options):
+    args = []
+    for key, value in options.items():
+        if value is None:
+            continue
+        flag = "--" + key.replace("_", "-")
+        if isinstance(value, bool):
+            value = "true" if value else "false"
+        elif isinstance(value, (list, tuple)) or hasattr(value, "tolist"):
+            value = ",".join(repr(float(x)) if isinstance(x, float) else str(x) for x in list(value))
+        elif isinstance(value, float):
+            value = repr(value)
+        args += [flag, str(value)]
+    return args
+
+
+def _run_labtest(command, quiet, options):
+    summary, curves = _labtest(command, _option_args(options), quiet)
+    if len(curves) == 1:
+        summary["curve"] = curves[0]
+    else:
+        for entry, curve in zip(summary["per_realization"], curves):
+            entry["curve"] = curve
+    return summary
+
+
+def ucs(quiet=True, **options):
+    """Uniaxial compression test; keyword arguments are ``bbm ucs``'s options
+    (``size=0.3, pattern="trigon", realizations=3, out="dir"``...; see
+    ``bbm ucs --help``). Files are written only with ``out``. Returns the dict of
+    summary.json with the stress-strain curve as numpy arrays (``curve``; with
+    realizations, in each ``per_realization`` entry)."""
+    return _run_labtest("ucs", quiet, options)
+
+
+def tension(quiet=True, **options):
+    """Direct tension test; options as ``bbm tension`` (see ucs())."""
+    return _run_labtest("tension", quiet, options)
+
+
+def biaxial(quiet=True, **options):
+    """Biaxial compression at ``confinement`` (Pa); options as ``bbm biaxial`` (see ucs())."""
+    return _run_labtest("biaxial", quiet, options)
+
+
+def brazilian(quiet=True, **options):
+    """Brazilian test of a disc of diameter ``width``; options as ``bbm brazilian`` (see ucs())."""
+    return _run_labtest("brazilian", quiet, options)
+
+
+def calibrate(quiet=True, **options):
+    """Calibrates kn, ks, tensile strength and cohesion (and friction with
+    ``target_biaxial``) to targets; options as ``bbm calibrate`` (``target_E=20e9,
+    target_ucs=20.7e6``...). Returns the dict of calibration.json, with the joint
+    property set's model-file text in ``joint_property_toml``."""
+    return _calibrate(_option_args(options), quiet)

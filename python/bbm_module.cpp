@@ -1,0 +1,415 @@
+// bbm python: the extension module _bbm behind the `bbm` package (python/bbm/).
+//
+// A thin front end on the library (studies/): Model is studies::Model; the lab
+// tests and the calibration parse their keyword arguments, turned into option
+// strings by bbm/__init__.py, with the program's own option definitions.
+//
+// Arrays: the state the solver keeps in flat arrays that never move once the
+// model is built (block centroids, velocities, rotations, areas, regions; FE node
+// positions and velocities; zone corners, stresses and strains) is handed out as
+// read-only numpy views of the solver's memory, alive as long as the model.
+// Values derived on request (displacements, block stresses, zone areas) and the
+// contact arrays are fresh arrays: contacts are created and removed as blocks
+// move, so their storage grows and moves during a run, and a view of it would
+// dangle. The GIL is released while the loop runs; a callback, or Ctrl-C every
+// 1,000 steps, takes it back.
+#include "base/error.hpp"
+#include "studies/commands.hpp"
+#include "studies/model.hpp"
+
+#include <nlohmann/json.hpp>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cmath>
+#include <optional>
+
+namespace py = pybind11;
+using namespace bbm;
+using studies::Model;
+
+namespace {
+
+py::object json_to_python(const nlohmann::json& j) {
+    return py::module_::import("json").attr("loads")(j.dump());
+}
+
+/// A read-only numpy view of `count` rows of `cols` values of type T starting at
+/// `data`, `stride` bytes between rows; `owner` keeps the memory alive.
+template <class T>
+py::array view(const void* data, py::ssize_t count, py::ssize_t cols, py::ssize_t stride, py::handle owner) {
+    std::vector<py::ssize_t> shape{count}, strides{stride};
+    if (cols > 0) shape.push_back(cols), strides.push_back(sizeof(T));
+    py::array a(py::dtype::of<T>(), shape, strides, data, owner);
+    py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    return a;
+}
+
+template <class T>
+py::array_t<T> fresh(py::ssize_t count, py::ssize_t cols = 0) {
+    if (cols > 0) return py::array_t<T>({count, cols});
+    return py::array_t<T>(count);
+}
+
+/// Runs `work` without the GIL; a Python callback every `every` steps, and a check
+/// for Ctrl-C every 1,000 steps. A Python exception raised in the callback (or
+/// KeyboardInterrupt) stops the run after that step and is raised here.
+template <class Work>
+void run_released(Model& m, const std::optional<py::function>& callback, long every, Work&& work) {
+    std::optional<py::error_already_set> failure;
+    studies::ModelProgress progress;
+    progress.every = every > 0 ? every : 1000;
+    progress.callback = [&](const Model&) {
+        py::gil_scoped_acquire gil;
+        try {
+            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+            if (!callback) return true;
+            const py::object r = (*callback)(py::cast(m, py::return_value_policy::reference));
+            return r.is_none() || r.cast<bool>();
+        } catch (py::error_already_set& e) {
+            failure.emplace(std::move(e));
+            return false;
+        }
+    };
+    {
+        py::gil_scoped_release release;
+        work(progress);
+    }
+    if (failure) throw std::move(*failure);
+}
+
+struct BlockArrays {
+    py::object model;
+};
+struct ContactArrays {
+    py::object model;
+};
+struct ZoneArrays {
+    py::object model;
+};
+struct NodeArrays {
+    py::object model;
+};
+
+const Solver& solver_of(const py::object& m) { return m.cast<const Model&>().solver(); }
+
+} // namespace
+
+PYBIND11_MODULE(_bbm, mod) {
+    mod.doc() = "bbm: bonded-block models of rock failure (2D, plane strain) — the compiled core of the bbm package";
+
+    // Exceptions: bbm.InputError (a ValueError) carries file, line and key.
+    static py::exception<InputError> input_error(mod, "InputError", PyExc_ValueError);
+    static py::exception<NumericalError> numerical_error(mod, "NumericalError", PyExc_RuntimeError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const InputError& e) {
+            py::object err = input_error(py::str(e.what()));
+            err.attr("file") = e.file();
+            err.attr("line") = e.line();
+            err.attr("key") = e.key();
+            err.attr("message") = e.message();
+            PyErr_SetObject(input_error.ptr(), err.ptr());
+        } catch (const GeometryError& e) {
+            py::object err = input_error(py::str(e.what()));
+            err.attr("file") = "";
+            err.attr("line") = 0;
+            err.attr("key") = e.key();
+            err.attr("message") = std::string(e.what());
+            PyErr_SetObject(input_error.ptr(), err.ptr());
+        } catch (const NumericalError& e) {
+            numerical_error(e.what());
+        }
+    });
+
+    py::class_<BlockArrays>(mod, "BlockArrays", "Per-block arrays (N = blocks, excavated ones included)")
+        .def_property_readonly("count", [](const BlockArrays& a) { return solver_of(a.model).blocks().count(); })
+        .def_property_readonly("centroid", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<double>(b.centroid.data(), b.count(), 2, sizeof(Vec2), a.model);
+        }, "N×2 current centroids, m (view)")
+        .def_property_readonly("velocity", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<double>(b.velocity.data(), b.count(), 2, sizeof(Vec2), a.model);
+        }, "N×2 velocities, m/s (quasi-static: m per step) (view)")
+        .def_property_readonly("rotation", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<double>(b.theta.data(), b.count(), 0, sizeof(double), a.model);
+        }, "N rotations, rad, counter-clockwise (view)")
+        .def_property_readonly("area", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<double>(b.area.data(), b.count(), 0, sizeof(double), a.model);
+        }, "N areas, m² (view)")
+        .def_property_readonly("region", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<int>(b.region.data(), b.count(), 0, sizeof(int), a.model);
+        }, "N region indices into Model.region_names (view)")
+        .def_property_readonly("removed", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<std::uint8_t>(b.removed.data(), b.count(), 0, 1, a.model).attr("astype")("bool");
+        }, "N flags: excavated")
+        .def_property_readonly("deformable", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            return view<std::uint8_t>(b.deformable.data(), b.count(), 0, 1, a.model).attr("astype")("bool");
+        }, "N flags: meshed into zones")
+        .def_property_readonly("displacement", [](const BlockArrays& a) {
+            const auto& b = solver_of(a.model).blocks();
+            auto out = fresh<double>(b.count(), 2);
+            auto o = out.mutable_unchecked<2>();
+            for (int i = 0; i < b.count(); ++i) {
+                const Vec2 d = b.centroid[i] - b.centroid0[i];
+                o(i, 0) = d.x, o(i, 1) = d.y;
+            }
+            return out;
+        }, "N×2 centroid displacements since the start, m (computed)")
+        .def_property_readonly("stress", [](const BlockArrays& a) {
+            const auto s = solver_of(a.model).block_stresses();
+            auto out = fresh<double>(py::ssize_t(s.size()), 3);
+            auto o = out.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < s.size(); ++i)
+                for (int k = 0; k < 3; ++k) o(i, k) = s[i][k];
+            return out;
+        }, "N×3 block-averaged stress sxx, syy, sxy, Pa, tension positive (SPEC §7; computed)");
+
+    py::class_<ContactArrays>(mod, "ContactArrays", "Per-contact arrays (M = contacts now; fresh copies)")
+        .def_property_readonly("count", [](const ContactArrays& a) { return solver_of(a.model).contacts().size(); })
+        .def_property_readonly("normal_stress", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<double>(c.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].sn;
+            return out;
+        }, "M normal stresses σn, Pa, compression positive")
+        .def_property_readonly("shear_stress", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<double>(c.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].tau;
+            return out;
+        }, "M shear stresses τ, Pa")
+        .def_property_readonly("damage", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<double>(c.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].damage;
+            return out;
+        }, "M damage D of SPEC §4, 0 intact to 1 broken")
+        .def_property_readonly("state", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<std::int32_t>(c.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < c.size(); ++i) {
+                o(i) = int(contact::state_of(c.history[i])); // as contacts.vtu
+            }
+            return out;
+        }, "M states: 0 intact, 1 softening, 2 broken in tension, 3 broken in shear, 4 sliding")
+        .def_property_readonly("bonded", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<bool>(c.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].bonded;
+            return out;
+        }, "M flags: the bond holds")
+        .def_property_readonly("block_pair", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<std::int32_t>(c.size(), 2);
+            auto o = out.mutable_unchecked<2>();
+            for (int i = 0; i < c.size(); ++i) o(i, 0) = c.vertex_block[i], o(i, 1) = c.edge_block[i];
+            return out;
+        }, "M×2 blocks: the vertex's, the edge's")
+        .def_property_readonly("length", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<double>(c.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < c.size(); ++i) o(i) = c.length[i];
+            return out;
+        }, "M joint lengths the contacts stand for, m")
+        .def_property_readonly("normal", [](const ContactArrays& a) {
+            const auto& c = solver_of(a.model).contacts();
+            auto out = fresh<double>(c.size(), 2);
+            auto o = out.mutable_unchecked<2>();
+            for (int i = 0; i < c.size(); ++i) o(i, 0) = c.normal[i].x, o(i, 1) = c.normal[i].y;
+            return out;
+        }, "M×2 unit normals (out of the edge's block)")
+        .def_property_readonly("position", [](const ContactArrays& a) {
+            const auto& s = solver_of(a.model);
+            const auto& c = s.contacts();
+            auto out = fresh<double>(c.size(), 2);
+            auto o = out.mutable_unchecked<2>();
+            for (int i = 0; i < c.size(); ++i) {
+                const Vec2 x = s.blocks().vertex[c.vertex_id[i]];
+                o(i, 0) = x.x, o(i, 1) = x.y;
+            }
+            return out;
+        }, "M×2 contact points (the vertices), m");
+
+    py::class_<ZoneArrays>(mod, "ZoneArrays", "Per-zone arrays of deformable blocks (K = constant-strain triangles)")
+        .def_property_readonly("count", [](const ZoneArrays& a) { return solver_of(a.model).zones().size(); })
+        .def_property_readonly("nodes", [](const ZoneArrays& a) {
+            const auto& z = solver_of(a.model).zones();
+            return view<int>(z.node.data(), z.size(), 3, sizeof(std::array<int, 3>), a.model);
+        }, "K×3 node indices, counter-clockwise (view)")
+        .def_property_readonly("stress", [](const ZoneArrays& a) {
+            const auto& z = solver_of(a.model).zones();
+            return view<double>(z.stress.data(), z.size(), 3, sizeof(std::array<double, 3>), a.model);
+        }, "K×3 stress sxx, syy, sxy, Pa, tension positive (view)")
+        .def_property_readonly("strain", [](const ZoneArrays& a) {
+            const auto& z = solver_of(a.model).zones();
+            return view<double>(z.strain.data(), z.size(), 3, sizeof(std::array<double, 3>), a.model);
+        }, "K×3 strain exx, eyy, exy (tensor shear) (view)")
+        .def_property_readonly("block", [](const ZoneArrays& a) {
+            const auto& z = solver_of(a.model).zones();
+            return view<int>(z.block.data(), z.size(), 0, sizeof(int), a.model);
+        }, "K owning blocks (view)")
+        .def_property_readonly("region", [](const ZoneArrays& a) {
+            const auto& s = solver_of(a.model);
+            const auto& z = s.zones();
+            auto out = fresh<std::int32_t>(z.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < z.size(); ++i) o(i) = s.blocks().region[z.block[i]];
+            return out;
+        }, "K region indices (computed)")
+        .def_property_readonly("centroid", [](const ZoneArrays& a) {
+            const auto& s = solver_of(a.model);
+            const auto& z = s.zones();
+            auto out = fresh<double>(z.size(), 2);
+            auto o = out.mutable_unchecked<2>();
+            for (int i = 0; i < z.size(); ++i) {
+                const auto& p = s.nodes().position;
+                const Vec2 c = (p[z.node[i][0]] + p[z.node[i][1]] + p[z.node[i][2]]) / 3.0;
+                o(i, 0) = c.x, o(i, 1) = c.y;
+            }
+            return out;
+        }, "K×2 current centroids, m (computed)")
+        .def_property_readonly("area", [](const ZoneArrays& a) {
+            const auto& s = solver_of(a.model);
+            const auto& z = s.zones();
+            auto out = fresh<double>(z.size());
+            auto o = out.mutable_unchecked<1>();
+            for (int i = 0; i < z.size(); ++i) {
+                const auto& p = s.nodes().position;
+                o(i) = 0.5 * cross(p[z.node[i][1]] - p[z.node[i][0]], p[z.node[i][2]] - p[z.node[i][0]]);
+            }
+            return out;
+        }, "K current areas, m² (computed)");
+
+    py::class_<NodeArrays>(mod, "NodeArrays", "Per-node arrays of deformable blocks")
+        .def_property_readonly("count", [](const NodeArrays& a) { return solver_of(a.model).nodes().count(); })
+        .def_property_readonly("position", [](const NodeArrays& a) {
+            const auto& n = solver_of(a.model).nodes();
+            return view<double>(n.position.data(), n.count(), 2, sizeof(Vec2), a.model);
+        }, "n×2 positions, m (view)")
+        .def_property_readonly("velocity", [](const NodeArrays& a) {
+            const auto& n = solver_of(a.model).nodes();
+            return view<double>(n.velocity.data(), n.count(), 2, sizeof(Vec2), a.model);
+        }, "n×2 velocities (view)")
+        .def_property_readonly("displacement", [](const NodeArrays& a) {
+            const auto& n = solver_of(a.model).nodes();
+            auto out = fresh<double>(n.count(), 2);
+            auto o = out.mutable_unchecked<2>();
+            for (int i = 0; i < n.count(); ++i) {
+                const Vec2 d = n.position[i] - n.position0[i];
+                o(i, 0) = d.x, o(i, 1) = d.y;
+            }
+            return out;
+        }, "n×2 displacements since the start, m (computed)");
+
+    py::class_<Model>(mod, "Model")
+        .def(py::init([](const std::string& path, int threads, double max_elements) {
+                 py::gil_scoped_release release;
+                 return Model::from_file(path, threads, max_elements);
+             }),
+             py::arg("path"), py::arg("threads") = 1, py::arg("max_elements") = 0.0,
+             "Reads a model file as `bbm run` does (bbm.InputError naming file, line and key) and builds it.")
+        .def_static("_from_text", [](const std::string& text, const std::string& name, int threads, double max_elements) {
+                 py::gil_scoped_release release;
+                 return Model::from_text(text, name, threads, max_elements);
+             }, py::arg("text"), py::arg("name"), py::arg("threads") = 1, py::arg("max_elements") = 0.0)
+        .def_static("resume", [](const std::filesystem::path& path, int threads) {
+                 py::gil_scoped_release release;
+                 return Model::resume(path, threads);
+             }, py::arg("path"), py::arg("threads") = 1,
+             "A model saved by checkpoint(), ready to continue where it stopped.")
+        .def("run", [](Model& m, std::optional<py::function> callback, long every) {
+                 run_released(m, callback, every, [&](const studies::ModelProgress& p) { m.run(p); });
+             }, py::arg("callback") = py::none(), py::arg("every") = 1000,
+             "Runs the stages not yet done. callback(model) every `every` steps and at stage ends; returning "
+             "False stops after that step (run() again continues).")
+        .def("run_stage", [](Model& m, const std::string& name, std::optional<py::function> callback, long every) {
+                 run_released(m, callback, every, [&](const studies::ModelProgress& p) { m.run_stage(name, p); });
+             }, py::arg("name"), py::arg("callback") = py::none(), py::arg("every") = 1000,
+             "Runs the stages up to and including the one named.")
+        .def("step", [](Model& m, long n, std::optional<py::function> callback, long every) {
+                 run_released(m, callback, every, [&](const studies::ModelProgress& p) { m.step(n, p); });
+             }, py::arg("n") = 1, py::arg("callback") = py::none(), py::arg("every") = 1000,
+             "n explicit steps with the boundary conditions as they stand.")
+        .def("checkpoint", [](const Model& m, const std::filesystem::path& path) { m.checkpoint(path); },
+             py::arg("path"), "Saves the model (its text and state) to continue with Model.resume(path).")
+        .def("summary", [](const Model& m) { return json_to_python(m.summary()); },
+             "The dict of summary.json (as `bbm run` writes it) for the state now.")
+        .def("write_vtk", [](const Model& m, const std::filesystem::path& dir) { m.write_vtk(dir); }, py::arg("dir"),
+             "Writes DIR/blocks.vtu, contacts.vtu and result.pvd of the state now, for ParaView.")
+        .def_property_readonly("blocks", [](py::object self) { return BlockArrays{self}; })
+        .def_property_readonly("contacts", [](py::object self) { return ContactArrays{self}; })
+        .def_property_readonly("zones", [](py::object self) { return ZoneArrays{self}; })
+        .def_property_readonly("nodes", [](py::object self) { return NodeArrays{self}; })
+        .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
+        .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
+        .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })
+        .def_property_readonly("state_hash", [](const Model& m) { return std::to_string(m.solver().state_hash()); },
+                               "The hash summary.json reports: equal hashes, equal states")
+        .def_property_readonly("cracks", [](const Model& m) {
+            return py::dict(py::arg("tensile") = m.solver().cracks(contact::JointState::broken_tension),
+                            py::arg("shear") = m.solver().cracks(contact::JointState::broken_shear));
+        })
+        .def_property_readonly("stage_names", &Model::stage_names)
+        .def_property_readonly("stages_done", [](const Model& m) {
+            std::vector<std::string> names;
+            const auto all = m.stage_names();
+            for (int k = 0; k < m.cursor().stage && k < int(all.size()); ++k) names.push_back(all[k]);
+            return names;
+        })
+        .def_property_readonly("region_names", [](const Model& m) { return m.solver().region_names(); })
+        .def_property_readonly("name", &Model::name);
+
+    mod.def("_labtest", [](const std::string& command, const std::vector<std::string>& args, bool quiet) {
+        studies::LabTestStudy study;
+        {
+            py::gil_scoped_release release;
+            study = studies::run_labtest_args(command, args, quiet);
+        }
+        py::list curves;
+        for (const auto& r : study.results) {
+            const auto n = py::ssize_t(r.curve.size());
+            auto step = fresh<std::int64_t>(n);
+            auto axial_strain = fresh<double>(n), axial_stress = fresh<double>(n), lateral_strain = fresh<double>(n);
+            auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
+            auto ratio = fresh<double>(n), rate = fresh<double>(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& p = r.curve[i];
+                step.mutable_at(i) = p.step, axial_strain.mutable_at(i) = p.axial_strain;
+                axial_stress.mutable_at(i) = p.axial_stress, lateral_strain.mutable_at(i) = p.lateral_strain;
+                tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
+                ratio.mutable_at(i) = p.unbalanced_ratio, rate.mutable_at(i) = p.strain_per_step;
+            }
+            py::dict c;
+            c["step"] = step, c["axial_strain"] = axial_strain, c["axial_stress"] = axial_stress;
+            c["lateral_strain"] = lateral_strain, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
+            c["unbalanced_ratio"] = ratio, c["strain_per_step"] = rate;
+            curves.append(c);
+        }
+        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), curves);
+    });
+    mod.def("_calibrate", [](const std::vector<std::string>& args, bool quiet) {
+        std::string json;
+        {
+            py::gil_scoped_release release;
+            json = studies::run_calibrate_args(args, quiet);
+        }
+        return py::module_::import("json").attr("loads")(json);
+    });
+}

@@ -1,0 +1,722 @@
+#include "studies/commands.hpp"
+
+#include "io/model_input.hpp"
+#include "io/picture.hpp"
+#include "io/vtk_output.hpp"
+#include "base/error.hpp"
+#include "core/solver.hpp"
+#include "meshing/blocks.hpp"
+#include "studies/calibrate.hpp"
+#include "studies/cli_checks.hpp"
+#include "studies/labtest.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <numbers>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+namespace bbm::studies {
+
+
+using namespace bbm;
+namespace cli = bbm::cli;
+namespace fs = std::filesystem;
+
+
+
+namespace {
+
+nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::GenerationStats& st,
+                            double seconds) {
+    using nlohmann::json;
+    double total_area = 0.0, inner_area = 0.0;
+    int inner_blocks = 0;
+    double min_edge = INFINITY;
+    for (int b = 0; b < a.block_count(); ++b) {
+        total_area += a.area[b];
+        if (a.pattern[b] == meshing::PatternSpec::Kind::single) continue;
+        inner_area += a.area[b];
+        ++inner_blocks;
+        const auto p = a.block(b);
+        for (std::size_t i = 0; i < p.size(); ++i) min_edge = std::min(min_edge, norm(p[(i + 1) % p.size()] - p[i]));
+    }
+    json regions = json::array();
+    for (int r = 0; r < int(a.region_names.size()); ++r) {
+        int n = 0;
+        double area = 0.0;
+        meshing::PatternSpec::Kind kind{};
+        for (int b = 0; b < a.block_count(); ++b)
+            if (a.region[b] == r) ++n, area += a.area[b], kind = a.pattern[b];
+        regions.push_back({{"name", a.region_names[r]},
+                           {"pattern", n ? meshing::to_string(kind) : "none"},
+                           {"blocks", n},
+                           {"area", area},
+                           {"target_size", a.region_size[r]},
+                           {"mean_feret_diameter", meshing::mean_feret_diameter(a, r)},
+                           {"equal_area_diameter", meshing::mean_block_size(a, r)}});
+    }
+    std::map<std::string, int> tags;
+    for (const auto& j : a.joints) ++tags[meshing::to_string(j.tag)];
+    return {{"blocks", a.block_count()},
+            {"joints", a.joints.size()},
+            {"joints_by_tag", tags},
+            {"total_area", total_area},
+            {"inner_blocks", inner_blocks},
+            {"equal_area_diameter",
+             inner_blocks ? std::sqrt(4.0 * inner_area / inner_blocks / 3.141592653589793) : 0.0},
+            {"min_edge_length", inner_blocks ? min_edge : 0.0},
+            {"collapsed_edges", st.collapsed_edges},
+            {"short_edges_left", st.short_edges_left},
+            {"regions", regions},
+            {"seconds", {{"regions", st.seconds_regions},
+                         {"patterns", st.seconds_patterns},
+                         {"topology", st.seconds_topology},
+                         {"total", seconds}}}};
+}
+
+} // namespace
+
+int run_mesh(const MeshCommand& command, bool quiet, bool check_only) {
+    const std::string& model_path = command.model;
+    const fs::path& out = command.out;
+    const double max_elements = command.max_elements;
+    io::PictureOptions picture;
+    if (command.window.size() == 4) {
+        const auto& w = command.window;
+        if (!(w[2] > w[0] && w[3] > w[1])) throw InputError("--window", 0, "", "needs XMIN < XMAX and YMIN < YMAX");
+        picture.window.add({w[0], w[1]});
+        picture.window.add({w[2], w[3]});
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    io::ModelFile model = io::read_model(model_path);
+    if (max_elements > 0) model.geometry.max_elements = max_elements;
+    meshing::GenerationStats stats;
+    meshing::BlockAssembly blocks;
+    try {
+        blocks = meshing::generate_blocks(model.geometry, &stats);
+    } catch (const GeometryError& e) {
+        throw io::to_input_error(model.source, e);
+    }
+    if (check_only) return 0;
+    io::make_output_directory(out);
+    io::write_blocks_vtu(blocks, out / "blocks.vtu");
+    io::write_joints_vtu(blocks, out / "joints.vtu");
+    io::draw_blocks(blocks, out / "blocks.png", picture);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const auto summary = mesh_summary(blocks, stats, seconds);
+    io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
+    if (!quiet) {
+        std::printf("%s: %d blocks, %zu joints, area %.6g m² (%.2f s)\n", model_path.c_str(),
+                    blocks.block_count(), blocks.joints.size(), summary["total_area"].get<double>(), seconds);
+        for (const auto& r : summary["regions"])
+            std::printf("  region %-12s %-9s %7d blocks  %10.4f m²  mean Feret diameter %.4g m, equal-area "
+                        "diameter %.4g m\n",
+                        r["name"].get<std::string>().c_str(), r["pattern"].get<std::string>().c_str(),
+                        r["blocks"].get<int>(), r["area"].get<double>(), r["mean_feret_diameter"].get<double>(),
+                        r["equal_area_diameter"].get<double>());
+        std::printf("  wrote %s/{blocks.vtu, joints.vtu, blocks.png, summary.json}\n", out.string().c_str());
+    }
+    return 0;
+}
+
+
+
+const char* labtest_name(LabTestOptions::Kind kind) {
+    switch (kind) {
+    case LabTestOptions::Kind::ucs: return "ucs";
+    case LabTestOptions::Kind::tension: return "tension";
+    case LabTestOptions::Kind::biaxial: return "biaxial";
+    case LabTestOptions::Kind::brazilian: return "brazilian";
+    }
+    return "ucs";
+}
+
+LabTestOptions::Kind labtest_kind(const std::string& command) {
+    for (auto k : {LabTestOptions::Kind::ucs, LabTestOptions::Kind::tension, LabTestOptions::Kind::biaxial,
+                   LabTestOptions::Kind::brazilian})
+        if (command == labtest_name(k)) return k;
+    throw InputError(command, 0, "", "not a lab test (ucs, tension, biaxial, brazilian)");
+}
+
+LabTestCli labtest_defaults(LabTestOptions::Kind kind) {
+    LabTestCli c;
+    c.o.kind = kind;
+    // Direct tension peaks at a tenth of the strain: loaded ten times slower.
+    if (kind == LabTestOptions::Kind::tension) c.o.strain_per_step = 5e-9;
+    if (kind == LabTestOptions::Kind::brazilian) c.o.width = 4.0, c.o.strain_per_step = 1e-8;
+    return c;
+}
+
+const char* const max_elements_help =
+    "Largest number of blocks plus triangles the model may ask for (estimated before generating; default: what "
+    "fits in half of this machine's memory)";
+
+void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
+    auto& o = c.o;
+    sub->add_option("--pattern", c.pattern, "Inner-block pattern")
+        ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
+        ->capture_default_str();
+    sub->add_option("--size", o.size, "Mean block size d (m), measured as --size-measure says")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--size-measure", c.size_measure,
+                    "feret: the blocks' mean Feret (caliper) diameter, perimeter / pi (for trigon, of the triangles); "
+                    "area: the diameter of the circle of the mean area of the Voronoi cells (trigon: before "
+                    "splitting) or Delaunay triangles")
+        ->check(CLI::IsMember({"feret", "area"}))->capture_default_str();
+    sub->add_option("--width", o.width, "Specimen width (m); brazilian: disc diameter")->check(cli::positive())->capture_default_str();
+    sub->add_option("--height", o.height, "Specimen height (m)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--seed", o.seed, "Random seed of the block pattern")->check(cli::whole_at_least(0))->capture_default_str();
+    sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations (0: cells of random points; more: more regular cells)")
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--kn", o.joint.kn, "Joint normal stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--ks", o.joint.ks, "Joint shear stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--tensile", o.joint.tensile, "Joint tensile strength (Pa)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--cohesion", o.joint.cohesion, "Joint cohesion (Pa)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
+    sub->add_option("--residual-friction", o.joint.residual_friction, "Friction after failure (degrees; default: --friction)")
+        ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--tension-softening", c.tension_softening, "Tension softening b1,a1,a2 (SPEC §4)")
+        ->delimiter(',')->expected(3)->capture_default_str();
+    sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
+        ->delimiter(',')->expected(3)->capture_default_str();
+    sub->add_option("--density", o.density, "Block density (kg/m³)")->check(cli::positive())->capture_default_str();
+    sub->add_option("--deformable-fraction", o.deformable_fraction,
+                    "Deformable blocks (meshed into triangles) taking this fraction f of the deformation: blocks "
+                    "get --young / f, joints --kn, --ks / (1 - f) (SPEC §6); 0 = rigid blocks")
+        ->check(cli::in_range(0.0, 0.99));
+    sub->add_option("--young", o.young, "With --deformable-fraction: target modulus E of the rock mass (Pa)")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--poisson", o.poisson, "With --deformable-fraction: Poisson's ratio of the blocks")
+        ->check(cli::in_range(0.0, 0.49))->capture_default_str();
+    sub->add_option("--mesh-size", o.mesh_size, "With --deformable-fraction: triangle size (m; default size / 2)")
+        ->check(cli::non_negative());
+    sub->add_option("--strain-rate", o.strain_per_step,
+                    "Platen velocity over specimen height, per step (with the servo: the unit of its rates)")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--servo", o.servo,
+                    "Servo-controlled platens: slower while cracks form, faster after failure (docs/calibration.md)")
+        ->capture_default_str();
+    sub->add_option("--servo-cracks", o.servo_cracks, "Servo: new cracks per record (20 steps) per 5,000 contacts it aims at")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--servo-min", o.servo_min_factor, "Servo: slowest platen speed, times --strain-rate")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--servo-max", o.servo_max_factor, "Servo: fastest platen speed before failure, times --strain-rate")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--servo-post-peak", o.servo_post_peak_factor, "Servo: platen speed after failure, times --strain-rate")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--preload", o.elastic_preload,
+                    "The linear part by one implicit solve, up to just below the first joint's yield")
+        ->capture_default_str();
+    sub->add_option("--platens", c.platens, "rough: the face blocks are held horizontally; smooth: free to slide")
+        ->check(CLI::IsMember({"rough", "smooth"}))->capture_default_str();
+    sub->add_option("--platen-friction", o.platen_friction,
+                    "Rigid platen blocks pressing on the faces through contacts of this friction angle (degrees), "
+                    "instead of prescribed face blocks (--platens); ucs and biaxial")
+        ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
+        ->check(cli::in_range(0.0, 1.0))->capture_default_str();
+    sub->add_option("--failure-drop", o.failure_drop,
+                    "A drop by this fraction from the peak marks failure; the run stops if the stress then climbs back above the peak")
+        ->check(cli::in_range(0.0, 1.0))->capture_default_str();
+    sub->add_option("--frame-every", o.frame_every,
+                    "Steps between frames of the failure series in result.pvd (0: the final state only)")
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(cli::positive())->capture_default_str();
+    sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
+        ->check(cli::positive())->capture_default_str();
+    sub->add_option("--threads", c.threads,
+                    "Threads (0 = all cores): realizations run in parallel; a single one uses them in its contact loop")
+        ->check(cli::non_negative());
+    sub->add_option("--max-elements", o.max_elements, max_elements_help)->check(cli::positive());
+    sub->add_option("-o,--out", c.out, "Output directory")->capture_default_str();
+    sub->add_flag("-q,--quiet", quiet, "No progress, only errors");
+}
+
+namespace {
+
+nlohmann::json labtest_json(const LabTestResult& r) {
+    return {{"E", r.E}, {"nu", r.nu}, {"E50", r.E50}, {"linear_limit_stress", r.linear_limit_stress},
+            {"peak_stress", r.peak_stress}, {"strain_at_peak", r.strain_at_peak},
+            {"crack_initiation_stress", r.crack_initiation_stress}, {"crack_damage_stress", r.crack_damage_stress},
+            {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
+            {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
+            {"post_peak_locking", r.post_peak_locking},
+            {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
+            {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
+                                   {"within_30_of_vertical", r.cracks_near_vertical},
+                                   {"within_30_of_horizontal", r.cracks_near_horizontal},
+                                   {"within_30_of_vertical_at_peak", r.cracks_near_vertical_at_peak},
+                                   {"within_30_of_horizontal_at_peak", r.cracks_near_horizontal_at_peak}}}};
+}
+
+/// The failure series: one frame of blocks and contacts every `frame_every` steps,
+/// named by step; `frames` collects them for result.pvd.
+void write_labtest_frame(const Solver& s, const fs::path& dir, std::vector<std::pair<double, std::string>>& frames) {
+    fs::create_directories(dir / "vtk");
+    char name[64];
+    std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
+    io::write_state_blocks_vtu(s, dir / name);
+    frames.push_back({double(s.steps()), name});
+    std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
+    io::write_state_contacts_vtu(s, dir / name);
+    frames.push_back({double(s.steps()), name});
+}
+
+void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path& dir, const std::string& title,
+                         std::vector<std::pair<double, std::string>> frames) {
+    fs::create_directories(dir / "vtk");
+    std::ostringstream csv;
+    csv << "step,axial_strain,axial_stress_Pa,lateral_strain,cracks_tensile,cracks_shear,unbalanced_ratio,"
+           "strain_per_step\n";
+    csv.precision(10);
+    // Stress against the axial, lateral (expansion negative) and volumetric strains,
+    // as Martin & Chandler draw them, with σci and σcd marked.
+    io::Series axial{"axial", {}, {}}, lateral{"lateral", {}, {}}, volumetric{"volumetric", {}, {}};
+    for (const auto& p : r.curve) {
+        csv << p.step << ',' << p.axial_strain << ',' << p.axial_stress << ',' << p.lateral_strain << ','
+            << p.cracks_tensile << ',' << p.cracks_shear << ',' << p.unbalanced_ratio << ',' << p.strain_per_step
+            << '\n';
+        const double sigma = 1e-6 * p.axial_stress;
+        axial.x.push_back(1e3 * p.axial_strain), axial.y.push_back(sigma);
+        lateral.x.push_back(-1e3 * p.lateral_strain), lateral.y.push_back(sigma);
+        volumetric.x.push_back(1e3 * (p.axial_strain - p.lateral_strain)), volumetric.y.push_back(sigma);
+    }
+    io::write_text_atomically(dir / "stress_strain.csv", csv.str());
+    std::vector<io::Series> curves{axial};
+    if (r.crack_initiation_stress > 0.0) {
+        curves.push_back(lateral), curves.push_back(volumetric);
+        double x0 = 0.0, x1 = 0.0;
+        for (const auto& c : curves) x0 = std::min(x0, *std::min_element(c.x.begin(), c.x.end())), x1 = std::max(x1, *std::max_element(c.x.begin(), c.x.end()));
+        for (const auto& [name, stress] : {std::pair{"sigma_ci", r.crack_initiation_stress}, std::pair{"sigma_cd", r.crack_damage_stress}})
+            curves.push_back({name, {x0, x1}, {1e-6 * stress, 1e-6 * stress}});
+    }
+    char label[200];
+    std::snprintf(label, sizeof label, "%s: E = %.2f GPa, peak = %.2f MPa, sigma_ci %.1f, sigma_cd %.1f MPa", title.c_str(),
+                  r.E / 1e9, r.peak_stress / 1e6, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6);
+    io::draw_curves(curves, "strain (1e-3): axial, lateral, volumetric", "axial stress (MPa)", dir / "stress_strain.png",
+                    label);
+    io::FailurePlotOptions fo;
+    fo.title = title;
+    io::draw_failure(s, dir / "failure.png", fo);
+    io::draw_failure(s, dir / "failure.svg", fo);
+    io::write_state_blocks_vtu(s, dir / "vtk/blocks_final.vtu");
+    io::write_state_contacts_vtu(s, dir / "vtk/contacts_final.vtu");
+    if (!frames.empty() && frames.back().first == double(r.steps)) frames.resize(frames.size() - 2);
+    frames.push_back({double(r.steps), "vtk/blocks_final.vtu"});
+    frames.push_back({double(r.steps), "vtk/contacts_final.vtu"});
+    io::write_pvd(dir / "result.pvd", frames);
+    io::write_text_atomically(dir / "summary.json", labtest_json(r).dump(2) + "\n");
+}
+
+/// --pattern and --size-measure -> the options' pattern.
+void apply_pattern_flags(LabTestCli& c) {
+    const std::map<std::string, meshing::PatternSpec::Kind> kinds{
+        {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
+        {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
+        {"brick", meshing::PatternSpec::Kind::brick}};
+    c.o.pattern = kinds.at(c.pattern);
+    c.o.size_measure =
+        c.size_measure == "area" ? meshing::PatternSpec::SizeMeasure::area : meshing::PatternSpec::SizeMeasure::feret;
+}
+
+/// --tension-softening / --shear-softening b1,a1,a2 -> the points (a1, b1), (a2, 0)
+/// of the joint's curves, checked.
+void apply_softening_flags(LabTestCli& c) {
+    auto curve = [](const std::vector<double>& v, const char* flag) {
+        const double b1 = v[0], a1 = v[1], a2 = v[2];
+        if (!(b1 > 0 && b1 < 1 && a1 > 1 && a2 > a1 && a2 > 0 && a1 - b1 < a2))
+            throw InputError(flag, 0, "", "needs 0 < b1 < 1, 1 < a1 < a2 (points (a1, b1), (a2, 0) after the peak)");
+        return std::vector<std::pair<double, double>>{{a1, b1}, {a2, 0.0}};
+    };
+    c.o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
+    c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
+}
+
+std::string fmt_number(double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.6g", v);
+    return b;
+}
+
+/// The flag behind a key of the specimen's region (GeometryError from the generator).
+std::string labtest_flag(const std::string& key) {
+    if (key == "pattern.size") return "--size";
+    if (key == "mesh.size") return "--mesh-size";
+    return "--width/--height";
+}
+
+/// Refuses, before anything is generated, a specimen narrower than a few blocks or
+/// asking for more blocks and triangles than the limit.
+void check_specimen_size(const LabTestCli& c) {
+    const auto& o = c.o;
+    const bool disc = o.kind == LabTestOptions::Kind::brazilian;
+    const double width = o.width, height = disc ? o.width : o.height;
+    if (std::min(width, height) < 3.0 * o.size)
+        throw InputError("--size", 0, "",
+                         "blocks of " + fmt_number(o.size) + " m do not fit a specimen " + fmt_number(width) + " m x " +
+                             fmt_number(height) + " m: give at least 3 blocks across (--size <= " +
+                             fmt_number(std::min(width, height) / 3.0) + ")");
+    const auto geometry = labtest_geometry(o);
+    const double area = disc ? std::numbers::pi / 4.0 * width * width : width * height;
+    const auto e = meshing::estimate_region(geometry.regions.front(), area, 0.0);
+    const double limit = o.max_elements > 0 ? o.max_elements : meshing::default_max_elements();
+    if (!(e.blocks + e.zones <= limit)) {
+        const bool zones = e.zones > e.blocks;
+        throw InputError(zones ? "--mesh-size" : "--size", 0, "",
+                         "the specimen asks for about " + fmt_number(std::round(e.blocks)) + " blocks and " +
+                             fmt_number(std::round(e.zones)) + " triangles (about " + fmt_number(std::round(e.bytes() / 1e8) / 10) +
+                             " GB), over the limit of " + fmt_number(std::round(limit)) +
+                             (o.max_elements > 0 ? " (--max-elements)" : " (half of this machine's memory)") +
+                             ": give a larger size, or raise --max-elements if the machine has the memory");
+    }
+}
+
+} // namespace
+
+int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bool check_only, LabTestStudy* study) {
+    const char* name = labtest_name(kind);
+    auto& o = c.o;
+    o.kind = kind;
+    apply_pattern_flags(c);
+    apply_softening_flags(c);
+    o.rough_platens = c.platens == "rough";
+    if (o.platen_friction >= 0.0 && (kind == LabTestOptions::Kind::tension || kind == LabTestOptions::Kind::brazilian))
+        throw InputError("--platen-friction", 0, "",
+                         std::string("applies to ucs and biaxial only: ") + name +
+                             " needs platens that hold the specimen (use --platens rough or smooth)");
+    check_specimen_size(c);
+    if (check_only) return 0;
+    const fs::path out = c.out;
+    const bool write = c.write_files;
+    if (write) io::make_output_directory(out);
+    const int n = c.realizations;
+    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = std::max(1, std::min(n, available));
+    const int threads_for_loop = available;
+    std::vector<LabTestResult> results(n);
+    std::mutex print;
+    if (!quiet)
+        std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s\n", name,
+                     c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
+                     n > 1 ? "s" : "", n > 1 ? threads : threads_for_loop, (n > 1 ? threads : threads_for_loop) > 1 ? "s" : "");
+    std::atomic<int> next{0};
+    std::exception_ptr failure;
+    auto worker = [&] {
+        for (int k = next++; k < n; k = next++) try {
+            LabTestOptions ok = o;
+            ok.seed = o.seed + k;
+            // One realization: its threads go to the contact loop; several: one each.
+            ok.threads = n == 1 ? threads_for_loop : 1;
+            const fs::path dir = n > 1 ? out / ("realization_" + std::to_string(k + 1)) : out;
+            auto last = std::chrono::steady_clock::now();
+            auto progress = [&](const StressStrainPoint& p) {
+                if (quiet || n > 1) return;
+                const auto now = std::chrono::steady_clock::now();
+                if (std::chrono::duration<double>(now - last).count() < 1.0) return;
+                last = now;
+                std::fprintf(stderr, "\r  step %8ld  strain %.3e  stress %7.2f MPa  cracks %5d T %5d S   ", p.step,
+                             p.axial_strain, p.axial_stress / 1e6, p.cracks_tensile, p.cracks_shear);
+            };
+            std::vector<std::pair<double, std::string>> frames;
+            using Finish = std::function<void(const Solver&, const LabTestResult&)>;
+            using Frame = std::function<void(const Solver&, const StressStrainPoint&)>;
+            const LabTestResult r = run_labtest(
+                ok, progress,
+                write ? Finish([&](const Solver& s, const LabTestResult& res) {
+                    char title[64];
+                    std::snprintf(title, sizeof title, "%s, seed %llu", name, static_cast<unsigned long long>(ok.seed));
+                    write_labtest_files(res, s, dir, title, frames);
+                })
+                      : Finish(),
+                write ? Frame([&](const Solver& s, const StressStrainPoint&) { write_labtest_frame(s, dir, frames); })
+                      : Frame());
+            results[k] = r;
+            if (!quiet) {
+                std::lock_guard lock(print);
+                std::fprintf(stderr, "\r  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
+                                     "sigma_ci %.2f  sigma_cd %.2f MPa  cracks %d T %d S  %ld steps  %.1f s\n",
+                             static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.E50 / 1e9, r.nu, r.peak_stress / 1e6,
+                             r.strain_at_peak, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6,
+                             r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
+                if (r.post_peak_locking)
+                    std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
+                                         "jammed between the platens): stopped there; peak is the strength before failure\n",
+                                 static_cast<unsigned long long>(ok.seed));
+            }
+        } catch (...) {
+            // The first failure is reported; the other realizations stop.
+            std::lock_guard lock(print);
+            if (!failure) failure = std::current_exception();
+            next = n;
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+    if (failure) {
+        try {
+            std::rethrow_exception(failure);
+        } catch (const GeometryError& e) {
+            throw InputError(labtest_flag(e.key()), 0, "", e.what());
+        }
+    }
+    nlohmann::json summary = n == 1 ? labtest_json(results[0]) : nlohmann::json();
+    if (n > 1) {
+        auto stats = [&](auto get) {
+            double m = 0, v = 0;
+            for (const auto& r : results) m += get(r);
+            m /= n;
+            for (const auto& r : results) v += (get(r) - m) * (get(r) - m);
+            return nlohmann::json{{"mean", m}, {"std", n > 1 ? std::sqrt(v / (n - 1)) : 0.0}};
+        };
+        nlohmann::json per = nlohmann::json::array();
+        for (const auto& r : results) per.push_back(labtest_json(r));
+        summary = nlohmann::json{{"test", name},
+                                     {"realizations", n},
+                                     {"E", stats([](const LabTestResult& r) { return r.E; })},
+                                     {"nu", stats([](const LabTestResult& r) { return r.nu; })},
+                                     {"E50", stats([](const LabTestResult& r) { return r.E50; })},
+                                     {"peak_stress", stats([](const LabTestResult& r) { return r.peak_stress; })},
+                                     {"strain_at_peak", stats([](const LabTestResult& r) { return r.strain_at_peak; })},
+                                     {"crack_initiation_stress", stats([](const LabTestResult& r) { return r.crack_initiation_stress; })},
+                                     {"crack_damage_stress", stats([](const LabTestResult& r) { return r.crack_damage_stress; })},
+                                     {"per_realization", per}};
+        if (write) io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
+        if (!quiet)
+            std::fprintf(stderr, "mean of %d: E %.2f GPa, nu %.3f, peak %.2f MPa%s%s\n", n,
+                         summary["E"]["mean"].get<double>() / 1e9, summary["nu"]["mean"].get<double>(),
+                         summary["peak_stress"]["mean"].get<double>() / 1e6, write ? "; wrote " : "",
+                         write ? (out / "summary.json").string().c_str() : "");
+    }
+    if (study) {
+        study->results = std::move(results);
+        study->summary_json = summary.dump();
+    }
+    return 0;
+}
+
+/// `bbm calibrate`: iterates the micro-properties and writes the joint property
+/// set as a TOML fragment, with the iteration table as JSON.
+int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string* calibration_json) {
+    LabTestCli& c = values.lab;
+    const CalibrationTargets& targets = values.targets;
+    const int iterations = values.iterations;
+    const fs::path out = c.out;
+    if ((targets.biaxial > 0.0) != (targets.confinement > 0.0))
+        throw InputError(targets.biaxial > 0.0 ? "--target-biaxial" : "--target-confinement", 0, "",
+                         "--target-biaxial and --target-confinement go together (the strength and the lateral stress "
+                         "of one biaxial test)");
+    if (targets.biaxial > 0.0 && targets.biaxial <= targets.ucs)
+        throw InputError("--target-biaxial", 0, "",
+                         "a confined strength must exceed the UCS target (" + fmt_number(targets.ucs) + " Pa); got " +
+                             fmt_number(targets.biaxial) + " Pa");
+    CalibrationOptions o;
+    o.base = c.o;
+    // Joint values given on the command line (or in --config) are the starting point.
+    o.start_kn = values.given_kn;
+    o.start_ks = values.given_ks;
+    o.start_tensile = values.given_tensile;
+    o.start_cohesion = values.given_cohesion;
+    apply_softening_flags(c);
+    apply_pattern_flags(c);
+    o.base.pattern = c.o.pattern;
+    o.base.size_measure = c.o.size_measure;
+    o.realizations = c.realizations;
+    o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    o.max_iterations = iterations;
+    check_specimen_size(c);
+    if (check_only) return 0;
+    // SPEC §8's first estimates, kn = E/d and ks = G/d, for reference; the iteration
+    // starts from the lattice inversion on the generated blocks (calibrate.hpp).
+    const double first_kn = targets.E / o.base.size, first_ks = targets.E / (2.0 * (1.0 + targets.nu)) / o.base.size;
+    const JointPropertySpec start = calibration_start(targets, o);
+    if (c.write_files) io::make_output_directory(out);
+    const bool with_phi = targets.biaxial > 0.0;
+    if (!quiet) {
+        std::fprintf(stderr,
+                     "bbm calibrate: %s blocks of %.3g m, %g m x %g m, %d realizations of UCS and direct tension per "
+                     "iteration\ntargets: E %.4g GPa, nu %.3g, UCS %.4g MPa, tensile %.4g MPa\n",
+                     c.pattern.c_str(), o.base.size, o.base.width, o.base.height, o.realizations, targets.E / 1e9,
+                     targets.nu, targets.ucs / 1e6, targets.tensile / 1e6);
+        if (with_phi)
+            std::fprintf(stderr, "and biaxial strength %.4g MPa at %.4g MPa confinement: friction angle calibrated too "
+                                 "(phi and sigma1 at the end of each row)\n",
+                         targets.biaxial / 1e6, targets.confinement / 1e6);
+        std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start kn %.2f, ks %.2f GPa/m (%s)\n",
+                     first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9,
+                     o.start_kn || o.start_ks ? "as given" : "lattice inversion on the generated blocks");
+        std::fprintf(stderr, "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n", "iter", "kn GPa/m", "ks GPa/m",
+                     "st MPa", "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
+    }
+    nlohmann::json table = nlohmann::json::array();
+    int k = 0;
+    const auto iterations_done = calibrate(targets, o, [&](const CalibrationIteration& it) {
+        ++k;
+        if (!quiet) {
+            std::fprintf(stderr, "%4d %10.2f %10.2f %9.3f %9.3f | %9.2f %9.2f %7.3f %10.2f %10.3f %8.0f", k,
+                         it.joint.kn / 1e9, it.joint.ks / 1e9, it.joint.tensile / 1e6, it.joint.cohesion / 1e6,
+                         it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds);
+            if (with_phi) std::fprintf(stderr, "   phi %5.2f  sigma1 %7.2f MPa", it.joint.friction, it.biaxial / 1e6);
+            std::fprintf(stderr, "%s\n", it.converged ? "  converged" : "");
+        }
+        table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
+                         {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
+                         {"nu_std", it.nu_std}, {"ucs", it.ucs}, {"ucs_std", it.ucs_std}, {"tensile_strength", it.tensile},
+                         {"tensile_strength_std", it.tensile_std}, {"friction", it.joint.friction},
+                         {"biaxial_strength", it.biaxial}, {"biaxial_strength_std", it.biaxial_std},
+                         {"seconds", it.seconds}, {"converged", it.converged}});
+    });
+    const auto& last = iterations_done.back();
+    const auto& j = last.joint;
+    // The calibrated set on seeds it has not seen: what a new model will get.
+    const auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, with_phi ? targets.confinement : 0.0);
+    if (!quiet) {
+        std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "
+                             "(std %.3f)",
+                     static_cast<unsigned long long>(o.base.seed + 1000), fresh.E / 1e9, fresh.E_test / 1e9, fresh.nu,
+                     fresh.ucs / 1e6, fresh.ucs_std / 1e6, fresh.tensile / 1e6, fresh.tensile_std / 1e6);
+        if (with_phi) std::fprintf(stderr, ", sigma1 %.2f MPa (std %.2f)", fresh.biaxial / 1e6, fresh.biaxial_std / 1e6);
+        std::fprintf(stderr, "\n");
+    }
+    // The set holds for this pattern only: say which, as a model file writes it.
+    const std::string pattern_line = "pattern = { type = \"" + c.pattern + "\", size = " + fmt_number(o.base.size) +
+                                     ", size_measure = \"" + c.size_measure + "\", lloyd = " +
+                                     std::to_string(o.base.lloyd) + " }";
+    std::string toml = "# bbm calibrate: " + c.pattern + " blocks of " + fmt_number(o.base.size) + " m (" +
+                       (c.size_measure == "area" ? "equal-area diameter" : "mean Feret diameter") + "), Lloyd " +
+                       std::to_string(o.base.lloyd) + ", in a " + fmt_number(o.base.width) + " m x " +
+                       fmt_number(o.base.height) + " m specimen; for regions with\n#   " + pattern_line +
+                       "\n# Targets E " +
+                       fmt_number(targets.E) + " Pa, nu " + fmt_number(targets.nu) + ", UCS " + fmt_number(targets.ucs) +
+                       " Pa, tensile " + fmt_number(targets.tensile) + " Pa" +
+                       (with_phi ? ", biaxial " + fmt_number(targets.biaxial) + " Pa at " + fmt_number(targets.confinement) +
+                                       " Pa"
+                                 : std::string()) +
+                       ".\n# Last iteration (mean of " +
+                       std::to_string(o.realizations) + "): E " + fmt_number(last.E) + " Pa, nu " + fmt_number(last.nu) +
+                       ", UCS " + fmt_number(last.ucs) + " Pa, tensile " + fmt_number(last.tensile) + " Pa" +
+                       (with_phi ? ", biaxial " + fmt_number(last.biaxial) + " Pa" : std::string()) +
+                       (last.converged ? "" : " (NOT converged: see calibration.json)") + ".\n";
+    auto pts = [](const std::vector<std::pair<double, double>>& v) {
+        std::string s = "[";
+        for (std::size_t i = 0; i < v.size(); ++i)
+            s += (i ? ", [" : "[") + fmt_number(v[i].first) + ", " + fmt_number(v[i].second) + "]";
+        return s + "]";
+    };
+    toml += "[[joint_property]]\nname = \"calibrated\"\nlaw = \"softening\"\nkn = " + fmt_number(j.kn) +
+            "\nks = " + fmt_number(j.ks) + "\ntensile = " + fmt_number(j.tensile) + "\ncohesion = " +
+            fmt_number(j.cohesion) + "\nfriction = " + fmt_number(j.friction) +
+            "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
+    const nlohmann::json calibration{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
+                                                          {"tensile", targets.tensile}, {"biaxial", targets.biaxial},
+                                                          {"confinement", targets.confinement}}},
+                                             {"pattern", c.pattern},
+                                             {"size", o.base.size},
+                                             {"size_measure", c.size_measure},
+                                             {"lloyd", o.base.lloyd},
+                                             {"realizations", o.realizations},
+                                             {"converged", last.converged},
+                                             {"first_estimate", {{"kn", first_kn}, {"ks", first_ks}}},
+                                             {"start", {{"kn", start.kn}, {"ks", start.ks}, {"tensile", start.tensile},
+                                                        {"cohesion", start.cohesion}}},
+                                             {"fresh_seeds", {{"first_seed", o.base.seed + 1000}, {"E", fresh.E},
+                                                              {"E_ucs_curve", fresh.E_test}, {"nu", fresh.nu},
+                                                              {"ucs", fresh.ucs}, {"ucs_std", fresh.ucs_std},
+                                                              {"tensile_strength", fresh.tensile},
+                                                              {"tensile_strength_std", fresh.tensile_std},
+                                                              {"biaxial_strength", fresh.biaxial},
+                                                              {"biaxial_strength_std", fresh.biaxial_std}}},
+                                             {"iterations", table},
+                                             {"joint_property_toml", toml}};
+    if (calibration_json) *calibration_json = calibration.dump();
+    if (c.write_files) {
+        io::write_text_atomically(out / "joint_property.toml", toml);
+        io::write_text_atomically(out / "calibration.json", calibration.dump(2) + "\n");
+        if (!quiet)
+            std::fprintf(stderr, "wrote %s/joint_property.toml and calibration.json%s\n", out.string().c_str(),
+                         last.converged ? "" : " (not converged within the iteration limit)");
+    }
+    return last.converged ? 0 : 4;
+}
+
+void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
+    add_labtest_options(cmd, v.lab, quiet);
+    auto& t = v.targets;
+    cmd->add_option("--target-E", t.E, "Target Young's modulus (Pa)")->check(cli::positive())->capture_default_str();
+    cmd->add_option("--target-nu", t.nu, "Target Poisson's ratio")->check(cli::in_range(0.01, 0.33))->capture_default_str();
+    cmd->add_option("--target-ucs", t.ucs, "Target uniaxial compressive strength (Pa)")->check(cli::positive())->capture_default_str();
+    cmd->add_option("--target-tensile", t.tensile, "Target direct tensile strength (Pa)")->check(cli::positive())->capture_default_str();
+    cmd->add_option("--target-biaxial", t.biaxial,
+                    "Optional: target strength sigma1 of a biaxial test at --target-confinement (Pa); calibrates the "
+                    "friction angle too")
+        ->check(cli::positive());
+    cmd->add_option("--target-confinement", t.confinement,
+                    "Lateral stress of the --target-biaxial test (Pa, compression positive)")
+        ->check(cli::positive());
+    cmd->add_option("--iterations", v.iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
+}
+
+void note_given_joint_values(const CLI::App& cmd, CalibrateCli& v) {
+    v.given_kn = cmd.count("--kn") > 0;
+    v.given_ks = cmd.count("--ks") > 0;
+    v.given_tensile = cmd.count("--tensile") > 0;
+    v.given_cohesion = cmd.count("--cohesion") > 0;
+}
+
+namespace {
+
+/// Parses option strings with a command's option definitions; a parse error
+/// becomes an InputError naming the command and what CLI11 said (the flag).
+void parse_options(CLI::App& app, const std::string& command, const std::vector<std::string>& args) {
+    std::vector<std::string> reversed(args.rbegin(), args.rend()); // CLI11 takes them last first
+    try {
+        app.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+        throw InputError(command, 0, "", e.what());
+    }
+}
+
+} // namespace
+
+LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet) {
+    const auto kind = labtest_kind(command);
+    LabTestCli values = labtest_defaults(kind);
+    values.write_files = false;
+    CLI::App app{command, command};
+    bool quiet_flag = quiet;
+    add_labtest_options(&app, values, quiet_flag);
+    if (kind == LabTestOptions::Kind::biaxial)
+        app.add_option("--confinement", values.o.confinement, "Lateral stress (Pa, compression positive)")
+            ->required()
+            ->check(cli::non_negative());
+    parse_options(app, command, args);
+    values.write_files = app.count("--out") > 0;
+    LabTestStudy study;
+    run_labtest_command(values, kind, quiet_flag, false, &study);
+    return study;
+}
+
+std::string run_calibrate_args(const std::vector<std::string>& args, bool quiet) {
+    CalibrateCli values;
+    CLI::App app{"calibrate", "calibrate"};
+    bool quiet_flag = quiet;
+    add_calibrate_options(&app, values, quiet_flag);
+    parse_options(app, "calibrate", args);
+    note_given_joint_values(app, values);
+    values.lab.write_files = app.count("--out") > 0;
+    std::string json;
+    run_calibrate(values, quiet_flag, false, &json);
+    return json;
+}
+
+} // namespace bbm::studies

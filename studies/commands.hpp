@@ -1,0 +1,101 @@
+// bbm studies: the commands a user runs — `mesh`, the lab tests (`ucs`, `tension`,
+// `biaxial`, `brazilian`) and `calibrate` — as library calls with their options,
+// their output files and their summaries, so that the program (apps/main.cpp) and
+// the Python module (python/) are thin front ends that run the same code.
+//
+// The lab tests' options are CLI11 options (add_labtest_options): the program puts
+// them on its subcommands, and run_labtest_args() parses a list of "--key value"
+// strings with the same definitions, so a Python keyword argument is checked,
+// defaulted and reported exactly as the flag is. Each run returns its exit status
+// (0 done, 4 calibration not converged) and, when asked, its summary as JSON text
+// (the summary.json a run writes) and the lab-test results with their curves.
+// Bad options throw InputError naming the flag.
+#pragma once
+
+#include "studies/calibrate.hpp"
+#include "studies/labtest.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace bbm::studies {
+
+/// Command-line values of the lab tests, defaults = the paper's calibration run.
+struct LabTestCli {
+    LabTestOptions o = LabTestOptions::paper_ucs();
+    std::string pattern = "voronoi";
+    std::vector<double> tension_softening{0.5, 1.7, 4.0}, shear_softening{0.5, 1.3, 2.1};
+    std::string platens = "rough";
+    std::string size_measure = "feret";
+    int realizations = 1;
+    int threads = 0;
+    std::string out = "out";
+    /// false: nothing is written (the Python module without `out`).
+    bool write_files = true;
+};
+
+/// The lab-test command names: "ucs", "tension", "biaxial", "brazilian".
+LabTestOptions::Kind labtest_kind(const std::string& command);
+
+/// A lab-test command's defaults (tension and brazilian load slower, the disc is 4 m).
+LabTestCli labtest_defaults(LabTestOptions::Kind kind);
+
+extern const char* const max_elements_help;
+
+/// The lab-test options on a (sub)command; `quiet` gets -q/--quiet.
+void add_labtest_options(CLI::App* command, LabTestCli& values, bool& quiet);
+
+/// What a lab-test command produced: one result per realization, and the summary.
+struct LabTestStudy {
+    std::vector<LabTestResult> results;
+    std::string summary_json;
+};
+
+/// Runs a lab test (realizations spread over threads), writing its files in
+/// values.out when values.write_files. check_only: validate and stop.
+int run_labtest_command(LabTestCli& values, LabTestOptions::Kind kind, bool quiet, bool check_only,
+                        LabTestStudy* study = nullptr);
+
+/// The same from option strings as the program takes them after the command name
+/// ({"--width", "2", "--seed", "3"}). Throws InputError naming the flag.
+LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet);
+
+/// `bbm calibrate`'s values.
+struct CalibrateCli {
+    LabTestCli lab;
+    CalibrationTargets targets;
+    int iterations = 6;
+    /// Joint values given (they are the starting point rather than estimates).
+    bool given_kn = false, given_ks = false, given_tensile = false, given_cohesion = false;
+    CalibrateCli() { lab.realizations = 3; }
+};
+
+/// The calibrate options (lab-test options and targets) on a (sub)command.
+void add_calibrate_options(CLI::App* command, CalibrateCli& values, bool& quiet);
+/// After parsing: which joint values the user gave.
+void note_given_joint_values(const CLI::App& command, CalibrateCli& values);
+
+/// Runs the calibration; writes joint_property.toml and calibration.json in
+/// values.lab.out when values.lab.write_files; returns 0, or 4 if not converged.
+/// `calibration_json` gets the calibration.json text when not null.
+int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string* calibration_json = nullptr);
+
+/// run_calibrate from option strings, as run_labtest_args. Returns calibration.json's text.
+std::string run_calibrate_args(const std::vector<std::string>& args, bool quiet);
+
+/// `bbm mesh`: generate a model file's blocks, write blocks.vtu, joints.vtu,
+/// blocks.png and summary.json in `out`.
+struct MeshCommand {
+    std::string model;
+    std::filesystem::path out = "out";
+    std::vector<double> window; ///< XMIN YMIN XMAX YMAX of blocks.png, or empty
+    double max_elements = 0;
+};
+int run_mesh(const MeshCommand& command, bool quiet, bool check_only);
+
+} // namespace bbm::studies

@@ -1,0 +1,288 @@
+#include "studies/model.hpp"
+
+#include "base/error.hpp"
+#include "io/vtk_output.hpp"
+#include "meshing/blocks.hpp"
+#include "studies/opening.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <stdexcept>
+
+namespace bbm::studies {
+
+namespace fs = std::filesystem;
+
+nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
+                           const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
+                           const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,
+                           bool interrupted, bool complete) {
+    int rigid = 0;
+    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver.blocks().deformable[i];
+    nlohmann::json stages = nlohmann::json::array();
+    for (const auto& r : reports) {
+        nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
+                         {"seconds", r.seconds}, {"converged", r.converged}};
+        if (!r.method.empty()) j["method"] = r.method;
+        stages.push_back(j);
+    }
+    nlohmann::json summary{
+        {"model", model_name},
+        {"blocks", rigid},
+        {"deformable_blocks", blocks.block_count() - rigid},
+        {"zones", solver.zones().size()},
+        {"nodes", solver.nodes().count()},
+        {"contacts", solver.contacts().size()},
+        {"steps", solver.steps()},
+        {"time", solver.time()},
+        {"timestep", solver.timestep()},
+        {"wall_seconds", wall_seconds},
+        {"meshing_seconds", generation.seconds_regions + generation.seconds_patterns + generation.seconds_topology},
+        {"cracks", {{"tensile", solver.cracks(contact::JointState::broken_tension)},
+                    {"shear", solver.cracks(contact::JointState::broken_shear)}}},
+        {"unbalanced_ratio", solver.unbalanced_ratio()},
+        {"energy", {{"kinetic", solver.kinetic_energy()}, {"strain", solver.strain_energy()},
+                    {"dissipated", solver.dissipated_energy()}, {"external_work", solver.external_work()}}},
+        {"state_hash", std::to_string(solver.state_hash())},
+        {"interrupted", interrupted},
+        // false: stopped by a health check or interrupted; the fields describe the
+        // last good state, not the end of the model's stages.
+        {"complete", complete},
+        {"stages", stages}};
+    const auto& rep = file.analysis.report;
+    if (rep.opening) {
+        const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);
+        summary["opening"] = {
+            {"springline_displacement", {m.springline_displacement.x, m.springline_displacement.y}},
+            {"crown_displacement", {m.crown_displacement.x, m.crown_displacement.y}},
+            {"springline_convergence", m.springline_convergence},
+            {"crown_convergence", m.crown_convergence},
+            {"failed_depth_springline", m.failed_depth_springline},
+            {"failed_depth_crown", m.failed_depth_crown},
+            {"cracks_springline_sector", m.cracks_springline_sector},
+            {"cracks_crown_sector", m.cracks_crown_sector},
+            {"springline_sector_tensile", m.tensile_springline_sector},
+            {"springline_sector_shear", m.shear_springline_sector}};
+        // Hoop stress profiles from the wall outwards (compression positive, MPa).
+        const auto stress = solver.block_stresses();
+        const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
+        nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
+        for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
+            const double hs = hoop_stress_at(solver, stress, rep.center, rep.springline, f * a_s, 0.3);
+            const double hc = hoop_stress_at(solver, stress, rep.center, rep.crown, f * a_c, 0.3);
+            spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
+            crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
+        }
+        summary["opening"]["hoop_stress_springline"] = spring;
+        summary["opening"]["hoop_stress_crown"] = crown;
+    }
+    return summary;
+}
+
+namespace {
+
+const char* const checkpoint_magic = "bbm-model-checkpoint-1";
+
+template <class T>
+void put(std::ostream& o, const T& v) {
+    o.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+void put_string(std::ostream& o, const std::string& s) {
+    put(o, std::uint64_t(s.size()));
+    o.write(s.data(), std::streamsize(s.size()));
+}
+template <class T>
+T get(std::istream& i) {
+    T v{};
+    i.read(reinterpret_cast<char*>(&v), sizeof v);
+    if (!i) throw std::runtime_error("checkpoint is truncated");
+    return v;
+}
+std::string get_string(std::istream& i, std::uint64_t limit) {
+    const auto n = get<std::uint64_t>(i);
+    if (n > limit) throw std::runtime_error("checkpoint is corrupt");
+    std::string s(n, '\0');
+    i.read(s.data(), std::streamsize(n));
+    if (!i) throw std::runtime_error("checkpoint is truncated");
+    return s;
+}
+
+/// Passes steps to a Progress callback; stops when it says so.
+class CallbackObserver : public StageObserver {
+public:
+    CallbackObserver(const Model& m, const Model::Progress& p) : model_(m), progress_(p) {}
+    void step_done(const Solver& s, const StageSpec&, long) override { poll(s); }
+    void stage_done(const Solver&, const StageReport&) override {
+        if (progress_.callback && !progress_.callback(model_)) stop_ = true;
+    }
+    bool stop_requested() override { return stop_; }
+    void poll(const Solver& s) {
+        if (progress_.callback && progress_.every > 0 && s.steps() % progress_.every == 0 &&
+            !progress_.callback(model_))
+            stop_ = true;
+    }
+    const StageCursor& cursor() const { return cursor_; }
+    void at(const Solver&, const StageCursor& c) override { cursor_ = c; }
+
+private:
+    const Model& model_;
+    const Model::Progress& progress_;
+    StageCursor cursor_;
+    bool stop_ = false;
+};
+
+} // namespace
+
+Model Model::from_file(const std::string& path, int threads, double max_elements) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "", "cannot open the model file");
+    Model m;
+    m.text_.assign(std::istreambuf_iterator<char>(in), {});
+    m.name_ = path;
+    m.file_ = io::read_model(path);
+    m.build(threads, max_elements);
+    return m;
+}
+
+Model Model::from_text(const std::string& text, const std::string& name, int threads, double max_elements) {
+    Model m;
+    m.text_ = text;
+    m.name_ = name;
+    m.file_ = io::parse_model(text, name);
+    m.build(threads, max_elements);
+    return m;
+}
+
+void Model::build(int threads, double max_elements) {
+    file_.analysis.solver.threads = threads;
+    if (max_elements > 0) file_.geometry.max_elements = max_elements;
+    assembly_ = std::make_unique<meshing::BlockAssembly>();
+    try {
+        *assembly_ = meshing::generate_blocks(file_.geometry, &generation_);
+    } catch (const GeometryError& e) {
+        throw io::to_input_error(file_.source, e);
+    }
+    try {
+        solver_ = std::make_unique<Solver>(*assembly_, file_.analysis);
+    } catch (const InputError& e) {
+        throw InputError(name_, file_.source.line_of(e.key()), e.key(), e.message());
+    }
+}
+
+std::vector<std::string> Model::stage_names() const {
+    std::vector<std::string> names;
+    for (const auto& s : file_.analysis.stages) names.push_back(s.name);
+    return names;
+}
+
+void Model::run_until(int last_stage, const Progress& progress) {
+    const auto& all = file_.analysis.stages;
+    const std::vector<StageSpec> stages(all.begin(), all.begin() + last_stage + 1);
+    CallbackObserver observer(*this, progress);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto done = run_stages(*solver_, stages, observer, cursor_);
+    run_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // A stage cut short by the callback stays open; the cursor says where.
+    for (auto& r : done) {
+        if (!reports_.empty() && reports_.back().name == r.name && cursor_.started &&
+            &r == &done.front()) {
+            reports_.back().steps = r.steps, reports_.back().ratio = r.ratio, reports_.back().converged = r.converged;
+            reports_.back().seconds += r.seconds;
+        } else {
+            reports_.push_back(r);
+        }
+    }
+    const bool stopped = observer.stop_requested();
+    cursor_ = observer.cursor();
+    if (!stopped) cursor_ = StageCursor{last_stage + 1, false, 0};
+}
+
+void Model::run(const Progress& progress) {
+    if (file_.analysis.stages.empty())
+        throw InputError(name_, 0, "stage", "the model has no [[stage]] to run");
+    if (cursor_.stage >= int(file_.analysis.stages.size())) return;
+    run_until(int(file_.analysis.stages.size()) - 1, progress);
+}
+
+void Model::run_stage(const std::string& name, const Progress& progress) {
+    const auto& stages = file_.analysis.stages;
+    int index = -1;
+    for (int k = 0; k < int(stages.size()); ++k)
+        if (stages[k].name == name) index = k;
+    if (index < 0) {
+        std::string known;
+        for (const auto& s : stages) known += (known.empty() ? "" : ", ") + s.name;
+        throw InputError(name_, 0, "stage", "no stage named '" + name + "' (stages: " + known + ")");
+    }
+    if (index < cursor_.stage)
+        throw InputError(name_, 0, "stage", "stage '" + name + "' is already done");
+    run_until(index, progress);
+}
+
+void Model::step(long n, const Progress& progress) {
+    CallbackObserver observer(*this, progress);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long k = 0; k < n && !observer.stop_requested(); ++k) {
+        solver_->step();
+        observer.poll(*solver_);
+    }
+    run_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void Model::checkpoint(const fs::path& file) const {
+    std::ostringstream o(std::ios::binary);
+    o.write(checkpoint_magic, std::streamsize(std::char_traits<char>::length(checkpoint_magic)));
+    put_string(o, name_);
+    put_string(o, text_);
+    put(o, cursor_.stage), put(o, cursor_.started), put(o, cursor_.step);
+    put(o, std::uint64_t(reports_.size()));
+    for (const auto& r : reports_) {
+        put_string(o, r.name), put_string(o, r.kind), put_string(o, r.method);
+        put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged);
+    }
+    put(o, run_seconds_);
+    solver_->save_state(o);
+    io::write_text_atomically(file, o.str());
+}
+
+Model Model::resume(const fs::path& file, int threads) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file.string(), 0, "", "cannot open the checkpoint");
+    std::string magic(std::char_traits<char>::length(checkpoint_magic), '\0');
+    in.read(magic.data(), std::streamsize(magic.size()));
+    if (!in || magic != checkpoint_magic) throw InputError(file.string(), 0, "", "not a bbm model checkpoint");
+    const std::string name = get_string(in, 1u << 20);
+    const std::string text = get_string(in, 1u << 30);
+    Model m = from_text(text, name, threads);
+    m.cursor_.stage = get<int>(in), m.cursor_.started = get<bool>(in), m.cursor_.step = get<long>(in);
+    const auto reports = get<std::uint64_t>(in);
+    if (reports > 100000) throw std::runtime_error("checkpoint is corrupt");
+    for (std::uint64_t k = 0; k < reports; ++k) {
+        StageReport r;
+        r.name = get_string(in, 1u << 20), r.kind = get_string(in, 1u << 20), r.method = get_string(in, 1u << 20);
+        r.steps = get<long>(in), r.ratio = get<double>(in), r.seconds = get<double>(in), r.converged = get<bool>(in);
+        m.reports_.push_back(r);
+    }
+    m.run_seconds_ = get<double>(in);
+    m.solver_->load_state(in);
+    return m;
+}
+
+nlohmann::json Model::summary() const {
+    const bool complete = cursor_.stage >= int(file_.analysis.stages.size());
+    return run_summary(name_, file_, *assembly_, generation_, *solver_, reports_, run_seconds_, false, complete);
+}
+
+void Model::write_vtk(const fs::path& dir) const {
+    io::make_output_directory(dir);
+    io::write_state_blocks_vtu(*solver_, dir / "blocks.vtu");
+    io::write_state_contacts_vtu(*solver_, dir / "contacts.vtu");
+    io::write_pvd(dir / "result.pvd", {{solver_->time(), "blocks.vtu"}, {solver_->time(), "contacts.vtu"}});
+}
+
+} // namespace bbm::studies

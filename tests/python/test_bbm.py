@@ -1,0 +1,239 @@
+"""The Python module against the program: same model, same state (hash); the
+numpy arrays' shapes, units and write protection; errors that name the key.
+
+Run by CTest (python.pytest) with PYTHONPATH=build/python, BBM_EXE (the bbm
+program) and BBM_SOURCE_DIR set."""
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tomllib
+
+import numpy as np
+import pytest
+
+import bbm
+
+SOURCE = pathlib.Path(os.environ.get("BBM_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+BBM_EXE = os.environ.get("BBM_EXE", str(SOURCE / "build/apps/bbm"))
+INSITU = SOURCE / "examples/verification/insitu_voronoi.toml"
+SPLIT = SOURCE / "examples/verification/deformable_split.toml"
+TUNNEL = SOURCE / "examples/tunnel_voronoi.toml"
+
+
+def cli(*args, cwd=None):
+    done = subprocess.run([BBM_EXE, *map(str, args)], capture_output=True, text=True, cwd=cwd)
+    return done.returncode, done.stdout + done.stderr
+
+
+def cli_run(model, out):
+    rc, log = cli("run", model, "--out", out, "--quiet")
+    assert rc == 0, log
+    return json.loads((pathlib.Path(out) / "summary.json").read_text())
+
+
+def short_tunnel(seed=7):
+    """The paper's tunnel with a short failure stage (a test, not a study)."""
+    d = tomllib.loads(TUNNEL.read_text())
+    for region in d["region"]:
+        if region["name"] == "bonded":
+            region["pattern"]["seed"] = seed
+    for stage in d["stage"]:
+        if stage["name"] == "excavation":
+            stage["relax_steps"] = 300
+        if stage["name"] == "failure":
+            stage["max_steps"] = 300
+    return d
+
+
+def test_model_run_matches_the_program(tmp_path):
+    m = bbm.Model(str(INSITU))
+    m.run()
+    s = m.summary()
+    ref = cli_run(INSITU, tmp_path / "cli")
+    assert s["state_hash"] == ref["state_hash"]
+    assert s["steps"] == ref["steps"] == 100
+    assert s["complete"] and ref["complete"]
+    assert [x["name"] for x in s["stages"]] == [x["name"] for x in ref["stages"]]
+    assert m.stages_done == m.stage_names
+
+
+def test_tunnel_from_dict_same_as_program(tmp_path):
+    d = short_tunnel()
+    path = tmp_path / "tunnel.toml"
+    path.write_text(bbm.to_toml(d))
+    ref = cli_run(path, tmp_path / "cli")
+    m = bbm.Model.from_dict(d, threads=2)
+    m.run()
+    s = m.summary()
+    assert s["state_hash"] == ref["state_hash"]
+    assert s["opening"]["cracks_springline_sector"] == ref["opening"]["cracks_springline_sector"]
+    # The dict read back from the file is the file: the same model.
+    assert bbm.Model(str(path)).summary()["blocks"] == s["blocks"]
+
+
+def test_block_views_shapes_units_and_protection():
+    m = bbm.Model(str(INSITU))
+    b = m.blocks
+    n = b.count
+    assert n > 50
+    assert b.centroid.shape == (n, 2) and b.centroid.dtype == np.float64
+    assert b.velocity.shape == (n, 2) and b.rotation.shape == (n,)
+    assert b.region.shape == (n,) and b.region.dtype == np.int32
+    # Areas in m² tile the 4 m x 4 m region.
+    assert b.area.sum() == pytest.approx(16.0, rel=1e-9)
+    # Views of the solver's memory: no copy, and not writable.
+    assert not b.centroid.flags.writeable and not b.centroid.flags.owndata
+    with pytest.raises(ValueError):
+        b.centroid[0, 0] = 1.0
+    before = b.centroid.copy()
+    m.run_stage("insitu")
+    # Block stresses in Pa, tension positive: the in-situ state sxx = -10, syy = -20 MPa.
+    s = b.stress
+    assert s.shape == (n, 3)
+    inner = (np.abs(b.centroid - 2.0) < 1.2).all(axis=1)
+    assert np.median(s[inner, 0]) == pytest.approx(-10e6, rel=0.02)
+    assert np.median(s[inner, 1]) == pytest.approx(-20e6, rel=0.02)
+    m.run()
+    # Equilibrium: nothing moved (displacement in m, computed from the centroids).
+    assert np.abs(b.displacement).max() < 1e-6
+    assert np.abs(b.centroid - before).max() < 1e-6
+
+
+def test_contact_arrays():
+    m = bbm.Model(str(INSITU))
+    m.run_stage("insitu")
+    c = m.contacts
+    k = c.count
+    assert k > 100
+    assert c.normal_stress.shape == (k,) and c.shear_stress.shape == (k,)
+    assert c.block_pair.shape == (k, 2) and c.block_pair.dtype == np.int32
+    assert c.block_pair.max() < m.blocks.count
+    assert c.state.shape == (k,) and set(np.unique(c.state)) <= {0, 1, 2, 3, 4}
+    assert np.allclose(np.linalg.norm(c.normal, axis=1), 1.0)
+    # sigma_n = n . sigma . n of the in-situ field, compression positive, Pa.
+    n = c.normal
+    expected = -(n[:, 0] ** 2 * -10e6 + n[:, 1] ** 2 * -20e6)
+    assert np.allclose(c.normal_stress, expected, rtol=1e-6, atol=1.0)
+    assert (c.damage == 0).all() and c.bonded.all()
+
+
+def test_zone_views_of_deformable_blocks():
+    m = bbm.Model(str(SPLIT))
+    z = m.zones
+    assert z.count > 0
+    assert z.nodes.shape == (z.count, 3) and z.stress.shape == (z.count, 3)
+    assert z.nodes.max() < m.nodes.count
+    assert (z.area > 0).all()
+    assert not z.stress.flags.writeable
+    m.run()
+    assert np.isfinite(z.stress).all()
+    assert m.nodes.position.shape == (m.nodes.count, 2)
+
+
+def test_step_callback_checkpoint_and_resume(tmp_path):
+    ref = bbm.Model(str(INSITU))
+    ref.run()
+    seen = []
+    m = bbm.Model(str(INSITU))
+    m.run(callback=lambda model: seen.append(model.steps) or model.steps < 40, every=20)
+    assert m.steps == 40 and seen[:2] == [20, 40]
+    m.checkpoint(tmp_path / "half.bin")
+    resumed = bbm.Model.resume(str(tmp_path / "half.bin"))
+    assert resumed.steps == 40
+    resumed.run()
+    assert resumed.steps == 100
+    assert resumed.summary()["state_hash"] == ref.summary()["state_hash"]
+    m.step(5)
+    assert m.steps == 45
+
+
+def test_callback_exception_stops_and_propagates():
+    m = bbm.Model(str(INSITU))
+
+    def boom(model):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        m.run(callback=boom, every=10)
+    assert m.steps == 10
+
+
+def test_bad_model_file_raises_input_error_with_key(tmp_path):
+    text = INSITU.read_text().replace("size = 0.4", "size = -0.4")
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(bbm.InputError) as e:
+        bbm.Model(str(path))
+    assert e.value.key == "region[0].pattern.size"
+    assert e.value.line == text.splitlines().index(next(l for l in text.splitlines() if "size = -0.4" in l)) + 1
+    assert "bad.toml" in str(e.value) and "region[0].pattern.size" in str(e.value)
+    # The program says the same.
+    rc, log = cli("run", path, "--out", tmp_path / "out")
+    assert rc == 2 and "region[0].pattern.size" in log
+
+
+def test_bad_dict_raises_input_error_with_key():
+    d = tomllib.loads(INSITU.read_text())
+    d["joint_property"][0]["kn"] = -1.0
+    with pytest.raises(bbm.InputError) as e:
+        bbm.Model.from_dict(d)
+    assert e.value.key == "joint_property[0].kn"
+    d = tomllib.loads(INSITU.read_text())
+    d["solver"]["modee"] = "dynamic"
+    with pytest.raises(bbm.InputError, match="solver.modee"):
+        bbm.Model.from_dict(d)
+
+
+def test_ucs_matches_the_program(tmp_path):
+    r = bbm.ucs(width=2, height=4, seed=3, max_strain=0.0015)
+    rc, log = cli("ucs", "--width", 2, "--height", 4, "--seed", 3, "--max-strain", 0.0015, "--out", tmp_path, "--quiet")
+    assert rc == 0, log
+    ref = json.loads((tmp_path / "summary.json").read_text())
+    assert r["steps"] == ref["steps"]
+    assert r["peak_stress"] == ref["peak_stress"] and r["E"] == ref["E"]
+    curve = r["curve"]
+    assert curve["axial_stress"].shape == curve["axial_strain"].shape == (len(curve["step"]),)
+    # Pa and strain: the peak of the curve is the peak reported.
+    assert curve["axial_stress"].max() == pytest.approx(r["peak_stress"], rel=1e-12)
+    assert 5e9 < r["E"] < 40e9
+
+
+def test_labtest_options_are_checked_as_flags():
+    with pytest.raises(bbm.InputError, match="--kn"):
+        bbm.ucs(kn=-1.0)
+    with pytest.raises(bbm.InputError, match="--pattren|pattren"):
+        bbm.ucs(pattren="trigon")
+    with pytest.raises(bbm.InputError, match="--size"):
+        bbm.ucs(size=5.0, width=2, height=4)
+
+
+def test_realizations_give_one_curve_each():
+    r = bbm.tension(width=2, height=4, realizations=2, threads=2)
+    assert r["realizations"] == 2
+    assert len(r["per_realization"]) == 2
+    for entry in r["per_realization"]:
+        assert entry["curve"]["axial_stress"].size > 10
+    assert r["peak_stress"]["mean"] > 0
+
+
+@pytest.mark.parametrize("script", ["tunnel_seeds.py", "calibration_sweep.py"])
+def test_examples_run(script, tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    args = [sys.executable, str(SOURCE / "examples/python" / script), "--quick", "--out", str(tmp_path)]
+    if script == "tunnel_seeds.py":
+        args += ["--seeds", "7", "17", "27"]
+    else:
+        args += ["--tensile", "2e6", "4e6"]
+    done = subprocess.run(args, capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert pngs == (["cracks.png", "hoop_stress.png"] if script == "tunnel_seeds.py" else ["curves.png", "sweep.png"])
+    rows = json.loads(next(tmp_path.glob("*.json")).read_text())
+    if script == "calibration_sweep.py":
+        # A stronger bond makes a stronger rock.
+        assert rows[1]["tensile_strength"] > rows[0]["tensile_strength"]
+    else:
+        assert len({r["state_hash"] for r in rows}) == 3
