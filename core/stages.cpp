@@ -67,7 +67,8 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         const bool stopped = obs.stop_requested();
         if (!stopped) obs.stage_done(s, r);
         reports.push_back(r);
-        if (stopped) break;
+        // A stop asked for at the stage's end (by the observer) holds too.
+        if (stopped || obs.stop_requested()) break;
     }
     return reports;
 }

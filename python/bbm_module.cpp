@@ -108,14 +108,14 @@ PYBIND11_MODULE(_bbm, mod) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const InputError& e) {
-            py::object err = input_error(py::str(e.what()));
+            py::object err = py::reinterpret_borrow<py::object>(input_error.ptr())(py::str(e.what()));
             err.attr("file") = e.file();
             err.attr("line") = e.line();
             err.attr("key") = e.key();
             err.attr("message") = e.message();
             PyErr_SetObject(input_error.ptr(), err.ptr());
         } catch (const GeometryError& e) {
-            py::object err = input_error(py::str(e.what()));
+            py::object err = py::reinterpret_borrow<py::object>(input_error.ptr())(py::str(e.what()));
             err.attr("file") = "";
             err.attr("line") = 0;
             err.attr("key") = e.key();
