@@ -13,6 +13,7 @@
 #include "io/model_input.hpp"
 #include "studies/cli_checks.hpp"
 #include "studies/commands.hpp"
+#include "studies/ranks.hpp"
 #include "studies/run_model.hpp"
 
 #include <CLI/CLI.hpp>
@@ -24,7 +25,9 @@
 
 using namespace bbm;
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_cli(int argc, char** argv) {
     CLI::App app{"bbm — bonded-block models of rock failure (2D, plane strain).\n"
                  "Rigid or deformable blocks bonded by softening joints, one explicit loop.",
                  "bbm"};
@@ -158,14 +161,28 @@ int main(int argc, char** argv) {
             if (*command) return studies::run_labtest_command(values, values.o.kind, quiet, check_only);
         if (*mesh) return studies::run_mesh(mesh_command, quiet, check_only);
     } catch (const InputError& e) {
-        std::fprintf(stderr, "bbm: error: %s\n", e.what());
+        // Under mpirun every rank meets the same error: one says it.
+        if (studies::Ranks::root()) std::fprintf(stderr, "bbm: error: %s\n", e.what());
         return 2;
     } catch (const NumericalError& e) {
-        std::fprintf(stderr, "bbm: stopped: %s\n", e.what());
+        if (studies::Ranks::root()) std::fprintf(stderr, "bbm: stopped: %s\n", e.what());
         return 3;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "bbm: error: %s\n", e.what());
+        std::fprintf(stderr, "bbm: error%s: %s\n",
+                     studies::Ranks::size() > 1 ? (" on rank " + std::to_string(studies::Ranks::rank())).c_str() : "",
+                     e.what());
         return 1;
     }
     return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    // Under mpirun (or srun) the independent runs of a study are spread over the
+    // ranks (studies/ranks.hpp); otherwise nothing changes.
+    studies::Ranks::start(&argc, &argv);
+    const int status = run_cli(argc, argv);
+    studies::Ranks::stop();
+    return status;
 }

@@ -9,6 +9,7 @@
 #include "studies/calibrate.hpp"
 #include "studies/cli_checks.hpp"
 #include "studies/labtest.hpp"
+#include "studies/ranks.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -259,6 +260,39 @@ nlohmann::json labtest_json(const LabTestResult& r) {
                                    {"within_30_of_horizontal_at_peak", r.cracks_near_horizontal_at_peak}}}};
 }
 
+/// A realization's result as it travels between ranks: the summary fields and the
+/// curve (doubles as JSON numbers round-trip exactly).
+nlohmann::json labtest_record(const LabTestResult& r) {
+    nlohmann::json j = labtest_json(r);
+    j["linear_limit_stress"] = r.linear_limit_stress;
+    nlohmann::json curve = nlohmann::json::array();
+    for (const auto& p : r.curve)
+        curve.push_back({p.step, p.axial_strain, p.axial_stress, p.lateral_strain, p.cracks_tensile, p.cracks_shear,
+                         p.unbalanced_ratio, p.strain_per_step});
+    j["curve"] = std::move(curve);
+    return j;
+}
+
+LabTestResult labtest_from_record(const nlohmann::json& j) {
+    LabTestResult r;
+    r.E = j["E"], r.nu = j["nu"], r.E50 = j["E50"], r.linear_limit_stress = j["linear_limit_stress"];
+    r.peak_stress = j["peak_stress"], r.strain_at_peak = j["strain_at_peak"];
+    r.crack_initiation_stress = j["crack_initiation_stress"], r.crack_damage_stress = j["crack_damage_stress"];
+    r.tensile_strength = j["tensile_strength"], r.blocks = j["blocks"], r.contacts = j["contacts"];
+    r.steps = j["steps"], r.wall_seconds = j["wall_seconds"], r.peak_passed = j["peak_passed"];
+    r.post_peak_locking = j["post_peak_locking"];
+    r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
+    const auto& o = j["crack_orientation"];
+    r.crack_orientation = o["counts"].get<std::array<int, 12>>();
+    r.cracks_near_vertical = o["within_30_of_vertical"], r.cracks_near_horizontal = o["within_30_of_horizontal"];
+    r.cracks_near_vertical_at_peak = o["within_30_of_vertical_at_peak"];
+    r.cracks_near_horizontal_at_peak = o["within_30_of_horizontal_at_peak"];
+    for (const auto& p : j["curve"])
+        r.curve.push_back({p[0].get<long>(), p[1].get<double>(), p[2].get<double>(), p[3].get<double>(),
+                           p[4].get<int>(), p[5].get<int>(), p[6].get<double>(), p[7].get<double>()});
+    return r;
+}
+
 /// The failure series: one frame of blocks and contacts every `frame_every` steps,
 /// named by step; `frames` collects them for result.pvd.
 void write_labtest_frame(const Solver& s, const fs::path& dir, std::vector<std::pair<double, std::string>>& frames) {
@@ -403,16 +437,16 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
     const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     const int threads = std::max(1, std::min(n, available));
     const int threads_for_loop = available;
-    std::vector<LabTestResult> results(n);
     std::mutex print;
+    // Progress from rank 0 only; the others run quietly.
+    quiet = quiet || !Ranks::root();
     if (!quiet)
-        std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s\n", name,
+        std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s%s\n", name,
                      c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
-                     n > 1 ? "s" : "", n > 1 ? threads : threads_for_loop, (n > 1 ? threads : threads_for_loop) > 1 ? "s" : "");
-    std::atomic<int> next{0};
-    std::exception_ptr failure;
-    auto worker = [&] {
-        for (int k = next++; k < n; k = next++) try {
+                     n > 1 ? "s" : "", n > 1 ? threads : threads_for_loop, (n > 1 ? threads : threads_for_loop) > 1 ? "s" : "",
+                     Ranks::size() > 1 ? (" per rank, " + std::to_string(Ranks::size()) + " ranks").c_str() : "");
+    auto realization = [&](int k) -> std::string {
+        try {
             LabTestOptions ok = o;
             ok.seed = o.seed + k;
             // One realization: its threads go to the contact loop; several: one each.
@@ -440,7 +474,6 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                       : Finish(),
                 write ? Frame([&](const Solver& s, const StressStrainPoint&) { write_labtest_frame(s, dir, frames); })
                       : Frame());
-            results[k] = r;
             if (!quiet) {
                 std::lock_guard lock(print);
                 std::fprintf(stderr, "\r  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
@@ -453,23 +486,15 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",
                                  static_cast<unsigned long long>(ok.seed));
             }
-        } catch (...) {
-            // The first failure is reported; the other realizations stop.
-            std::lock_guard lock(print);
-            if (!failure) failure = std::current_exception();
-            next = n;
-        }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
-    if (failure) {
-        try {
-            std::rethrow_exception(failure);
+            return labtest_record(r).dump();
         } catch (const GeometryError& e) {
             throw InputError(labtest_flag(e.key()), 0, "", e.what());
         }
-    }
+    };
+    // Realizations over ranks (k mod ranks) and threads; every rank gets them all.
+    std::vector<LabTestResult> results;
+    for (const auto& text : run_spread(n, n > 1 ? threads : 1, realization))
+        results.push_back(labtest_from_record(nlohmann::json::parse(text)));
     nlohmann::json summary = n == 1 ? labtest_json(results[0]) : nlohmann::json();
     if (n > 1) {
         auto stats = [&](auto get) {
@@ -491,7 +516,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                                      {"crack_initiation_stress", stats([](const LabTestResult& r) { return r.crack_initiation_stress; })},
                                      {"crack_damage_stress", stats([](const LabTestResult& r) { return r.crack_damage_stress; })},
                                      {"per_realization", per}};
-        if (write) io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
+        if (write && Ranks::root()) io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
         if (!quiet)
             std::fprintf(stderr, "mean of %d: E %.2f GPa, nu %.3f, peak %.2f MPa%s%s\n", n,
                          summary["E"]["mean"].get<double>() / 1e9, summary["nu"]["mean"].get<double>(),
