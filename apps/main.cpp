@@ -5,6 +5,9 @@
 //   bbm compare A.toml B.toml ...   run several models, tabulate and plot them
 //   bbm ucs | tension | biaxial | brazilian [flags]   numerical lab tests (SPEC §8)
 //   bbm calibrate [flags]           micro-properties from macro targets
+//   bbm sweep MODEL --set KEY=V1,V2 --seeds S   runs over key values and seeds
+// Under mpirun the independent runs (realizations, calibration runs, compared
+// models, sweep runs) are spread over the ranks; rank 0 writes the summaries.
 // Exit status: 0 success, 2 bad input (the message names file, line and key),
 // 3 stopped by a numerical health check, 4 calibration not converged, 130
 // interrupted, 1 any other failure. Earlier output in DIR is only replaced by
@@ -15,10 +18,12 @@
 #include "studies/commands.hpp"
 #include "studies/ranks.hpp"
 #include "studies/run_model.hpp"
+#include "studies/sweep.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -82,6 +87,40 @@ int run_cli(int argc, char** argv) {
     std::vector<std::string> compare_models;
     std::string compare_out = "out/compare";
     int compare_threads = 1;
+    studies::SweepOptions sweep_options;
+    std::vector<std::string> sweep_sets;
+    auto* sweep = app.add_subcommand(
+        "sweep", "Run a model file over the cross product of key overrides and seeds (under mpirun: spread over the "
+                 "ranks). Each run gets DIR/run_NNN (the edited model.toml and the output of bbm run); DIR/sweep.csv "
+                 "and sweep.json tabulate them (values, status, error, steps, cracks, the --plot value) and "
+                 "sweep.png plots --plot against the first --set key. A failed run is reported and the others go "
+                 "on (exit status 1 if any failed).");
+    sweep->add_option("model", sweep_options.model, "Model file (TOML; keys in docs/input.md)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    sweep->add_option("--set", sweep_sets,
+                      "KEY=V1,V2,...: a model-file key as error messages name it and its values, e.g. "
+                      "joint_property[0].tensile=2e6,3e6 or region[1].pattern.size=0.2,0.3 (repeatable)")
+        ->take_all();
+    sweep->add_option("--seeds", sweep_options.seeds,
+                      "Seeds per combination: the random patterns' seeds plus 0, 1, ... seeds-1")
+        ->check(cli::whole_at_least(1))
+        ->capture_default_str();
+    sweep->add_option("-o,--out", sweep_options.out, "Output directory")->capture_default_str();
+    sweep->add_option("--threads", sweep_options.threads, "Threads of each run's loop")
+        ->check(cli::positive())
+        ->capture_default_str();
+    sweep->add_option("--jobs", sweep_options.jobs, "Runs at once (per rank under mpirun)")
+        ->check(cli::positive())
+        ->capture_default_str();
+    sweep->add_flag("--resume", sweep_options.resume,
+                    "Keep the runs already finished in --out (complete summary, same model)");
+    sweep->add_option("--plot", sweep_options.plot,
+                      "The summary.json value drawn in sweep.png, dotted (cracks.shear, steps, "
+                      "opening.failed_depth_springline, ...)")
+        ->capture_default_str();
+    sweep->add_flag("-q,--quiet", quiet, "No progress, only errors");
+
     auto* compare = app.add_subcommand(
         "compare", "Run several model files (e.g. rigid and deformable blocks, examples/compare_rigid_deformable/) "
                    "into DIR/<name>/ and write DIR/comparison.csv, comparison.md (wall displacements, cracks by "
@@ -129,12 +168,15 @@ int run_cli(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ConfigError& e) {
         const auto* config = app.get_config_ptr();
+        if (studies::Ranks::root())
         std::fprintf(stderr, "bbm: error: %s: %s (keys are the long option names of the command, without '--'; "
                              "see bbm COMMAND --help)\n",
                      config && config->count() ? config->as<std::string>().c_str() : "--config", e.what());
         return 2;
     } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
+        // Under mpirun every rank parses the same line: rank 0 says what is wrong.
+        std::ostringstream discard;
+        const int code = studies::Ranks::root() ? app.exit(e) : app.exit(e, discard, discard);
         return code == 0 ? 0 : 2;
     }
     try {
@@ -149,6 +191,12 @@ int run_cli(int argc, char** argv) {
         if (*calibrate_cmd) {
             studies::note_given_joint_values(*calibrate_cmd, calibrate_values);
             return studies::run_calibrate(calibrate_values, quiet, check_only);
+        }
+        if (*sweep) {
+            for (const auto& text : sweep_sets) sweep_options.set.push_back(studies::parse_set(text));
+            sweep_options.quiet = quiet;
+            sweep_options.check_only = check_only;
+            return studies::run_sweep(sweep_options);
         }
         if (*compare) {
             if (check_only) {

@@ -1356,3 +1356,124 @@ InputError to_input_error(const ModelSource& source, const GeometryError& error)
 }
 
 } // namespace bbm::io
+
+namespace bbm::io {
+
+namespace {
+
+/// "joint_property[0].tensile" -> {"joint_property", 0, "tensile"}: names and indices.
+struct KeyStep {
+    std::string name;
+    long index = -1; ///< >= 0: an element of the array `name`
+};
+
+std::vector<KeyStep> split_key(const std::string& key, const std::string& flag) {
+    std::vector<KeyStep> steps;
+    std::size_t at = 0;
+    while (at < key.size()) {
+        const auto end = key.find_first_of(".[", at);
+        KeyStep s{key.substr(at, end == std::string::npos ? std::string::npos : end - at)};
+        if (s.name.empty()) throw InputError(flag, 0, key, "a key is names joined by '.', with [i] after an array");
+        at = end == std::string::npos ? key.size() : end;
+        if (at < key.size() && key[at] == '[') {
+            const auto close = key.find(']', at);
+            if (close == std::string::npos) throw InputError(flag, 0, key, "a '[' without its ']'");
+            try {
+                s.index = std::stol(key.substr(at + 1, close - at - 1));
+            } catch (...) {
+                throw InputError(flag, 0, key, "[i] needs a whole number");
+            }
+            if (s.index < 0) throw InputError(flag, 0, key, "[i] needs a whole number >= 0");
+            at = close + 1;
+        }
+        if (at < key.size()) {
+            if (key[at] != '.') throw InputError(flag, 0, key, "a key is names joined by '.', with [i] after an array");
+            ++at;
+        }
+        steps.push_back(std::move(s));
+    }
+    if (steps.empty()) throw InputError(flag, 0, key, "empty key");
+    return steps;
+}
+
+/// A value as TOML would read it on the right of '=' (2e6, "trigon", [1, 2], true);
+/// a bare word that is not TOML becomes a string.
+toml::node_view<toml::node> parse_value(const std::string& text, toml::table& holder) {
+    try {
+        holder = toml::parse("v = " + text);
+    } catch (const toml::parse_error&) {
+        holder = toml::table{{"v", text}};
+    }
+    return holder["v"];
+}
+
+} // namespace
+
+std::string edit_model_text(std::string_view text, const std::string& name,
+                            const std::vector<std::pair<std::string, std::string>>& set, long seed_offset) {
+    toml::table doc;
+    try {
+        doc = toml::parse(text, std::string_view{name});
+    } catch (const toml::parse_error& e) {
+        throw InputError(name, static_cast<int>(e.source().begin.line), "",
+                         "TOML syntax error: " + std::string(e.description()));
+    }
+    for (const auto& [key, value] : set) {
+        const auto steps = split_key(key, "--set");
+        toml::table* table = &doc;
+        std::string walked;
+        for (std::size_t k = 0; k + 1 <= steps.size(); ++k) {
+            const auto& s = steps[k];
+            if (!walked.empty()) walked += '.';
+            walked += s.name;
+            const bool last = k + 1 == steps.size();
+            if (last && s.index < 0) {
+                toml::table holder;
+                auto v = parse_value(value, holder);
+                table->insert_or_assign(s.name, *v.node());
+                break;
+            }
+            toml::node* node = table->get(s.name);
+            if (!node)
+                throw InputError("--set", 0, key, "the model " + name + " has no '" + walked + "' (" +
+                                 (k == 0 ? "a top-level table" : "a key") + " must exist to be set inside)");
+            if (s.index >= 0) {
+                auto* array = node->as_array();
+                if (!array) throw InputError("--set", 0, key, "'" + walked + "' is not an array");
+                if (std::size_t(s.index) >= array->size())
+                    throw InputError("--set", 0, key,
+                                     "'" + walked + "' has " + std::to_string(array->size()) + " entries (index from 0)");
+                walked += '[';
+                walked += std::to_string(s.index);
+                walked += ']';
+                if (last) {
+                    toml::table holder;
+                    auto v = parse_value(value, holder);
+                    array->replace(array->begin() + s.index, *v.node());
+                    break;
+                }
+                node = array->get(std::size_t(s.index));
+            }
+            table = node->as_table();
+            if (!table) throw InputError("--set", 0, key, "'" + walked + "' is not a table");
+        }
+    }
+    if (seed_offset != 0) {
+        // Random patterns (voronoi, trigon, delaunay) of every region draw from seed + offset.
+        if (auto* regions = doc["region"].as_array())
+            for (auto& r : *regions) {
+                auto* pattern = r.as_table() ? (*r.as_table())["pattern"].as_table() : nullptr;
+                if (!pattern) continue;
+                const auto type = (*pattern)["type"].value_or(std::string{});
+                if (type != "voronoi" && type != "trigon" && type != "delaunay") continue;
+                const auto seed = (*pattern)["seed"].value_or(std::int64_t{1});
+                pattern->insert_or_assign("seed", seed + seed_offset);
+            }
+    }
+    std::ostringstream out;
+    out << "# " << name << (set.empty() && seed_offset == 0 ? "" : ", edited by bbm sweep") << "\n"
+        << toml::toml_formatter{doc} << "\n";
+    return out.str();
+}
+
+} // namespace bbm::io

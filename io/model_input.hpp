@@ -64,6 +64,14 @@ ModelFile read_model(const std::string& path);
 /// The same from text; `name` stands for the file name in messages (for tests).
 ModelFile parse_model(std::string_view text, const std::string& name);
 
+/// The text of a model file with keys set (`set`: full key as in messages,
+/// "joint_property[0].tensile" or "region[1].pattern.size", and a TOML value) and
+/// the seeds of random patterns (voronoi, trigon, delaunay) moved by `seed_offset`
+/// (`bbm sweep`). Comments are not kept. Throws InputError naming --set and the
+/// key if the key's tables do not exist; the result is checked by parse_model.
+std::string edit_model_text(std::string_view text, const std::string& name,
+                            const std::vector<std::pair<std::string, std::string>>& set, long seed_offset);
+
 /// "file:line: region[i].key: message" for a defect found by meshing/.
 InputError to_input_error(const ModelSource& source, const GeometryError& error);
 

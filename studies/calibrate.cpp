@@ -1,10 +1,14 @@
 #include "studies/calibrate.hpp"
 
+#include "studies/ranks.hpp"
+
 #include "core/solver.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <stdexcept>
 #include <cmath>
 #include <numbers>
 #include <thread>
@@ -80,32 +84,39 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     const int n = o.realizations;
     // UCS, direct tension (and biaxial) runs for each seed, shared among the threads.
     const int kinds = confinement > 0.0 ? 3 : 2;
-    std::vector<LabTestResult> ucs(n), tension(n), biaxial(n);
-    std::atomic<int> next{0};
-    auto worker = [&] {
-        for (int k = next++; k < kinds * n; k = next++) {
-            LabTestOptions lo = o.base;
-            lo.joint = joint;
-            lo.seed = first_seed + std::uint64_t(k % n);
-            lo.threads = 1;
-            if (k < n) {
-                lo.kind = LabTestOptions::Kind::ucs;
-                ucs[k] = run_labtest(lo);
-            } else if (k < 2 * n) {
-                lo.kind = LabTestOptions::Kind::tension;
-                lo.strain_per_step = 0.1 * o.base.strain_per_step; // its peak comes at a tenth of the strain
-                lo.platen_friction = -1.0;                           // tension needs platens that hold
-                tension[k - n] = run_labtest(lo);
-            } else {
-                lo.kind = LabTestOptions::Kind::biaxial;
-                lo.confinement = confinement;
-                biaxial[k - 2 * n] = run_labtest(lo);
-            }
-        }
+    // Each run travels (between ranks under mpirun) as the three numbers used here.
+    struct Measured {
+        double E = 0, nu = 0, peak_stress = 0;
     };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < std::max(1, std::min(o.threads, kinds * n)); ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    auto run = [&](int k) -> std::string {
+        LabTestOptions lo = o.base;
+        lo.joint = joint;
+        lo.seed = first_seed + std::uint64_t(k % n);
+        lo.threads = 1;
+        if (k < n) {
+            lo.kind = LabTestOptions::Kind::ucs;
+        } else if (k < 2 * n) {
+            lo.kind = LabTestOptions::Kind::tension;
+            lo.strain_per_step = 0.1 * o.base.strain_per_step; // its peak comes at a tenth of the strain
+            lo.platen_friction = -1.0;                           // tension needs platens that hold
+        } else {
+            lo.kind = LabTestOptions::Kind::biaxial;
+            lo.confinement = confinement;
+        }
+        const LabTestResult r = run_labtest(lo);
+        char text[96];
+        std::snprintf(text, sizeof text, "%.17g %.17g %.17g", r.E, r.nu, r.peak_stress);
+        return text;
+    };
+    // Runs over ranks and threads; every rank gets every result.
+    std::vector<Measured> ucs(n), tension(n), biaxial(n);
+    const auto texts = studies::run_spread(kinds * n, o.threads, run);
+    for (int k = 0; k < kinds * n; ++k) {
+        Measured m;
+        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf", &m.E, &m.nu, &m.peak_stress) != 3)
+            throw std::runtime_error("calibration: a run's result did not arrive");
+        (k < n ? ucs[k] : k < 2 * n ? tension[k - n] : biaxial[k - 2 * n]) = m;
+    }
     CalibrationIteration it;
     it.joint = joint;
     std::vector<double> E, nu, peak, ten;

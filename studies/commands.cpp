@@ -533,6 +533,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
 /// `bbm calibrate`: iterates the micro-properties and writes the joint property
 /// set as a TOML fragment, with the iteration table as JSON.
 int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string* calibration_json) {
+    quiet = quiet || !Ranks::root(); // under mpirun, rank 0 reports and writes
     LabTestCli& c = values.lab;
     const CalibrationTargets& targets = values.targets;
     const int iterations = values.iterations;
@@ -664,7 +665,7 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                                              {"iterations", table},
                                              {"joint_property_toml", toml}};
     if (calibration_json) *calibration_json = calibration.dump();
-    if (c.write_files) {
+    if (c.write_files && Ranks::root()) {
         io::write_text_atomically(out / "joint_property.toml", toml);
         io::write_text_atomically(out / "calibration.json", calibration.dump(2) + "\n");
         if (!quiet)

@@ -6,6 +6,7 @@
 #include "core/stages.hpp"
 #include "studies/model.hpp"
 #include "studies/opening.hpp"
+#include "studies/ranks.hpp"
 #include "base/error.hpp"
 #include "meshing/blocks.hpp"
 
@@ -409,15 +410,26 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
        << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::vector<Series> curves;
     int status = 0;
-    for (const auto& model : models) {
-        const std::string name = fs::path(model).stem().string();
+    // The models over ranks under mpirun (one after another within a rank, each on
+    // `threads` threads); rank 0 tabulates them.
+    const bool parallel = Ranks::size() > 1;
+    const auto codes = run_spread(int(models.size()), 1, [&](int k) {
+        const std::string name = fs::path(models[k]).stem().string();
         RunOptions o;
-        o.model = model;
+        o.model = models[k];
         o.out = out / name;
         o.threads = threads;
-        o.quiet = quiet;
-        if (!quiet) std::fprintf(stderr, "== %s\n", name.c_str());
-        const int rc = run_model(o);
+        o.quiet = quiet || parallel;
+        if (!o.quiet) std::fprintf(stderr, "== %s\n", name.c_str());
+        return std::to_string(run_model(o));
+    });
+    if (!Ranks::root()) return 0;
+    for (std::size_t m = 0; m < models.size(); ++m) {
+        const auto& model = models[m];
+        const std::string name = fs::path(model).stem().string();
+        RunOptions o;
+        o.out = out / name;
+        const int rc = std::stoi(codes[m]);
         if (rc != 0 && status == 0) status = rc;
         std::ifstream f(o.out / "summary.json");
         const auto j = nlohmann::json::parse(f);
