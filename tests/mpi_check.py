@@ -2,6 +2,8 @@
 
     mpi_check.py BBM MPIEXEC DIR labtest|sweep|calibrate|errors
 
+    mpi_check.py ... studies: calibrate and compare on 2 ranks as serially
+
 labtest: `bbm ucs --realizations 4` on 2 and 3 ranks writes the summary of the
 serial run (wall times aside). sweep: a sweep over 2 values x 2 seeds, with a run
 that fails (a load no stiffness carries), on 2 ranks gives the serial table; the
@@ -88,6 +90,35 @@ def sweep():
     print("sweep: 8 runs, 4 stopped and reported, the same table on 2 ranks; --resume kept 4")
 
 
+def studies():
+    # calibrate: its UCS and tension runs over 2 ranks, the same iterations.
+    args = ["calibrate", "--width", 2, "--height", 4, "--realizations", 2, "--iterations", 2, "--quiet"]
+    run(args + ["--out", DIR / "cal_serial", "--threads", 2])
+    run(args + ["--out", DIR / "cal_ranks2", "--threads", 1], 2)
+    a = json.loads((DIR / "cal_serial/calibration.json").read_text())
+    b = json.loads((DIR / "cal_ranks2/calibration.json").read_text())
+    if without_times(a) != without_times(b):
+        sys.exit("calibrate on 2 ranks: calibration.json differs from the serial one")
+    assert (DIR / "cal_ranks2/joint_property.toml").read_text() == (DIR / "cal_serial/joint_property.toml").read_text()
+    # compare: one model per rank, one table.
+    models = [SOURCE / "examples/verification/insitu_voronoi.toml", SOURCE / "examples/verification/hybrid_elastic.toml"]
+    run(["compare", *models, "--out", DIR / "cmp_serial", "--quiet"])
+    run(["compare", *models, "--out", DIR / "cmp_ranks2", "--quiet"], 2)
+
+    def table(d):
+        rows = list(csv.DictReader(open(d / "comparison.csv")))
+        for r in rows:
+            r.pop("wall_seconds")
+        return rows
+
+    assert table(DIR / "cmp_serial") == table(DIR / "cmp_ranks2")
+    for m in models:
+        a = json.loads((DIR / "cmp_serial" / m.stem / "summary.json").read_text())
+        b = json.loads((DIR / "cmp_ranks2" / m.stem / "summary.json").read_text())
+        assert a["state_hash"] == b["state_hash"]
+    print("calibrate and compare on 2 ranks: the serial results")
+
+
 def errors():
     # Bad input under mpirun: exit 2 from every rank, one message.
     done = run(["ucs", "--kn", "nan", "--quiet"], 2, expect=2)
@@ -101,4 +132,4 @@ def errors():
 
 shutil.rmtree(DIR, ignore_errors=True)
 DIR.mkdir(parents=True)
-{"labtest": labtest, "sweep": sweep, "errors": errors}[WHAT]()
+{"labtest": labtest, "sweep": sweep, "studies": studies, "errors": errors}[WHAT]()
