@@ -18,6 +18,65 @@ namespace bbm::studies {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, f, a, b, c);
+    return buf;
+}
+
+/// NaN, runaway motion (more than the detection tolerance in one step: contacts
+/// can no longer follow) and overlaps beyond the tolerance (a contact pushed
+/// through). Cheap checks every 100 steps, the overlap scan every 1000.
+} // namespace
+
+void check_run_health(const Solver& s) {
+    const double tol = s.detection_tolerance(), dt = s.timestep();
+    const std::string advice =
+        " Reduce solver.safety (the automatic time step is safety x the critical step) or a solver.timestep "
+        "given explicitly, or, for a load applied by velocity, the velocity; check that stiffness and strength "
+        "values are in SI units (Pa/m, Pa).";
+    if (!std::isfinite(s.unbalanced_ratio()) || !std::isfinite(s.kinetic_energy()))
+        throw NumericalError("the solution became NaN or infinite at step " + std::to_string(s.steps()) + "." + advice);
+    if (!(s.timestep() >= 1e-3 * s.initial_timestep()))
+        throw NumericalError(fmt("the time step collapsed at step %.0f, from %.3g s to %.3g s: ", double(s.steps()),
+                              s.initial_timestep(), s.timestep()) +
+                          "a contact far stiffer, or a block far lighter, than at the start (a sliver block left by a "
+                          "cut, or a runaway overlap). Look at the last output; raise the pattern's min_edge to remove "
+                          "slivers.");
+    const auto& b = s.blocks();
+    for (int i = 0; i < b.count(); ++i) {
+        if (b.removed[i] || b.deformable[i]) continue;
+        if (norm(b.velocity[i]) * dt > tol)
+            throw NumericalError(fmt("runaway motion at step %.0f: block %.0f moves %.3g m in one step, more than the "
+                                  "detection tolerance, so contacts can no longer follow it. Either part of the "
+                                  "model is collapsing (a mechanism: look at the last output) or the step is "
+                                  "unstable.",
+                                  double(s.steps()), i, norm(b.velocity[i]) * dt) +
+                              advice);
+    }
+    const auto& n = s.nodes();
+    for (int k = 0; k < n.count(); ++k)
+        if (!b.removed[n.block[k]] && norm(n.velocity[k]) * dt > tol)
+            throw NumericalError(fmt("runaway motion at step %.0f: node %.0f moves %.3g m in one step.", double(s.steps()),
+                                  k, norm(n.velocity[k]) * dt) +
+                              advice);
+    if (s.steps() % 1000 != 0) return;
+    const auto& c = s.contacts();
+    for (int i = 0; i < c.size(); ++i) {
+        const Vec2 x = b.vertex[c.vertex_id[i]], p = b.vertex[c.edge_id[i]];
+        const double gap = dot(x - p, c.normal[i]);
+        const double elastic = std::max(0.0, -c.history[i].un);
+        if (gap < -(tol + elastic))
+            throw NumericalError(fmt("blocks overlap at step %.0f: a contact at (%.3g, %.3g) is pushed through its edge "
+                                  "by more than the detection tolerance.",
+                                  double(s.steps()), x.x, x.y) +
+                              advice);
+    }
+}
+
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
                            const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
                            const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,
@@ -116,7 +175,10 @@ std::string get_string(std::istream& i, std::uint64_t limit) {
 class CallbackObserver : public StageObserver {
 public:
     CallbackObserver(const Model& m, const Model::Progress& p) : model_(m), progress_(p) {}
-    void step_done(const Solver& s, const StageSpec&, long) override { poll(s); }
+    void step_done(const Solver& s, const StageSpec&, long) override {
+        if (s.steps() % 100 == 0) check_run_health(s);
+        poll(s);
+    }
     void stage_done(const Solver&, const StageReport&) override {
         if (progress_.callback && !progress_.callback(model_)) stop_ = true;
     }
@@ -229,6 +291,7 @@ void Model::step(long n, const Progress& progress) {
     const auto t0 = std::chrono::steady_clock::now();
     for (long k = 0; k < n && !observer.stop_requested(); ++k) {
         solver_->step();
+        if (solver_->steps() % 100 == 0) check_run_health(*solver_);
         observer.poll(*solver_);
     }
     run_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -86,6 +86,12 @@ private:
     double run_seconds_ = 0;
 };
 
+/// The numerical health checks of a run, every 100 steps: NaN, a collapsing time
+/// step, runaway motion (farther than the detection tolerance in a step) and,
+/// every 1,000 steps, overlaps beyond it. Throws NumericalError naming the cause
+/// and what to change.
+void check_run_health(const Solver& solver);
+
 /// The summary of a run, keys as in `bbm run`'s summary.json: counts, steps,
 /// cracks, energies, state hash, the stages, and with a [report] the opening's
 /// measures and hoop-stress profiles. `wall_seconds`, `interrupted` and

@@ -32,65 +32,6 @@ namespace {
 
 std::atomic<bool> interrupted{false};
 
-/// A run stopped by a health check; the message says why and what to change.
-struct HealthError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf, f, a, b, c);
-    return buf;
-}
-
-/// NaN, runaway motion (more than the detection tolerance in one step: contacts
-/// can no longer follow) and overlaps beyond the tolerance (a contact pushed
-/// through). Cheap checks every 100 steps, the overlap scan every 1000.
-void check_health(const Solver& s) {
-    const double tol = s.detection_tolerance(), dt = s.timestep();
-    const std::string advice =
-        " Reduce solver.safety (the automatic time step is safety x the critical step) or a solver.timestep "
-        "given explicitly, or, for a load applied by velocity, the velocity; check that stiffness and strength "
-        "values are in SI units (Pa/m, Pa).";
-    if (!std::isfinite(s.unbalanced_ratio()) || !std::isfinite(s.kinetic_energy()))
-        throw HealthError("the solution became NaN or infinite at step " + std::to_string(s.steps()) + "." + advice);
-    if (!(s.timestep() >= 1e-3 * s.initial_timestep()))
-        throw HealthError(fmt("the time step collapsed at step %.0f, from %.3g s to %.3g s: ", double(s.steps()),
-                              s.initial_timestep(), s.timestep()) +
-                          "a contact far stiffer, or a block far lighter, than at the start (a sliver block left by a "
-                          "cut, or a runaway overlap). Look at the last output; raise the pattern's min_edge to remove "
-                          "slivers.");
-    const auto& b = s.blocks();
-    for (int i = 0; i < b.count(); ++i) {
-        if (b.removed[i] || b.deformable[i]) continue;
-        if (norm(b.velocity[i]) * dt > tol)
-            throw HealthError(fmt("runaway motion at step %.0f: block %.0f moves %.3g m in one step, more than the "
-                                  "detection tolerance, so contacts can no longer follow it. Either part of the "
-                                  "model is collapsing (a mechanism: look at the last output) or the step is "
-                                  "unstable.",
-                                  double(s.steps()), i, norm(b.velocity[i]) * dt) +
-                              advice);
-    }
-    const auto& n = s.nodes();
-    for (int k = 0; k < n.count(); ++k)
-        if (!b.removed[n.block[k]] && norm(n.velocity[k]) * dt > tol)
-            throw HealthError(fmt("runaway motion at step %.0f: node %.0f moves %.3g m in one step.", double(s.steps()),
-                                  k, norm(n.velocity[k]) * dt) +
-                              advice);
-    if (s.steps() % 1000 != 0) return;
-    const auto& c = s.contacts();
-    for (int i = 0; i < c.size(); ++i) {
-        const Vec2 x = b.vertex[c.vertex_id[i]], p = b.vertex[c.edge_id[i]];
-        const double gap = dot(x - p, c.normal[i]);
-        const double elastic = std::max(0.0, -c.history[i].un);
-        if (gap < -(tol + elastic))
-            throw HealthError(fmt("blocks overlap at step %.0f: a contact at (%.3g, %.3g) is pushed through its edge "
-                                  "by more than the detection tolerance.",
-                                  double(s.steps()), x.x, x.y) +
-                              advice);
-    }
-}
-
 // --- binary helpers for the checkpoint's run part ------------------------------
 template <class T>
 void put(std::ostream& o, const T& v) {
@@ -136,7 +77,7 @@ public:
     void step_done(const Solver& s, const StageSpec& st, long k) override {
         if (s.steps() % settings_.history_every == 0) record(s);
         if (settings_.output_every > 0 && s.steps() % settings_.output_every == 0) snapshot(s);
-        if (s.steps() % 100 == 0) check_health(s);
+        if (s.steps() % 100 == 0) check_run_health(s);
         if (options_.quiet) return;
         const auto now = std::chrono::steady_clock::now();
         if (std::chrono::duration<double>(now - last_print_).count() < 1.0) return;
@@ -344,8 +285,6 @@ int run_model(const RunOptions& opt) {
     std::string health;
     try {
         reports = run_stages(*solver, model.analysis.stages, output, start);
-    } catch (const HealthError& e) {
-        health = e.what();
     } catch (const NumericalError& e) {
         health = e.what();
     }

@@ -241,3 +241,13 @@ def test_examples_run(script, tmp_path):
         assert rows[1]["tensile_strength"] > rows[0]["tensile_strength"]
     else:
         assert len({r["state_hash"] for r in rows}) == 3
+
+
+def test_unstable_model_raises_numerical_error(tmp_path):
+    # A time step far above the stable one: the health checks stop it, as bbm run does (exit 3).
+    text = (SOURCE / "examples/verification/pwave_column.toml").read_text()
+    text = text.replace("safety = 0.5", "safety = 0.5\ntimestep = 1.0e-4")
+    m = bbm.Model._from_text(text, "unstable.toml")
+    with pytest.raises(bbm.NumericalError, match="step"):
+        m.run()
+    assert not m.summary()["complete"]
