@@ -25,6 +25,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <mutex>
 #include <optional>
 
 namespace py = pybind11;
@@ -81,20 +82,63 @@ void run_released(Model& m, const std::optional<py::function>& callback, long ev
     if (failure) throw std::move(*failure);
 }
 
-struct BlockArrays {
+/// The arrays of a solver's state: `model` keeps it alive (views point into it);
+/// a lab test's frame has none, and its arrays are copied at once (snapshot()).
+struct StateArrays {
     py::object model;
+    const Solver* solver = nullptr;
 };
-struct ContactArrays {
-    py::object model;
-};
-struct ZoneArrays {
-    py::object model;
-};
-struct NodeArrays {
-    py::object model;
-};
+struct BlockArrays : StateArrays {};
+struct ContactArrays : StateArrays {};
+struct ZoneArrays : StateArrays {};
+struct NodeArrays : StateArrays {};
 
-const Solver& solver_of(const py::object& m) { return m.cast<const Model&>().solver(); }
+const Solver& solver_of(const StateArrays& a) { return *a.solver; }
+
+template <class Arrays>
+Arrays arrays_of(py::object model) {
+    Arrays a;
+    a.solver = &model.cast<const Model&>().solver();
+    a.model = std::move(model);
+    return a;
+}
+
+/// A fresh array of one value per contact (or `cols` values: get fills a row).
+template <class T, class Get>
+py::array_t<T> per_contact(const ContactArrays& a, Get get, py::ssize_t cols = 0) {
+    const Solver& s = solver_of(a);
+    const auto& c = s.contacts();
+    auto out = fresh<T>(c.size(), cols);
+    T* data = out.mutable_data();
+    for (int i = 0; i < c.size(); ++i) get(s, c, i, data + (cols > 0 ? cols * i : i));
+    return out;
+}
+
+/// Every property of `arrays`, copied, as a dict (the solver outlives it not).
+py::dict copy_properties(py::object arrays, std::initializer_list<const char*> names) {
+    py::dict d;
+    for (const char* n : names) d[n] = arrays.attr(n).attr("copy")();
+    return d;
+}
+
+/// A lab test's state at a frame, copied: the point of the curve, blocks and contacts.
+py::dict frame_snapshot(const Solver& s, const StressStrainPoint& p, int realization) {
+    py::dict d;
+    d["realization"] = realization, d["step"] = p.step, d["axial_strain"] = p.axial_strain;
+    d["axial_stress"] = p.axial_stress, d["lateral_strain"] = p.lateral_strain;
+    d["cracks_tensile"] = p.cracks_tensile, d["cracks_shear"] = p.cracks_shear;
+    BlockArrays b;
+    b.solver = &s, b.model = py::none();
+    d["blocks"] = copy_properties(py::cast(b), {"centroid", "velocity", "rotation", "area", "region", "removed",
+                                                "displacement", "stress"});
+    ContactArrays c;
+    c.solver = &s, c.model = py::none();
+    d["contacts"] = copy_properties(py::cast(c), {"normal_stress", "shear_stress", "normal_displacement",
+                                                  "shear_displacement", "damage", "state", "bonded", "property",
+                                                  "block_pair", "length", "normal", "position", "edge_parameter"});
+    d["property_names"] = s.property_names();
+    return d;
+}
 
 } // namespace
 
@@ -127,37 +171,37 @@ PYBIND11_MODULE(_bbm, mod) {
     });
 
     py::class_<BlockArrays>(mod, "BlockArrays", "Per-block arrays (N = blocks, excavated ones included)")
-        .def_property_readonly("count", [](const BlockArrays& a) { return solver_of(a.model).blocks().count(); })
+        .def_property_readonly("count", [](const BlockArrays& a) { return solver_of(a).blocks().count(); })
         .def_property_readonly("centroid", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<double>(b.centroid.data(), b.count(), 2, sizeof(Vec2), a.model);
         }, "N×2 current centroids, m (view)")
         .def_property_readonly("velocity", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<double>(b.velocity.data(), b.count(), 2, sizeof(Vec2), a.model);
         }, "N×2 velocities, m/s (quasi-static: m per step) (view)")
         .def_property_readonly("rotation", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<double>(b.theta.data(), b.count(), 0, sizeof(double), a.model);
         }, "N rotations, rad, counter-clockwise (view)")
         .def_property_readonly("area", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<double>(b.area.data(), b.count(), 0, sizeof(double), a.model);
         }, "N areas, m² (view)")
         .def_property_readonly("region", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<int>(b.region.data(), b.count(), 0, sizeof(int), a.model);
         }, "N region indices into Model.region_names (view)")
         .def_property_readonly("removed", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<std::uint8_t>(b.removed.data(), b.count(), 0, 1, a.model).attr("astype")("bool");
         }, "N flags: excavated")
         .def_property_readonly("deformable", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             return view<std::uint8_t>(b.deformable.data(), b.count(), 0, 1, a.model).attr("astype")("bool");
         }, "N flags: meshed into zones")
         .def_property_readonly("displacement", [](const BlockArrays& a) {
-            const auto& b = solver_of(a.model).blocks();
+            const auto& b = solver_of(a).blocks();
             auto out = fresh<double>(b.count(), 2);
             auto o = out.mutable_unchecked<2>();
             for (int i = 0; i < b.count(); ++i) {
@@ -167,7 +211,7 @@ PYBIND11_MODULE(_bbm, mod) {
             return out;
         }, "N×2 centroid displacements since the start, m (computed)")
         .def_property_readonly("stress", [](const BlockArrays& a) {
-            const auto s = solver_of(a.model).block_stresses();
+            const auto s = solver_of(a).block_stresses();
             auto out = fresh<double>(py::ssize_t(s.size()), 3);
             auto o = out.mutable_unchecked<2>();
             for (std::size_t i = 0; i < s.size(); ++i)
@@ -176,97 +220,72 @@ PYBIND11_MODULE(_bbm, mod) {
         }, "N×3 block-averaged stress sxx, syy, sxy, Pa, tension positive (SPEC §7; computed)");
 
     py::class_<ContactArrays>(mod, "ContactArrays", "Per-contact arrays (M = contacts now; fresh copies)")
-        .def_property_readonly("count", [](const ContactArrays& a) { return solver_of(a.model).contacts().size(); })
+        .def_property_readonly("count", [](const ContactArrays& a) { return solver_of(a).contacts().size(); })
         .def_property_readonly("normal_stress", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<double>(c.size());
-            auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].sn;
-            return out;
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].sn; });
         }, "M normal stresses σn, Pa, compression positive")
         .def_property_readonly("shear_stress", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<double>(c.size());
-            auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].tau;
-            return out;
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].tau; });
         }, "M shear stresses τ, Pa")
         .def_property_readonly("damage", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<double>(c.size());
-            auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].damage;
-            return out;
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].damage; });
         }, "M damage D of SPEC §4, 0 intact to 1 broken")
         .def_property_readonly("state", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<std::int32_t>(c.size());
-            auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < c.size(); ++i) {
-                o(i) = int(contact::state_of(c.history[i])); // as contacts.vtu
-            }
-            return out;
+            return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { *o = int(contact::state_of(c.history[i])); /* as contacts.vtu */ });
         }, "M states: 0 intact, 1 softening, 2 broken in tension, 3 broken in shear, 4 sliding")
         .def_property_readonly("bonded", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<bool>(c.size());
-            auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < c.size(); ++i) o(i) = c.history[i].bonded;
-            return out;
+            return per_contact<bool>(a, [](const Solver&, const contact::Contacts& c, int i, bool* o) { *o = c.history[i].bonded; });
         }, "M flags: the bond holds")
         .def_property_readonly("block_pair", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<std::int32_t>(c.size(), 2);
-            auto o = out.mutable_unchecked<2>();
-            for (int i = 0; i < c.size(); ++i) o(i, 0) = c.vertex_block[i], o(i, 1) = c.edge_block[i];
-            return out;
+            return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { o[0] = c.vertex_block[i], o[1] = c.edge_block[i]; }, 2);
         }, "M×2 blocks: the vertex's, the edge's")
         .def_property_readonly("length", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<double>(c.size());
-            auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < c.size(); ++i) o(i) = c.length[i];
-            return out;
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.length[i]; });
         }, "M joint lengths the contacts stand for, m")
         .def_property_readonly("normal", [](const ContactArrays& a) {
-            const auto& c = solver_of(a.model).contacts();
-            auto out = fresh<double>(c.size(), 2);
-            auto o = out.mutable_unchecked<2>();
-            for (int i = 0; i < c.size(); ++i) o(i, 0) = c.normal[i].x, o(i, 1) = c.normal[i].y;
-            return out;
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { o[0] = c.normal[i].x, o[1] = c.normal[i].y; }, 2);
         }, "M×2 unit normals (out of the edge's block)")
         .def_property_readonly("position", [](const ContactArrays& a) {
-            const auto& s = solver_of(a.model);
-            const auto& c = s.contacts();
-            auto out = fresh<double>(c.size(), 2);
-            auto o = out.mutable_unchecked<2>();
-            for (int i = 0; i < c.size(); ++i) {
-                const Vec2 x = s.blocks().vertex[c.vertex_id[i]];
-                o(i, 0) = x.x, o(i, 1) = x.y;
-            }
-            return out;
-        }, "M×2 contact points (the vertices), m");
+            return per_contact<double>(a, [](const Solver& s, const contact::Contacts& c, int i, double* o) { const Vec2 x = s.blocks().vertex[c.vertex_id[i]];
+                o[0] = x.x, o[1] = x.y; }, 2);
+        }, "M×2 contact points (the vertices), m")
+        .def_property_readonly("normal_displacement", [](const ContactArrays& a) {
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].un; });
+        }, "M normal displacements un since bonding, m, opening positive (overlap negative)")
+        .def_property_readonly("shear_displacement", [](const ContactArrays& a) {
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].us; });
+        }, "M shear displacements us, m")
+        .def_property_readonly("property", [](const ContactArrays& a) {
+            return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { *o = c.property[i]; });
+        }, "M property sets (indices into Model.property_names; contacts formed in the run get solver.new_contact_property)")
+        .def_property_readonly("edge_parameter", [](const ContactArrays& a) {
+            return per_contact<double>(a, [](const Solver& s, const contact::Contacts& c, int i, double* o) {
+                const auto& v = s.blocks().vertex;
+                const Vec2 p = v[c.edge_id[i]], e = v[c.edge_end[i]] - p;
+                *o = dot(v[c.vertex_id[i]] - p, e) / dot(e, e);
+            });
+        }, "M positions of the vertex along its edge, 0 to 1 (outside: a vertex past the edge's end, on the rounded corner)");
 
     py::class_<ZoneArrays>(mod, "ZoneArrays", "Per-zone arrays of deformable blocks (K = constant-strain triangles)")
-        .def_property_readonly("count", [](const ZoneArrays& a) { return solver_of(a.model).zones().size(); })
+        .def_property_readonly("count", [](const ZoneArrays& a) { return solver_of(a).zones().size(); })
         .def_property_readonly("nodes", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a.model).zones();
+            const auto& z = solver_of(a).zones();
             return view<int>(z.node.data(), z.size(), 3, sizeof(std::array<int, 3>), a.model);
         }, "K×3 node indices, counter-clockwise (view)")
         .def_property_readonly("stress", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a.model).zones();
+            const auto& z = solver_of(a).zones();
             return view<double>(z.stress.data(), z.size(), 3, sizeof(std::array<double, 3>), a.model);
         }, "K×3 stress sxx, syy, sxy, Pa, tension positive (view)")
         .def_property_readonly("strain", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a.model).zones();
+            const auto& z = solver_of(a).zones();
             return view<double>(z.strain.data(), z.size(), 3, sizeof(std::array<double, 3>), a.model);
         }, "K×3 strain exx, eyy, exy (tensor shear) (view)")
         .def_property_readonly("block", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a.model).zones();
+            const auto& z = solver_of(a).zones();
             return view<int>(z.block.data(), z.size(), 0, sizeof(int), a.model);
         }, "K owning blocks (view)")
         .def_property_readonly("region", [](const ZoneArrays& a) {
-            const auto& s = solver_of(a.model);
+            const auto& s = solver_of(a);
             const auto& z = s.zones();
             auto out = fresh<std::int32_t>(z.size());
             auto o = out.mutable_unchecked<1>();
@@ -274,7 +293,7 @@ PYBIND11_MODULE(_bbm, mod) {
             return out;
         }, "K region indices (computed)")
         .def_property_readonly("centroid", [](const ZoneArrays& a) {
-            const auto& s = solver_of(a.model);
+            const auto& s = solver_of(a);
             const auto& z = s.zones();
             auto out = fresh<double>(z.size(), 2);
             auto o = out.mutable_unchecked<2>();
@@ -286,7 +305,7 @@ PYBIND11_MODULE(_bbm, mod) {
             return out;
         }, "K×2 current centroids, m (computed)")
         .def_property_readonly("area", [](const ZoneArrays& a) {
-            const auto& s = solver_of(a.model);
+            const auto& s = solver_of(a);
             const auto& z = s.zones();
             auto out = fresh<double>(z.size());
             auto o = out.mutable_unchecked<1>();
@@ -298,17 +317,17 @@ PYBIND11_MODULE(_bbm, mod) {
         }, "K current areas, m² (computed)");
 
     py::class_<NodeArrays>(mod, "NodeArrays", "Per-node arrays of deformable blocks")
-        .def_property_readonly("count", [](const NodeArrays& a) { return solver_of(a.model).nodes().count(); })
+        .def_property_readonly("count", [](const NodeArrays& a) { return solver_of(a).nodes().count(); })
         .def_property_readonly("position", [](const NodeArrays& a) {
-            const auto& n = solver_of(a.model).nodes();
+            const auto& n = solver_of(a).nodes();
             return view<double>(n.position.data(), n.count(), 2, sizeof(Vec2), a.model);
         }, "n×2 positions, m (view)")
         .def_property_readonly("velocity", [](const NodeArrays& a) {
-            const auto& n = solver_of(a.model).nodes();
+            const auto& n = solver_of(a).nodes();
             return view<double>(n.velocity.data(), n.count(), 2, sizeof(Vec2), a.model);
         }, "n×2 velocities (view)")
         .def_property_readonly("displacement", [](const NodeArrays& a) {
-            const auto& n = solver_of(a.model).nodes();
+            const auto& n = solver_of(a).nodes();
             auto out = fresh<double>(n.count(), 2);
             auto o = out.mutable_unchecked<2>();
             for (int i = 0; i < n.count(); ++i) {
@@ -353,10 +372,10 @@ PYBIND11_MODULE(_bbm, mod) {
              "The dict of summary.json (as `bbm run` writes it) for the state now.")
         .def("write_vtk", [](const Model& m, const std::filesystem::path& dir) { m.write_vtk(dir); }, py::arg("dir"),
              "Writes DIR/blocks.vtu, contacts.vtu and result.pvd of the state now, for ParaView.")
-        .def_property_readonly("blocks", [](py::object self) { return BlockArrays{self}; })
-        .def_property_readonly("contacts", [](py::object self) { return ContactArrays{self}; })
-        .def_property_readonly("zones", [](py::object self) { return ZoneArrays{self}; })
-        .def_property_readonly("nodes", [](py::object self) { return NodeArrays{self}; })
+        .def_property_readonly("blocks", [](py::object self) { return arrays_of<BlockArrays>(self); })
+        .def_property_readonly("contacts", [](py::object self) { return arrays_of<ContactArrays>(self); })
+        .def_property_readonly("zones", [](py::object self) { return arrays_of<ZoneArrays>(self); })
+        .def_property_readonly("nodes", [](py::object self) { return arrays_of<NodeArrays>(self); })
         .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
         .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
         .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })
@@ -374,14 +393,31 @@ PYBIND11_MODULE(_bbm, mod) {
             return names;
         })
         .def_property_readonly("region_names", [](const Model& m) { return m.solver().region_names(); })
+        .def_property_readonly("property_names", [](const Model& m) { return m.solver().property_names(); })
         .def_property_readonly("name", &Model::name);
 
-    mod.def("_labtest", [](const std::string& command, const std::vector<std::string>& args, bool quiet) {
+    mod.def("_labtest", [](const std::string& command, const std::vector<std::string>& args, bool quiet,
+                           std::optional<py::function> callback) {
         studies::LabTestStudy study;
+        std::function<void(const Solver&, const StressStrainPoint&, int)> on_frame;
+        std::optional<py::error_already_set> failure;
+        std::mutex once; // realizations on several threads: one callback at a time
+        if (callback)
+            on_frame = [&](const Solver& s, const StressStrainPoint& p, int realization) {
+                std::lock_guard lock(once);
+                py::gil_scoped_acquire gil;
+                if (failure) return;
+                try {
+                    (*callback)(frame_snapshot(s, p, realization));
+                } catch (py::error_already_set& e) {
+                    failure.emplace(std::move(e));
+                }
+            };
         {
             py::gil_scoped_release release;
-            study = studies::run_labtest_args(command, args, quiet);
+            study = studies::run_labtest_args(command, args, quiet, on_frame);
         }
+        if (failure) throw std::move(*failure);
         py::list curves;
         for (const auto& r : study.results) {
             const auto n = py::ssize_t(r.curve.size());
@@ -403,7 +439,7 @@ PYBIND11_MODULE(_bbm, mod) {
             curves.append(c);
         }
         return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), curves);
-    });
+    }, py::arg("command"), py::arg("args"), py::arg("quiet"), py::arg("callback") = py::none());
     mod.def("_calibrate", [](const std::vector<std::string>& args, bool quiet) {
         std::string json;
         {

@@ -472,8 +472,11 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                     write_labtest_files(res, s, dir, title, frames);
                 })
                       : Finish(),
-                write ? Frame([&](const Solver& s, const StressStrainPoint&) { write_labtest_frame(s, dir, frames); })
-                      : Frame());
+                write || c.on_frame ? Frame([&](const Solver& s, const StressStrainPoint& p) {
+                    if (write) write_labtest_frame(s, dir, frames);
+                    if (c.on_frame) c.on_frame(s, p, k);
+                })
+                                    : Frame());
             if (!quiet) {
                 std::lock_guard lock(print);
                 std::fprintf(stderr, "\r  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
@@ -714,7 +717,8 @@ void parse_options(CLI::App& app, const std::string& command, const std::vector<
 
 } // namespace
 
-LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet) {
+LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,
+                              const std::function<void(const Solver&, const StressStrainPoint&, int)>& on_frame) {
     const auto kind = labtest_kind(command);
     LabTestCli values = labtest_defaults(kind);
     values.write_files = false;
@@ -727,6 +731,7 @@ LabTestStudy run_labtest_args(const std::string& command, const std::vector<std:
             ->check(cli::non_negative());
     parse_options(app, command, args);
     values.write_files = app.count("--out") > 0;
+    values.on_frame = on_frame;
     LabTestStudy study;
     run_labtest_command(values, kind, quiet_flag, false, &study);
     return study;

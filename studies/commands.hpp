@@ -16,6 +16,7 @@
 #include "studies/labtest.hpp"
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct LabTestCli {
     std::string out = "out";
     /// false: nothing is written (the Python module without `out`).
     bool write_files = true;
+    /// Called with the state every --frame-every steps of loading (and the last
+    /// recorded point), from the thread running that realization (0, 1, ...).
+    std::function<void(const Solver&, const StressStrainPoint&, int realization)> on_frame;
 };
 
 /// The lab-test command names: "ucs", "tension", "biaxial", "brazilian".
@@ -63,7 +67,9 @@ int run_labtest_command(LabTestCli& values, LabTestOptions::Kind kind, bool quie
 
 /// The same from option strings as the program takes them after the command name
 /// ({"--width", "2", "--seed", "3"}). Throws InputError naming the flag.
-LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet);
+/// `on_frame`: as LabTestCli::on_frame (with --frame-every).
+LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,
+                              const std::function<void(const Solver&, const StressStrainPoint&, int)>& on_frame = {});
 
 /// `bbm calibrate`'s values.
 struct CalibrateCli {

@@ -1,6 +1,7 @@
 #include "studies/model.hpp"
 
 #include "base/error.hpp"
+#include "io/binary_stream.hpp"
 #include "io/vtk_output.hpp"
 #include "meshing/blocks.hpp"
 #include "studies/opening.hpp"
@@ -17,6 +18,10 @@
 namespace bbm::studies {
 
 namespace fs = std::filesystem;
+using io::get;
+using io::get_string;
+using io::put;
+using io::put_string;
 
 namespace {
 
@@ -147,29 +152,6 @@ namespace {
 
 const char* const checkpoint_magic = "bbm-model-checkpoint-1";
 
-template <class T>
-void put(std::ostream& o, const T& v) {
-    o.write(reinterpret_cast<const char*>(&v), sizeof v);
-}
-void put_string(std::ostream& o, const std::string& s) {
-    put(o, std::uint64_t(s.size()));
-    o.write(s.data(), std::streamsize(s.size()));
-}
-template <class T>
-T get(std::istream& i) {
-    T v{};
-    i.read(reinterpret_cast<char*>(&v), sizeof v);
-    if (!i) throw std::runtime_error("checkpoint is truncated");
-    return v;
-}
-std::string get_string(std::istream& i, std::uint64_t limit) {
-    const auto n = get<std::uint64_t>(i);
-    if (n > limit) throw std::runtime_error("checkpoint is corrupt");
-    std::string s(n, '\0');
-    i.read(s.data(), std::streamsize(n));
-    if (!i) throw std::runtime_error("checkpoint is truncated");
-    return s;
-}
 
 /// Passes steps to a Progress callback; stops when it says so.
 class CallbackObserver : public StageObserver {

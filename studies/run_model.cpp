@@ -2,6 +2,7 @@
 
 #include "io/model_input.hpp"
 #include "io/picture.hpp"
+#include "io/binary_stream.hpp"
 #include "io/vtk_output.hpp"
 #include "core/stages.hpp"
 #include "studies/model.hpp"
@@ -32,30 +33,6 @@ namespace {
 
 std::atomic<bool> interrupted{false};
 
-// --- binary helpers for the checkpoint's run part ------------------------------
-template <class T>
-void put(std::ostream& o, const T& v) {
-    o.write(reinterpret_cast<const char*>(&v), sizeof v);
-}
-void put_string(std::ostream& o, const std::string& s) {
-    put(o, std::uint64_t(s.size()));
-    o.write(s.data(), std::streamsize(s.size()));
-}
-template <class T>
-T get(std::istream& i) {
-    T v{};
-    i.read(reinterpret_cast<char*>(&v), sizeof v);
-    if (!i) throw std::runtime_error("checkpoint is truncated");
-    return v;
-}
-std::string get_string(std::istream& i) {
-    const auto n = get<std::uint64_t>(i);
-    if (n > (1u << 20)) throw std::runtime_error("checkpoint is corrupt");
-    std::string s(n, '\0');
-    i.read(s.data(), std::streamsize(n));
-    if (!i) throw std::runtime_error("checkpoint is truncated");
-    return s;
-}
 const char* checkpoint_magic = "bbm-run-checkpoint-1";
 
 /// Writes the ParaView series, the history, progress and checkpoints of a run.

@@ -138,8 +138,10 @@ def _option_args(options):
     return args
 
 
-def _run_labtest(command, quiet, options):
-    summary, curves = _labtest(command, _option_args(options), quiet)
+def _run_labtest(command, quiet, callback, options):
+    if callback is not None:
+        options.setdefault("frame_every", 1000)
+    summary, curves = _labtest(command, _option_args(options), quiet, callback)
     if len(curves) == 1:
         summary["curve"] = curves[0]
     else:
@@ -148,28 +150,35 @@ def _run_labtest(command, quiet, options):
     return summary
 
 
-def ucs(quiet=True, **options):
+def ucs(quiet=True, callback=None, **options):
     """Uniaxial compression test; keyword arguments are ``bbm ucs``'s options
     (``size=0.3, pattern="trigon", realizations=3, out="dir"``...; see
     ``bbm ucs --help``). Files are written only with ``out``. Returns the dict of
     summary.json with the stress-strain curve as numpy arrays (``curve``; with
-    realizations, in each ``per_realization`` entry)."""
-    return _run_labtest("ucs", quiet, options)
+    realizations, in each ``per_realization`` entry).
+
+    ``callback(frame)`` is called every ``frame_every`` steps of loading (1000
+    unless given) with a copy of the specimen's state: ``step``,
+    ``axial_strain``, ``axial_stress``, ``realization``, ``blocks`` (centroid,
+    displacement, rotation, area, stress, ...) and ``contacts`` (normal_stress,
+    shear_stress, normal_displacement, bonded, state, property, block_pair,
+    position, edge_parameter, ...) as numpy arrays, and ``property_names``."""
+    return _run_labtest("ucs", quiet, callback, options)
 
 
-def tension(quiet=True, **options):
+def tension(quiet=True, callback=None, **options):
     """Direct tension test; options as ``bbm tension`` (see ucs())."""
-    return _run_labtest("tension", quiet, options)
+    return _run_labtest("tension", quiet, callback, options)
 
 
-def biaxial(quiet=True, **options):
+def biaxial(quiet=True, callback=None, **options):
     """Biaxial compression at ``confinement`` (Pa); options as ``bbm biaxial`` (see ucs())."""
-    return _run_labtest("biaxial", quiet, options)
+    return _run_labtest("biaxial", quiet, callback, options)
 
 
-def brazilian(quiet=True, **options):
+def brazilian(quiet=True, callback=None, **options):
     """Brazilian test of a disc of diameter ``width``; options as ``bbm brazilian`` (see ucs())."""
-    return _run_labtest("brazilian", quiet, options)
+    return _run_labtest("brazilian", quiet, callback, options)
 
 
 def calibrate(quiet=True, **options):
