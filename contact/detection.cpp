@@ -204,10 +204,22 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
         const int vp = prev_vertex(b.first, A, int(v)), vn = next_vertex(b.first, A, int(v));
         const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
         const double l = 0.5 * (std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? norm(ep) : norm(en));
-        const Vec2 n{tb.y, -tb.x};
+        Vec2 n{tb.y, -tb.x};
         const double s_on = dot(x - b.vertex[best], tb) * b.inv_edge_length[best];
         const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
-        const double un = frame(x, b.vertex[best], b.vertex[e1]).gap - dot(vr, n) * in.dt;
+        double gap = frame(x, b.vertex[best], b.vertex[e1]).gap;
+        if (s_on < 0.0 || s_on > 1.0) {
+            // Past the end of the edge the contact's surface is the rounded corner
+            // (contact_kinematics), not the edge's line: a vertex beside the corner
+            // but inside that line is not in overlap. Measured against the line it
+            // would start compressed by up to the tolerance — at kn, hundreds of MPa
+            // on a fresh vertex-vertex contact (docs/calibration.md, After the peak).
+            const Vec2 centre = (s_on < 0.0 ? b.vertex[best] : b.vertex[e1]) - in.corner_radius * n;
+            const Vec2 r = x - centre;
+            const double rl = norm(r);
+            if (rl > 0.0) gap = rl - in.corner_radius, n = r / rl;
+        }
+        const double un = gap - dot(vr, n) * in.dt;
         candidates_.push_back({block_pair_key(A, B), A, int(v), B, best, e1, l, un});
     }
 }

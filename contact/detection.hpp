@@ -69,6 +69,10 @@ struct DetectionInput {
     /// pressed into a meshed region it touched only at that point. Once they have
     /// moved apart by more than the tolerance, contacts form as between any blocks.
     const std::vector<Junction>* junctions = nullptr;
+    /// Radius of the rounded corners unbonded contacts see past the end of an edge
+    /// (contact_kinematics): a vertex beside a corner starts with its gap to the
+    /// rounded corner, the surface its later increments are measured against.
+    double corner_radius = 0.0;
 };
 
 /// Key of an unordered block pair.

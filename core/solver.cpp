@@ -703,7 +703,7 @@ void Solver::detect_if_due() {
 
 void Solver::detection_pass() {
     contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
-                               new_contact_property_, dt_, &junctions_};
+                               new_contact_property_, dt_, &junctions_, corner_radius_};
     const auto r = detector_.update(c_, in);
     for (int i = 0; i < b_.count(); ++i) {
         if (!active_[i]) continue;

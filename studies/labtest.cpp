@@ -295,6 +295,24 @@ double fit_slope(const std::vector<double>& x, const std::vector<double>& y) {
     return sxx > 0 ? sxy / sxx : 0.0;
 }
 
+namespace {
+
+/// The share of the compression the contacts carry (Σ σn L over contacts in
+/// compression) that unbonded contacts carry: broken joints and contacts formed
+/// during the run.
+double unbonded_compression_share(const Solver& s) {
+    const auto& c = s.contacts();
+    double all = 0.0, unbonded = 0.0;
+    for (int i = 0; i < c.size(); ++i) {
+        const double f = std::max(0.0, c.history[i].sn) * c.length[i];
+        all += f;
+        if (!c.history[i].bonded) unbonded += f;
+    }
+    return all > 0.0 ? unbonded / all : 0.0;
+}
+
+} // namespace
+
 LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(const StressStrainPoint&)>& progress,
                           const std::function<void(const Solver&, const LabTestResult&)>& on_finish,
                           const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame) {
@@ -434,6 +452,9 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     platen.set_speed(rate * h);
     double ratio_max = 0.0;
     std::size_t stall_from = 0; ///< first record within 2e-4 of strain of the last
+    // Locking: the stress above the peak after failure for this many records in a row.
+    constexpr int lock_records = 10;
+    int records_above_peak = 0;
     while (s.steps() - start < o.max_steps) {
         s.step();
         strain += rate;
@@ -462,13 +483,29 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
         // After a failure drop the peak is the strength: rigid fragments cannot
         // break further, and a rubble core jammed between the platens can re-stiffen
-        // like dry masonry (trigon: new corner contacts carry most of the load).
+        // like dry masonry. A jam stays above the peak; a burst of cracks throws a
+        // dynamic transient (unbalanced ratio far above 1) that passes within a
+        // few records, and is no locking (docs/calibration.md, After the peak).
         if (failed && p.axial_stress > peak) {
-            r.post_peak_locking = true;
-            r.peak_passed = true;
-            break;
+            if (++records_above_peak >= lock_records) {
+                // Who carries the load now? Bonds still intact: the "failure" was a
+                // local burst of cracks in a specimen that had not failed (small
+                // specimens, a few blocks across), and loading goes on. Broken and
+                // new contacts: fragments jammed between the platens. Not under
+                // confinement: there the stall is the strength (a confined rock
+                // yields along shear bands with most bonds intact around them).
+                if (o.confinement <= 0.0 && unbonded_compression_share(s) < 0.5) {
+                    failed = false, records_above_peak = 0;
+                } else {
+                    r.post_peak_locking = true;
+                    r.peak_passed = true;
+                    break;
+                }
+            }
+        } else {
+            records_above_peak = 0;
         }
-        if (p.axial_stress > peak) {
+        if (!failed && p.axial_stress > peak) {
             peak = p.axial_stress, peak_step = p.step, strain_at_peak = p.axial_strain;
             r.cracks_near_vertical_at_peak = r.cracks_near_vertical;
             r.cracks_near_horizontal_at_peak = r.cracks_near_horizontal;

@@ -25,9 +25,13 @@
 //   ν  = −(least-squares slope of lateral against axial strain) over the same points
 // Brazilian: indirect tensile strength σt = 2P / (π D), P the peak line load.
 // The run stops when the stress has dropped below `stop_fraction` of the peak
-// after it, when it climbs back above the peak after failure (a drop by
-// `failure_drop`, or a stall of the stress over 2e-4 of strain: fragments locked
-// between the platens), or at `max_strain`.
+// after it, at `max_strain`, or when after failure (a drop by `failure_drop`, or
+// a stall of the stress over 2e-4 of strain) it stays above the peak for 10
+// records with broken and new contacts carrying at least half of the contact
+// compression: fragments locked between the platens (post_peak_locking). Above
+// the peak with the bonds carrying the load, the "failure" was a local burst of
+// cracks, and loading goes on (unconfined tests; docs/calibration.md, After the
+// peak); under confinement the stall is the strength.
 #pragma once
 
 #include "core/model_spec.hpp"

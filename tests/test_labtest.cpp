@@ -1,6 +1,7 @@
 // Numerical lab tests (studies/labtest.hpp) on the paper's 8 m × 16 m specimen of
 // Voronoi blocks with its joint properties (SPEC §8). The runs of minutes (trigon,
 // calibration) are in test_long.cpp.
+#include "core/solver.hpp"
 #include "studies/calibrate.hpp"
 #include "studies/labtest.hpp"
 
@@ -121,4 +122,66 @@ TEST_CASE("biaxial, paper specimen at 5 MPa: confinement applied without crackin
     // above the joints' 25° (interlocking of the cells) and below 50°.
     CHECK(phi > 25.0);
     CHECK(phi < 50.0);
+}
+
+namespace {
+
+/// A UCS run, and the stress at its end as a fraction of the peak.
+struct PostPeak {
+    LabTestResult r;
+    double end_fraction = 0, end_strain = 0;
+};
+PostPeak post_peak_run(LabTestOptions o) {
+    o.threads = 2;
+    PostPeak p{run_labtest(o)};
+    REQUIRE(!p.r.curve.empty());
+    p.end_fraction = p.r.curve.back().axial_stress / p.r.peak_stress;
+    p.end_strain = p.r.curve.back().axial_strain;
+    return p;
+}
+
+#define POST_PEAK_INFO(p)                                                                                          \
+    INFO("peak " << p.r.peak_stress / 1e6 << " MPa at strain " << p.r.strain_at_peak << ", end at "               \
+                 << p.end_fraction << " of it, strain " << p.end_strain << ", locking " << p.r.post_peak_locking \
+                 << ", cracks " << p.r.cracks_tensile << " T " << p.r.cracks_shear << " S")
+
+} // namespace
+
+TEST_CASE("post-peak, mechanism 1: local crack bursts of a small rigid specimen are not failure (2 x 4 m, seed 1)") {
+    // Before (issue 12): a stall after a burst of cracks was taken for failure,
+    // the intact skeleton (97% of the contact compression in intact bonds) loaded
+    // on above 30.10 MPa and the run stopped as "locking" at strain 1.83e-3. Now
+    // the load carriers are asked: bonds still carry it, loading goes on, and the
+    // specimen fails for real. Checked: without asking, it still locks.
+    auto o = LabTestOptions::paper_ucs();
+    o.width = 2.0, o.height = 4.0, o.seed = 1;
+    const auto p = post_peak_run(o);
+    POST_PEAK_INFO(p);
+    CHECK_FALSE(p.r.post_peak_locking);
+    CHECK(p.r.peak_passed);
+    CHECK(p.end_fraction <= 0.5);
+    CHECK(p.end_strain < 0.01);
+}
+
+TEST_CASE("post-peak, mechanisms 2 and 3: area-sized trigon 3 x 6 m (seed 3) softens without locking") {
+    // Before: contacts formed past the end of an edge started with the gap to the
+    // edge's line, not to the rounded corner the law then measures against: a
+    // vertex beside a corner, outside the block, was born compressed (up to 379
+    // MPa), and new corner contacts came to carry 16% of the compression, wedging
+    // the side fragments; and a single record of a crack burst's dynamic transient
+    // (14.2 -> 18.1 MPa, unbalanced ratio 22) above the peak stopped the run as
+    // "locking". Now new corner contacts start at their corner gap, and locking
+    // must hold for 10 records with the load on broken or new contacts. Checked:
+    // without the corner gap (the lock rules as now) this specimen still locks;
+    // with it but one record enough, it stops on the transient.
+    auto o = LabTestOptions::paper_ucs();
+    o.pattern = meshing::PatternSpec::Kind::trigon;
+    o.joint.kn = 162e9, o.joint.ks = 68e9;
+    o.size_measure = meshing::PatternSpec::SizeMeasure::area;
+    o.width = 3.0, o.height = 6.0, o.seed = 3;
+    const auto p = post_peak_run(o);
+    POST_PEAK_INFO(p);
+    CHECK_FALSE(p.r.post_peak_locking);
+    CHECK(p.end_fraction <= 0.5);
+    CHECK(p.end_strain < 0.01);
 }
