@@ -5,13 +5,11 @@
 #include "core/solver.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
 #include <cmath>
 #include <numbers>
-#include <thread>
 
 namespace bbm {
 

@@ -14,7 +14,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -132,6 +131,8 @@ int run_mesh(const MeshCommand& command, bool quiet, bool check_only) {
 
 
 
+namespace {
+
 const char* labtest_name(LabTestOptions::Kind kind) {
     switch (kind) {
     case LabTestOptions::Kind::ucs: return "ucs";
@@ -141,6 +142,8 @@ const char* labtest_name(LabTestOptions::Kind kind) {
     }
     return "ucs";
 }
+
+} // namespace
 
 LabTestOptions::Kind labtest_kind(const std::string& command) {
     for (auto k : {LabTestOptions::Kind::ucs, LabTestOptions::Kind::tension, LabTestOptions::Kind::biaxial,

@@ -32,14 +32,12 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
     return buf;
 }
 
-/// NaN, runaway motion (more than the detection tolerance in one step: contacts
-/// can no longer follow) and overlaps beyond the tolerance (a contact pushed
-/// through). Cheap checks every 100 steps, the overlap scan every 1000.
 } // namespace
 
 void check_run_health(const Solver& s) {
     const double tol = s.detection_tolerance(), dt = s.timestep();
-    const std::string advice =
+    // No allocation unless a check fails: it runs inside the loop.
+    constexpr const char* advice =
         " Reduce solver.safety (the automatic time step is safety x the critical step) or a solver.timestep "
         "given explicitly, or, for a load applied by velocity, the velocity; check that stiffness and strength "
         "values are in SI units (Pa/m, Pa).";
@@ -231,14 +229,16 @@ void Model::run_until(int last_stage, const Progress& progress) {
     const auto t0 = std::chrono::steady_clock::now();
     auto done = run_stages(*solver_, stages, observer, cursor_);
     run_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    // A stage cut short by the callback stays open; the cursor says where.
-    for (auto& r : done) {
-        if (!reports_.empty() && reports_.back().name == r.name && cursor_.started &&
-            &r == &done.front()) {
-            reports_.back().steps = r.steps, reports_.back().ratio = r.ratio, reports_.back().converged = r.converged;
-            reports_.back().seconds += r.seconds;
+    // A stage cut short by the callback stays open (the cursor says where): its
+    // report is completed by the run that continues it.
+    const bool continued = cursor_.started && !reports_.empty();
+    for (std::size_t k = 0; k < done.size(); ++k) {
+        if (k == 0 && continued) {
+            const double seconds = reports_.back().seconds;
+            reports_.back() = done[0];
+            reports_.back().seconds += seconds;
         } else {
-            reports_.push_back(r);
+            reports_.push_back(done[k]);
         }
     }
     const bool stopped = observer.stop_requested();

@@ -122,13 +122,6 @@ bool Ranks::available() {
 #endif
 }
 
-void Ranks::abort(int status) {
-#ifdef BBM_MPI
-    if (started) MPI_Abort(MPI_COMM_WORLD, status);
-#endif
-    std::exit(status);
-}
-
 std::vector<std::string> run_spread(int n, int threads, const std::function<std::string(int)>& run,
                                     std::vector<std::string>* errors) {
     std::vector<int> mine;

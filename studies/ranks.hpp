@@ -30,9 +30,6 @@ public:
     static bool root() { return rank() == 0; }
     /// Whether this build can use MPI.
     static bool available();
-    /// Aborts every rank with `status` (a rank that failed alone would leave the
-    /// others waiting in a collective).
-    [[noreturn]] static void abort(int status);
 };
 
 /// Runs run(k) for k = 0..n-1 spread over ranks and, within a rank, over
