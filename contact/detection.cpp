@@ -203,9 +203,20 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
         // The vertex's share: half of its adjacent edge that lies most along B's edge.
         const int vp = prev_vertex(b.first, A, int(v)), vn = next_vertex(b.first, A, int(v));
         const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
-        const double l = 0.5 * (std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? norm(ep) : norm(en));
+        const Vec2 along = std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? ep : en;
         Vec2 n{tb.y, -tb.x};
         const double s_on = dot(x - b.vertex[best], tb) * b.inv_edge_length[best];
+        double l = 0.5 * norm(along);
+        if (in.overlap_length) {
+            // The part of B's edge that the vertex's edge covers, shared with the
+            // contact at its other end; a corner touching a corner gets the arc of
+            // its rounding.
+            const double s_far = s_on + dot(along, tb) * b.inv_edge_length[best];
+            const double overlap =
+                std::max(0.0, std::min(std::max(s_on, s_far), 1.0) - std::max(std::min(s_on, s_far), 0.0)) /
+                b.inv_edge_length[best];
+            l = 0.5 * std::max(overlap, in.corner_radius);
+        }
         const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
         double gap = frame(x, b.vertex[best], b.vertex[e1]).gap;
         if (s_on < 0.0 || s_on > 1.0) {

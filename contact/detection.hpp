@@ -73,6 +73,10 @@ struct DetectionInput {
     /// (contact_kinematics): a vertex beside a corner starts with its gap to the
     /// rounded corner, the surface its later increments are measured against.
     double corner_radius = 0.0;
+    /// A new contact's length: false, half of the vertex's adjacent edge that lies
+    /// most along B's edge; true, half of that edge's overlap with B's edge (at
+    /// least corner_radius) — a face shared by its two end contacts, as UDEC does.
+    bool overlap_length = false;
 };
 
 /// Key of an unordered block pair.

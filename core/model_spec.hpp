@@ -79,6 +79,15 @@ struct SolverSpec {
     /// Contact detection tolerance (m) for new contacts; 0 = 0.02 × mean block size.
     double detection_tolerance = 0.0;
     std::string new_contact_property; ///< property set of contacts formed during the run
+    /// Radius (m) of the rounded corners unbonded contacts see past an edge's end;
+    /// 0 = 0.05 × the mean joint length.
+    double corner_radius = 0.0;
+    /// Length given to a contact formed during the run: `edge`, half of the vertex's
+    /// adjacent edge that lies most along the other block's edge; `overlap`, half of
+    /// that edge's overlap with the other block's edge (at least the corner radius),
+    /// as UDEC shares a face between its two end contacts.
+    enum class NewContactLength { edge, overlap };
+    NewContactLength new_contact_length = NewContactLength::edge;
     int output_every = 0;             ///< steps between VTK outputs; 0 = at stage ends only
     int history_every = 10;           ///< steps between history rows
     int threads = 1;                  ///< threads of the contact loop (from the command line)

@@ -206,7 +206,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     }
     if (!a.joints.empty()) mean_edge /= double(a.joints.size());
     c_.sort_by_blocks();
-    corner_radius_ = 0.05 * mean_edge;
+    corner_radius_ = settings_.corner_radius > 0.0 ? settings_.corner_radius : 0.05 * mean_edge;
 
     // Contacts formed during the run: the named set, or a built-in frictional one
     // (φ 30°, no bond) as stiff as the stiffest set of the model.
@@ -703,7 +703,8 @@ void Solver::detect_if_due() {
 
 void Solver::detection_pass() {
     contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
-                               new_contact_property_, dt_, &junctions_, corner_radius_};
+                               new_contact_property_, dt_, &junctions_, corner_radius_,
+                               settings_.new_contact_length == SolverSpec::NewContactLength::overlap};
     const auto r = detector_.update(c_, in);
     for (int i = 0; i < b_.count(); ++i) {
         if (!active_[i]) continue;

@@ -812,6 +812,7 @@ constexpr std::string_view pascals_per_metre = " Pa/m";
 
 // In the order of the enums of core/model_spec.hpp and meshing::JointTag.
 constexpr std::array<std::string_view, 2> solver_modes{"quasi_static", "dynamic"};
+constexpr std::array<std::string_view, 2> contact_lengths{"edge", "overlap"};
 constexpr std::array<std::string_view, 3> laws{"elastic", "coulomb", "softening"};
 constexpr std::array<std::string_view, 5> joint_tags{"inner", "radial", "peripheral", "real_joint",
                                                      "interface"};
@@ -829,13 +830,15 @@ constexpr std::array<std::string_view, 5> stage_types{"initialize", "solve", "ex
 SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
                        const Names& properties) {
     const toml::table& t = to_table(c, node, p, "a [solver] table");
-    static constexpr std::array<std::string_view, 9> keys{"mode",
+    static constexpr std::array<std::string_view, 11> keys{"mode",
                                                           "damping",
                                                           "safety",
                                                           "timestep",
                                                           "gravity",
                                                           "detection_tolerance",
+                                                          "corner_radius",
                                                           "new_contact_property",
+                                                          "new_contact_length",
                                                           "output_every",
                                                           "history_every"};
     check_keys(c, t, p, keys);
@@ -850,6 +853,10 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
     s.gravity = point(c, t, p, "gravity").value_or(s.gravity);
     s.detection_tolerance =
         number(c, t, p, "detection_tolerance", at_least(0, metres)).value_or(0.0);
+    s.corner_radius = number(c, t, p, "corner_radius", at_least(0, metres)).value_or(0.0);
+    if (t.contains("new_contact_length"))
+        s.new_contact_length = static_cast<SolverSpec::NewContactLength>(
+            choice(c, t, p, "new_contact_length", contact_lengths, "new contact length"));
     if (const toml::node* n = find(c, t, p, "new_contact_property")) {
         const Path np = p.key("new_contact_property");
         s.new_contact_property = to_str(c, *n, np);

@@ -533,7 +533,9 @@ safety = 0.2
 timestep = 1e-5
 gravity = [0.0, -9.81]
 detection_tolerance = 0.01
+corner_radius = 0.002
 new_contact_property = "unbonded"
+new_contact_length = "overlap"
 output_every = 1000
 history_every = 20
 
@@ -677,6 +679,8 @@ TEST_CASE("a complete analysis reads into the analysis description") {
     CHECK(an.solver.gravity == Vec2{0.0, -9.81});
     CHECK(an.solver.detection_tolerance == 0.01);
     CHECK(an.solver.new_contact_property == "unbonded");
+    CHECK(an.solver.corner_radius == 0.002);
+    CHECK(an.solver.new_contact_length == SolverSpec::NewContactLength::overlap);
     CHECK(an.solver.output_every == 1000);
     CHECK(an.solver.history_every == 20);
 
@@ -823,6 +827,10 @@ TEST_CASE("solver and material mistakes") {
                 "must be in (0, 1], got 0");
     check_error(with("[solver]\nmode = \"static\"\n"), "mode", "solver.mode",
                 "unknown solver mode 'static'; expected one of: quasi_static, dynamic");
+    check_error(with("[solver]\nnew_contact_length = \"half\"\n"), "new_contact_length",
+                "solver.new_contact_length", "unknown new contact length 'half'; expected one of: edge, overlap");
+    check_error(with("[solver]\ncorner_radius = -1\n"), "corner_radius", "solver.corner_radius",
+                "must be >= 0 m, got -1");
     check_error(with("[solver]\nhistory_every = 0\n"), "history_every", "solver.history_every",
                 "must be an integer >= 1, got 0");
     check_error(with("[solver]\ngravity = -9.81\n"), "gravity", "solver.gravity",

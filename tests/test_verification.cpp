@@ -215,6 +215,68 @@ TEST_CASE("verification 6: a block dropped on a bonded base forms contacts and c
     CHECK(fy == doctest::Approx(2700.0 * 9.81).epsilon(1e-6));
 }
 
+TEST_CASE("new contact lengths: half the edge, or the faces' overlap shared by its two end contacts") {
+    // A 1 m square set 5 mm (within the tolerance) above a 2 m wide block,
+    // overhanging its right edge by 0.2 m: the faces overlap over 0.8 m. Contacts:
+    // the square's left corner on the base's top face, the base's right corner on
+    // the square's bottom face.
+    const std::string text = R"(
+[solver]
+mode = "dynamic"
+damping = 0.3
+gravity = [0.0, -9.81]
+new_contact_property = "slide"
+detection_tolerance = 0.01
+NEW_CONTACT_LENGTH
+[[material]]
+name = "rock"
+density = 2700.0
+[[region]]
+name = "base"
+outline = { type = "rectangle", min = [0.0, 0.0], max = [2.0, 1.0] }
+pattern = { type = "single" }
+[[region]]
+name = "block"
+outline = { type = "rectangle", min = [1.2, 1.005], max = [2.2, 2.005] }
+pattern = { type = "single" }
+[[joint_property]]
+name = "slide"
+law = "coulomb"
+kn = 10.0e9
+ks = 4.0e9
+friction = 30.0
+[[boundary]]
+name = "bottom"
+type = "velocity"
+box = { min = [-1.0, -1.0], max = [3.0, 0.6] }
+vx = 0.0
+vy = 0.0
+omega = 0.0
+[[stage]]
+name = "drop"
+type = "cycle"
+steps = 6000
+)";
+    auto lengths = [&](const std::string& rule) {
+        std::string t = text;
+        t.replace(t.find("NEW_CONTACT_LENGTH"), 18, rule);
+        const auto file = io::parse_model(t, "drop.toml");
+        const auto blocks = meshing::generate_blocks(file.geometry);
+        Solver s(blocks, file.analysis);
+        Silent quiet;
+        run_stages(s, file.analysis.stages, quiet);
+        const auto& c = s.contacts();
+        double total = 0.0;
+        int n = 0;
+        for (int i = 0; i < c.size(); ++i) total += c.length[i], ++n;
+        CHECK(n == 2);
+        CHECK(s.kinetic_energy() < 1e-6); // at rest on the base, not tipped
+        return total;
+    };
+    CHECK(lengths("") == doctest::Approx(0.5 * 1.0 + 0.5 * 2.0).epsilon(1e-9));
+    CHECK(lengths("new_contact_length = \"overlap\"") == doctest::Approx(0.8).epsilon(1e-3));
+}
+
 TEST_CASE("verification 8: determinism — the state hash after a cracking run is pinned") {
     auto m = load("determinism.toml");
     Solver a(m.blocks, m.file.analysis), b(m.blocks, m.file.analysis);
