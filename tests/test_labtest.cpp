@@ -86,7 +86,24 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
     auto o = LabTestOptions::paper_ucs();
     o.pattern = meshing::PatternSpec::Kind::hexagonal;
     o.threads = 2;
-    const auto r = run_labtest(o);
+    o.frame_every = 1500;
+    // Statics after the axial joints split (docs/calibration.md, "The hexagonal
+    // lattice"): mean normal stress on the axial joints (normal horizontal) and on
+    // the inclined ones (normal 30° from the load) over the applied stress.
+    struct Frame { double stress, axial, inclined; };
+    std::vector<Frame> frames;
+    const auto on_frame = [&](const Solver& s, const StressStrainPoint& p) {
+        const auto& c = s.contacts();
+        double axial = 0, inclined = 0;
+        int na = 0, ni = 0;
+        for (int i = 0; i < c.size(); ++i) {
+            const double from_load = std::atan2(std::abs(c.normal[i].x), std::abs(c.normal[i].y)) * 180 / std::numbers::pi;
+            if (from_load > 85) axial += c.history[i].sn, ++na;
+            else if (std::abs(from_load - 30) < 5) inclined += c.history[i].sn, ++ni;
+        }
+        if (na > 0 && ni > 0 && p.axial_stress > 0) frames.push_back({p.axial_stress, axial / na / p.axial_stress, inclined / ni / p.axial_stress});
+    };
+    const auto r = run_labtest(o, {}, {}, on_frame);
     const double kn = o.joint.kn, ks = o.joint.ks, a = o.size;
     const double E = 2 * a * kn * (kn + ks) / (3 * kn + ks), nu = (kn - ks) / (3 * kn + ks);
     INFO("E " << r.E / 1e9 << " GPa (closed form " << E / 1e9 << "), nu " << r.nu << " (" << nu << "), E50 "
@@ -97,6 +114,27 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
     CHECK(r.linear_limit_stress > 0);
     CHECK(r.linear_limit_stress <= r.crack_initiation_stress);
     CHECK(r.crack_initiation_stress < r.peak_stress);
+    // Before cracking the inclined faces wedge the axial joints into tension; once
+    // those have split, each hexagon stands on two ±30° faces: σ1·√3a = 2a(σn cos30°
+    // + τ sin30°) with τ = σn tan30° gives σn = 0.75 σ1 there, and the lattice carries
+    // load far past σci. Then it fails (a shear band from the platen corners) and
+    // softens instead of locking.
+    int before = 0, after = 0;
+    for (const auto& f : frames) {
+        INFO("sigma1 " << f.stress / 1e6 << " MPa: axial joints " << f.axial << " sigma1, inclined " << f.inclined);
+        if (f.stress < r.crack_initiation_stress) {
+            ++before;
+            CHECK(f.axial < -0.1);
+        } else if (f.stress > 2.0 * r.crack_initiation_stress && f.stress < 0.95 * r.peak_stress) {
+            ++after;
+            CHECK(std::abs(f.axial) < 0.02);
+            CHECK(f.inclined == doctest::Approx(0.75).epsilon(0.04));
+        }
+    }
+    CHECK(before >= 1);
+    CHECK(after >= 3);
+    CHECK(r.peak_stress > 2.5 * r.crack_initiation_stress);
+    CHECK_FALSE(r.post_peak_locking);
 }
 
 TEST_CASE("biaxial, paper specimen at 5 MPa: confinement applied without cracking, strength envelope of a frictional rock") {
