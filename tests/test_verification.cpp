@@ -277,6 +277,72 @@ steps = 6000
     CHECK(lengths("new_contact_length = \"overlap\"") == doctest::Approx(0.8).epsilon(1e-3));
 }
 
+TEST_CASE("a vertex beside an acute corner, outside the block, is not born in overlap") {
+    // Block B is a sliver with an 11.4° tip at the origin. A's corner moves in at
+    // 0.3 mm a step (quasi-static, Δt = 1) and is detected about 2 mm beyond the
+    // tip, 1 mm below the line of B's upper edge: outside B, but inside the
+    // rounded-corner circle (r = 5 mm) tangent to that edge at the tip, which
+    // reaches past the block there. Measured against that circle the new contact
+    // was born about 0.3 mm in overlap, pushing with kn × 0.3 mm = 3 MPa on
+    // nothing; it must start open (issue 12, docs/calibration.md, "After the
+    // peak", fix 4).
+    const std::string text = R"(
+[solver]
+new_contact_property = "slide"
+detection_tolerance = 0.01
+corner_radius = 0.005
+[[material]]
+name = "rock"
+density = 2700.0
+[[region]]
+name = "a"
+outline = { type = "polygon", points = [[-0.0056, -0.001], [-0.5, 0.2], [-0.5, -0.3]] }
+pattern = { type = "single" }
+[[region]]
+name = "b"
+outline = { type = "polygon", points = [[0.0, 0.0], [1.0, -0.1], [1.0, 0.1]] }
+pattern = { type = "single" }
+[[joint_property]]
+name = "slide"
+law = "coulomb"
+kn = 10.0e9
+ks = 4.0e9
+friction = 30.0
+[[boundary]]
+name = "push"
+type = "velocity"
+box = { min = [-1.0, -1.0], max = [-0.1, 1.0] }
+vx = 0.0003
+vy = 0.0
+omega = 0.0
+[[boundary]]
+name = "hold"
+type = "velocity"
+box = { min = [0.3, -1.0], max = [2.0, 1.0] }
+vx = 0.0
+vy = 0.0
+omega = 0.0
+[[stage]]
+name = "approach"
+type = "cycle"
+steps = 13
+)";
+    const auto file = io::parse_model(text, "corner.toml");
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    Solver s(blocks, file.analysis);
+    Silent quiet;
+    run_stages(s, file.analysis.stages, quiet);
+    const auto& c = s.contacts();
+    REQUIRE(c.size() >= 1);
+    const Vec2 corner = s.blocks().vertex[c.vertex_id[0]];
+    INFO("corner at (" << corner.x << ", " << corner.y << "), un " << c.history[0].un << " m, sn " << c.history[0].sn
+                       << " Pa");
+    CHECK(c.vertex_block[0] == 0); // A's corner against B's edge
+    CHECK(corner.x < 0.0);         // still beside the tip, outside B
+    CHECK(c.history[0].un > 0.0);
+    CHECK(c.history[0].sn == 0.0);
+}
+
 TEST_CASE("verification 8: determinism — the state hash after a cracking run is pinned") {
     auto m = load("determinism.toml");
     Solver a(m.blocks, m.file.analysis), b(m.blocks, m.file.analysis);
