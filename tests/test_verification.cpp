@@ -280,11 +280,13 @@ steps = 6000
 TEST_CASE("a vertex beside an acute corner, outside the block, is not born in overlap") {
     // Block B is a sliver with an 11.4° tip at the origin. A's corner moves in at
     // 0.3 mm a step (quasi-static, Δt = 1) and is detected about 2 mm beyond the
-    // tip, 1 mm below the line of B's upper edge: outside B, but inside the
-    // rounded-corner circle (r = 5 mm) tangent to that edge at the tip, which
-    // reaches past the block there. Measured against that circle the new contact
-    // was born about 0.3 mm in overlap, pushing with kn × 0.3 mm = 3 MPa on
-    // nothing; it must start open (issue 12, docs/calibration.md, "After the
+    // tip, 1 mm below the line of B's upper edge — the nearest — and 1.2 mm
+    // outside the line of its lower one: outside B. Taken against the upper edge
+    // it was inside the rounded corner (r = 5 mm, a circle tangent to that edge
+    // at the tip, which reaches past so sharp a corner) and was born 0.3 mm in
+    // overlap, pushing with kn × 0.3 mm = 3 MPa on nothing, while its approach
+    // across the lower edge went unseen. It faces the lower edge: the contact is
+    // that edge's and starts open (issue 12, docs/calibration.md, "After the
     // peak", fix 4).
     const std::string text = R"(
 [solver]
@@ -339,7 +341,11 @@ steps = 13
                        << " Pa");
     CHECK(c.vertex_block[0] == 0); // A's corner against B's edge
     CHECK(corner.x < 0.0);         // still beside the tip, outside B
-    CHECK(c.history[0].un > 0.0);
+    // The lower edge, (0, 0) to (1, -0.1): its outward normal points down, and the
+    // gap is to its rounded corner at the tip, centre r inside: 6.48 mm - r.
+    CHECK(s.blocks().vertex[c.edge_id[0]].x == doctest::Approx(0.0));
+    CHECK(s.blocks().vertex[c.edge_end[0]].y == doctest::Approx(-0.1));
+    CHECK(c.history[0].un == doctest::Approx(1.476e-3).epsilon(0.01));
     CHECK(c.history[0].sn == 0.0);
 }
 
