@@ -10,6 +10,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 using namespace bbm;
@@ -32,6 +33,30 @@ double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
 
 
 struct Silent : StageObserver {};
+
+/// The rock and the frictional property of contacts formed during a run, shared by
+/// the two-block models written inline below.
+const std::string two_block_materials = R"(
+[[material]]
+name = "rock"
+density = 2700.0
+[[joint_property]]
+name = "slide"
+law = "coulomb"
+kn = 10.0e9
+ks = 4.0e9
+friction = 30.0
+)";
+
+/// Reads a model from text (with the materials above), builds it and runs its stages.
+std::unique_ptr<Solver> run_text(const std::string& text, const std::string& name) {
+    const auto file = io::parse_model(text + two_block_materials, name);
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    auto s = std::make_unique<Solver>(blocks, file.analysis);
+    Silent quiet;
+    run_stages(*s, file.analysis.stages, quiet);
+    return s;
+}
 
 } // namespace
 
@@ -228,9 +253,6 @@ gravity = [0.0, -9.81]
 new_contact_property = "slide"
 detection_tolerance = 0.01
 NEW_CONTACT_LENGTH
-[[material]]
-name = "rock"
-density = 2700.0
 [[region]]
 name = "base"
 outline = { type = "rectangle", min = [0.0, 0.0], max = [2.0, 1.0] }
@@ -239,12 +261,6 @@ pattern = { type = "single" }
 name = "block"
 outline = { type = "rectangle", min = [1.2, 1.005], max = [2.2, 2.005] }
 pattern = { type = "single" }
-[[joint_property]]
-name = "slide"
-law = "coulomb"
-kn = 10.0e9
-ks = 4.0e9
-friction = 30.0
 [[boundary]]
 name = "bottom"
 type = "velocity"
@@ -260,17 +276,13 @@ steps = 6000
     auto lengths = [&](const std::string& rule) {
         std::string t = text;
         t.replace(t.find("NEW_CONTACT_LENGTH"), 18, rule);
-        const auto file = io::parse_model(t, "drop.toml");
-        const auto blocks = meshing::generate_blocks(file.geometry);
-        Solver s(blocks, file.analysis);
-        Silent quiet;
-        run_stages(s, file.analysis.stages, quiet);
-        const auto& c = s.contacts();
+        const auto s = run_text(t, "drop.toml");
+        const auto& c = s->contacts();
         double total = 0.0;
         int n = 0;
         for (int i = 0; i < c.size(); ++i) total += c.length[i], ++n;
         CHECK(n == 2);
-        CHECK(s.kinetic_energy() < 1e-6); // at rest on the base, not tipped
+        CHECK(s->kinetic_energy() < 1e-6); // at rest on the base, not tipped
         return total;
     };
     CHECK(lengths("") == doctest::Approx(0.5 * 1.0 + 0.5 * 2.0).epsilon(1e-9));
@@ -293,9 +305,6 @@ TEST_CASE("a vertex beside an acute corner, outside the block, is not born in ov
 new_contact_property = "slide"
 detection_tolerance = 0.01
 corner_radius = 0.005
-[[material]]
-name = "rock"
-density = 2700.0
 [[region]]
 name = "a"
 outline = { type = "polygon", points = [[-0.0056, -0.001], [-0.5, 0.2], [-0.5, -0.3]] }
@@ -304,12 +313,6 @@ pattern = { type = "single" }
 name = "b"
 outline = { type = "polygon", points = [[0.0, 0.0], [1.0, -0.1], [1.0, 0.1]] }
 pattern = { type = "single" }
-[[joint_property]]
-name = "slide"
-law = "coulomb"
-kn = 10.0e9
-ks = 4.0e9
-friction = 30.0
 [[boundary]]
 name = "push"
 type = "velocity"
@@ -329,22 +332,18 @@ name = "approach"
 type = "cycle"
 steps = 13
 )";
-    const auto file = io::parse_model(text, "corner.toml");
-    const auto blocks = meshing::generate_blocks(file.geometry);
-    Solver s(blocks, file.analysis);
-    Silent quiet;
-    run_stages(s, file.analysis.stages, quiet);
-    const auto& c = s.contacts();
+    const auto s = run_text(text, "corner.toml");
+    const auto& c = s->contacts();
     REQUIRE(c.size() >= 1);
-    const Vec2 corner = s.blocks().vertex[c.vertex_id[0]];
+    const Vec2 corner = s->blocks().vertex[c.vertex_id[0]];
     INFO("corner at (" << corner.x << ", " << corner.y << "), un " << c.history[0].un << " m, sn " << c.history[0].sn
                        << " Pa");
     CHECK(c.vertex_block[0] == 0); // A's corner against B's edge
     CHECK(corner.x < 0.0);         // still beside the tip, outside B
     // The lower edge, (0, 0) to (1, -0.1): its outward normal points down, and the
     // gap is to its rounded corner at the tip, centre r inside: 6.48 mm - r.
-    CHECK(s.blocks().vertex[c.edge_id[0]].x == doctest::Approx(0.0));
-    CHECK(s.blocks().vertex[c.edge_end[0]].y == doctest::Approx(-0.1));
+    CHECK(s->blocks().vertex[c.edge_id[0]].x == doctest::Approx(0.0));
+    CHECK(s->blocks().vertex[c.edge_end[0]].y == doctest::Approx(-0.1));
     CHECK(c.history[0].un == doctest::Approx(1.476e-3).epsilon(0.01));
     CHECK(c.history[0].sn == 0.0);
 }
