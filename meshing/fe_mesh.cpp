@@ -235,6 +235,12 @@ TriangleMesh mesh_polygon(std::span<const Vec2> boundary, const SizeFunction& si
     TriangleMesh m;
     try {
         initialise_gmsh();
+        // gmsh applies its thread count as the calling thread's OpenMP setting, and
+        // each thread has its own: set once, it held for the first thread that meshed
+        // only, and a second thread (parallel realizations) meshed with a team of
+        // all cores inside gmsh, whose shared state is not thread-safe — the heap
+        // was corrupted (free(): unaligned chunk). Set here, under the lock, every call.
+        gmsh::option::setNumber("General.NumThreads", 1);
         gmsh::option::setNumber("General.Terminal", verbose ? 1 : 0);
         const GmshModel model;
         std::vector<int> lines(n);

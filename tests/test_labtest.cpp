@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <thread>
+#include <vector>
 
 using namespace bbm;
 
@@ -244,4 +246,33 @@ TEST_CASE("post-peak, mechanism 4: area-sized trigon 8 x 16 m (seed 2) softens w
     CHECK_FALSE(p.r.post_peak_locking);
     CHECK(p.end_fraction <= 0.5);
     CHECK(p.end_strain < 0.004);
+}
+
+TEST_CASE("deformable realizations in parallel threads mesh safely and give the serial answer") {
+    // gmsh's thread count is an OpenMP setting of the calling thread: set once, a
+    // second thread meshed with a team of all cores inside gmsh and corrupted the
+    // heap (`bbm ucs --deformable-fraction 0.95 --realizations 2 --threads 2`
+    // aborted with "free(): unaligned chunk detected in tcache"; meshing/fe_mesh.cpp).
+    auto o = LabTestOptions::paper_ucs();
+    o.width = 2.0, o.height = 4.0;
+    o.deformable_fraction = 0.95;
+    o.max_strain = 2e-4;
+    o.threads = 1;
+    std::vector<LabTestResult> serial, parallel(3);
+    for (int k = 0; k < 3; ++k) {
+        o.seed = std::uint64_t(k + 1);
+        serial.push_back(run_labtest(o));
+    }
+    std::vector<std::thread> pool;
+    for (int k = 0; k < 3; ++k)
+        pool.emplace_back([&parallel, o, k]() mutable {
+            o.seed = std::uint64_t(k + 1);
+            parallel[k] = run_labtest(o);
+        });
+    for (auto& t : pool) t.join();
+    for (int k = 0; k < 3; ++k) {
+        CHECK(parallel[k].blocks == serial[k].blocks);
+        CHECK(parallel[k].steps == serial[k].steps);
+        CHECK(parallel[k].curve.back().axial_stress == serial[k].curve.back().axial_stress);
+    }
 }

@@ -1,10 +1,12 @@
 // The long validation runs (minutes each; CTest label `long`, so `ctest -LE long`
-// leaves them out): the paper's trigon specimen and the calibration of issue 5.
+// leaves them out): the paper's trigon specimen, the calibration of issue 5 and
+// the post-peak targets of issue 12 over three seeds.
 #include "studies/calibrate.hpp"
 #include "studies/labtest.hpp"
 
 #include <doctest/doctest.h>
 
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -72,4 +74,82 @@ TEST_CASE("calibrate, paper specimen: targets E 20 GPa, nu 0.2, UCS 20 MPa, tens
     CHECK(fresh.nu == doctest::Approx(t.nu).epsilon(0.10));
     CHECK(fresh.ucs == doctest::Approx(t.ucs).epsilon(0.05));
     CHECK(fresh.tensile == doctest::Approx(t.tensile).epsilon(0.10));
+}
+
+namespace {
+
+/// Seeds 1–3 of a lab test, in parallel, one thread each.
+std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
+    std::vector<LabTestResult> r(3);
+    std::vector<std::thread> pool;
+    for (int k = 0; k < 3; ++k)
+        pool.emplace_back([&r, &base, k] {
+            auto o = base;
+            o.seed = std::uint64_t(k + 1);
+            o.threads = 1;
+            r[k] = run_labtest(o);
+        });
+    for (auto& t : pool) t.join();
+    return r;
+}
+
+/// Issue 12's post-peak target: below half the peak before 1% axial strain, no locking.
+void check_softens(const std::vector<LabTestResult>& r, const char* what) {
+    for (int k = 0; k < 3; ++k) {
+        const auto& end = r[k].curve.back();
+        MESSAGE(std::string(what) << ", seed " << k + 1 << ": peak " << r[k].peak_stress / 1e6 << " MPa, end at "
+                     << end.axial_stress / r[k].peak_stress << " of it, strain " << end.axial_strain << ", locking "
+                     << r[k].post_peak_locking);
+        CHECK(r[k].peak_passed);
+        CHECK_FALSE(r[k].post_peak_locking);
+        CHECK(end.axial_stress <= 0.5 * r[k].peak_stress);
+        CHECK(end.axial_strain < 0.01);
+    }
+}
+
+LabTestOptions area_trigon() {
+    auto o = LabTestOptions::paper_ucs();
+    o.pattern = meshing::PatternSpec::Kind::trigon;
+    o.joint.kn = 162e9, o.joint.ks = 68e9;
+    o.size_measure = meshing::PatternSpec::SizeMeasure::area;
+    return o;
+}
+
+LabTestOptions small(double deformable_fraction) {
+    auto o = LabTestOptions::paper_ucs();
+    o.width = 4.0, o.height = 8.0;
+    o.deformable_fraction = deformable_fraction;
+    return o;
+}
+
+} // namespace
+
+TEST_CASE("post-peak, 3 seeds: area-sized trigon 3 x 6 m and 8 x 16 m and rigid Voronoi 4 x 8 m soften without locking") {
+    // Issue 12: the area-sized trigon hardened to 176 MPa at 1% strain; after the
+    // four fixes of docs/calibration.md ("After the peak") every seed softens.
+    auto o = area_trigon();
+    o.width = 3.0, o.height = 6.0;
+    check_softens(three_seeds(o), "area trigon 3 x 6 m");
+    check_softens(three_seeds(area_trigon()), "area trigon 8 x 16 m");
+    check_softens(three_seeds(small(0.0)), "rigid Voronoi 4 x 8 m");
+}
+
+TEST_CASE("post-peak, 3 seeds: deformable blocks (f = 0.5, 4 x 8 m) soften, peaks within 15% of the rigid specimen") {
+    const auto rigid = three_seeds(small(0.0));
+    const auto deformable = three_seeds(small(0.5));
+    check_softens(deformable, "deformable f = 0.5, 4 x 8 m");
+    for (int k = 0; k < 3; ++k)
+        CHECK(deformable[k].peak_stress == doctest::Approx(rigid[k].peak_stress).epsilon(0.15));
+}
+
+TEST_CASE("post-peak, 3 seeds: deformable blocks (f = 0.95, 4 x 8 m) soften, peaks within 15% of the rigid specimen" *
+          doctest::may_fail()) {
+    // Known to miss (docs/calibration.md, "After the peak"): seed 2's rubble, held
+    // between the rough platens of a specimen 13 blocks wide, climbs back above
+    // the peak at 0.7% strain; with smooth platens it softens. The peaks hold.
+    const auto rigid = three_seeds(small(0.0));
+    const auto deformable = three_seeds(small(0.95));
+    for (int k = 0; k < 3; ++k)
+        CHECK(deformable[k].peak_stress == doctest::Approx(rigid[k].peak_stress).epsilon(0.15));
+    check_softens(deformable, "deformable f = 0.95, 4 x 8 m");
 }
