@@ -438,22 +438,29 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
     if (write) io::make_output_directory(out);
     const int n = c.realizations;
     const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    const int threads = std::max(1, std::min(n, available));
+    // Deformable specimens: realizations one at a time, each with the threads in its
+    // contact loop. Side by side in one process a 4 x 8 m f = 0.95 specimen gave,
+    // rarely (2 runs of about 40), another answer than alone — a thread-safety
+    // fault around meshing not found yet (docs/calibration.md, After the peak).
+    const bool one_at_a_time = o.deformable_fraction > 0.0;
+    const int threads = one_at_a_time ? 1 : std::max(1, std::min(n, available));
     const int threads_for_loop = available;
+    const int shown_threads = n > 1 && !one_at_a_time ? threads : threads_for_loop;
     std::mutex print;
     // Progress from rank 0 only; the others run quietly.
     quiet = quiet || !Ranks::root();
     if (!quiet)
         std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s%s\n", name,
                      c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
-                     n > 1 ? "s" : "", n > 1 ? threads : threads_for_loop, (n > 1 ? threads : threads_for_loop) > 1 ? "s" : "",
+                     n > 1 ? "s" : "", shown_threads, shown_threads > 1 ? "s" : "",
                      Ranks::size() > 1 ? (" per rank, " + std::to_string(Ranks::size()) + " ranks").c_str() : "");
     auto realization = [&](int k) -> std::string {
         try {
             LabTestOptions ok = o;
             ok.seed = o.seed + k;
-            // One realization: its threads go to the contact loop; several: one each.
-            ok.threads = n == 1 ? threads_for_loop : 1;
+            // One realization (or one at a time): its threads go to the contact loop;
+            // several side by side: one each.
+            ok.threads = n == 1 || one_at_a_time ? threads_for_loop : 1;
             const fs::path dir = n > 1 ? out / ("realization_" + std::to_string(k + 1)) : out;
             auto last = std::chrono::steady_clock::now();
             auto progress = [&](const StressStrainPoint& p) {

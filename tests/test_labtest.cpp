@@ -248,11 +248,14 @@ TEST_CASE("post-peak, mechanism 4: area-sized trigon 8 x 16 m (seed 2) softens w
     CHECK(p.end_strain < 0.004);
 }
 
-TEST_CASE("deformable realizations in parallel threads mesh safely and give the serial answer") {
+TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, the serial meshes") {
     // gmsh's thread count is an OpenMP setting of the calling thread: set once, a
     // second thread meshed with a team of all cores inside gmsh and corrupted the
     // heap (`bbm ucs --deformable-fraction 0.95 --realizations 2 --threads 2`
     // aborted with "free(): unaligned chunk detected in tcache"; meshing/fe_mesh.cpp).
+    // The meshes must be the serial ones. (The runs agree here too; a larger
+    // specimen side by side rarely did not, so `bbm ucs` now runs deformable
+    // realizations one at a time: docs/calibration.md.)
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0;
     o.deformable_fraction = 0.95;
@@ -272,7 +275,7 @@ TEST_CASE("deformable realizations in parallel threads mesh safely and give the 
     for (auto& t : pool) t.join();
     for (int k = 0; k < 3; ++k) {
         CHECK(parallel[k].blocks == serial[k].blocks);
-        CHECK(parallel[k].steps == serial[k].steps);
-        CHECK(parallel[k].curve.back().axial_stress == serial[k].curve.back().axial_stress);
+        CHECK(parallel[k].contacts == serial[k].contacts);
+        CHECK(parallel[k].E == serial[k].E); // the preload: one implicit solve on the mesh
     }
 }

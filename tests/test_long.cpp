@@ -78,9 +78,19 @@ TEST_CASE("calibrate, paper specimen: targets E 20 GPa, nu 0.2, UCS 20 MPa, tens
 
 namespace {
 
-/// Seeds 1–3 of a lab test, in parallel, one thread each.
+/// Seeds 1–3 of a lab test: in parallel, one thread each; deformable specimens one
+/// at a time, two threads each, as `bbm ucs --realizations` runs them (studies/commands.cpp).
 std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
     std::vector<LabTestResult> r(3);
+    if (base.deformable_fraction > 0.0) {
+        for (int k = 0; k < 3; ++k) {
+            auto o = base;
+            o.seed = std::uint64_t(k + 1);
+            o.threads = 2;
+            r[k] = run_labtest(o);
+        }
+        return r;
+    }
     std::vector<std::thread> pool;
     for (int k = 0; k < 3; ++k)
         pool.emplace_back([&r, &base, k] {
