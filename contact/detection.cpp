@@ -243,28 +243,10 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
             // but inside that line is not in overlap. Measured against the line it
             // would start compressed by up to the tolerance — at kn, hundreds of MPa
             // on a fresh vertex-vertex contact (docs/calibration.md, After the peak).
-            const Vec2 corner = s_on < 0.0 ? b.vertex[best] : b.vertex[e1];
-            const Vec2 centre = corner - in.corner_radius * n;
+            const Vec2 centre = (s_on < 0.0 ? b.vertex[best] : b.vertex[e1]) - in.corner_radius * n;
             const Vec2 r = x - centre;
             const double rl = norm(r);
             if (rl > 0.0) gap = rl - in.corner_radius, n = r / rl;
-            if (gap < 0.0) {
-                // That circle is tangent to this edge only, so beside an acute corner
-                // it reaches past the block: a vertex there, outside B, would be born
-                // compressed by up to r (344 of 515 contacts born below -0.1 mm in a
-                // 3 x 6 m area trigon specimen were outside B). Outside B — beyond
-                // either edge's line at a convex corner, both at a reflex one — the
-                // contact starts open, at its distance from those lines.
-                const Vec2 other = s_on < 0.0 ? b.vertex[prev_vertex(b.first, B, best)]
-                                              : b.vertex[next_vertex(b.first, B, e1)];
-                const Vec2 in_edge = s_on < 0.0 ? corner - other : corner - b.vertex[best];
-                const Vec2 out_edge = s_on < 0.0 ? b.vertex[e1] - corner : other - corner;
-                const double g_this = frame(x, b.vertex[best], b.vertex[e1]).gap;
-                const double g_other = s_on < 0.0 ? frame(x, other, corner).gap : frame(x, corner, other).gap;
-                const bool convex = cross(in_edge, out_edge) > 0.0; // counter-clockwise polygons
-                const bool outside = convex ? (g_this > 0.0 || g_other > 0.0) : (g_this > 0.0 && g_other > 0.0);
-                if (outside) gap = std::max(g_this, g_other);
-            }
         }
         const double un = gap - dot(vr, n) * in.dt;
         candidates_.push_back({block_pair_key(A, B), A, int(v), B, best, e1, l, un});
