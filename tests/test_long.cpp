@@ -3,6 +3,7 @@
 // the post-peak targets of issue 12 over three seeds.
 #include "studies/calibrate.hpp"
 #include "studies/labtest.hpp"
+#include "tests/specimens.hpp"
 
 #include <doctest/doctest.h>
 
@@ -117,14 +118,6 @@ void check_softens(const std::vector<LabTestResult>& r, const char* what) {
     }
 }
 
-LabTestOptions area_trigon() {
-    auto o = LabTestOptions::paper_ucs();
-    o.pattern = meshing::PatternSpec::Kind::trigon;
-    o.joint.kn = 162e9, o.joint.ks = 68e9;
-    o.size_measure = meshing::PatternSpec::SizeMeasure::area;
-    return o;
-}
-
 LabTestOptions small(double deformable_fraction) {
     auto o = LabTestOptions::paper_ucs();
     o.width = 4.0, o.height = 8.0;
@@ -137,10 +130,10 @@ LabTestOptions small(double deformable_fraction) {
 TEST_CASE("post-peak, 3 seeds: area-sized trigon 3 x 6 m and 8 x 16 m and rigid Voronoi 4 x 8 m soften without locking") {
     // Issue 12: the area-sized trigon hardened to 176 MPa at 1% strain; after the
     // four fixes of docs/calibration.md ("After the peak") every seed softens.
-    auto o = area_trigon();
+    auto o = test::area_trigon_ucs();
     o.width = 3.0, o.height = 6.0;
     check_softens(three_seeds(o), "area trigon 3 x 6 m");
-    check_softens(three_seeds(area_trigon()), "area trigon 8 x 16 m");
+    check_softens(three_seeds(test::area_trigon_ucs()), "area trigon 8 x 16 m");
     check_softens(three_seeds(small(0.0)), "rigid Voronoi 4 x 8 m");
 }
 
