@@ -212,6 +212,9 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
         ->capture_default_str();
     sub->add_option("--servo-cracks", o.servo_cracks, "Servo: new cracks per record (20 steps) per 5,000 contacts it aims at")
         ->check(cli::positive())->capture_default_str();
+    sub->add_option("--servo-balance", o.servo_balance,
+                    "Servo, once cracking has started: largest difference between the top and bottom platen forces, as a fraction of the load (0: off)")
+        ->check(cli::non_negative())->capture_default_str();
     sub->add_option("--servo-min", o.servo_min_factor, "Servo: slowest platen speed, times --strain-rate")
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--servo-max", o.servo_max_factor, "Servo: fastest platen speed before failure, times --strain-rate")

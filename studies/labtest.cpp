@@ -473,7 +473,12 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             if (failed) {
                 rate = std::min(1.1 * rate, o.strain_per_step * o.servo_post_peak_factor);
             } else {
-                const double f = made <= 0 ? 1.1 : std::clamp(target_cracks / made, 0.5, 1.1);
+                double f = made <= 0 ? 1.1 : std::clamp(target_cracks / made, 0.5, 1.1);
+                if (o.servo_balance > 0 && cracks_now > cracks_at_start) {
+                    const double top = s.boundary_force("top").y, bottom = s.boundary_force("bottom").y;
+                    const double mismatch = std::abs(top + bottom) / std::max(std::abs(top), 1e-300);
+                    if (mismatch > 0) f = std::min(f, std::clamp(o.servo_balance / mismatch, 0.5, 1.1));
+                }
                 rate = std::clamp(rate * f, rate_min, rate_max);
             }
             platen.set_speed(rate * h);

@@ -13,7 +13,7 @@
 
 using namespace bbm;
 
-TEST_CASE("uniaxial compression, paper trigon specimen, 3 realizations: the paper's modulus, a strength 10-20% below the paper's") {
+TEST_CASE("uniaxial compression, paper trigon specimen, 3 realizations: the paper's modulus, a quasi-static strength 15-29% below the paper's") {
     // Trigon with the paper's stiffnesses (SPEC §8): triangles of 0.3 m average
     // dimension, from the cells of random points. Realizations in parallel, one
     // thread each. After failure the fragments may jam between the platens and the
@@ -41,12 +41,40 @@ TEST_CASE("uniaxial compression, paper trigon specimen, 3 realizations: the pape
     }
     MESSAGE("trigon, mean of 3: E " << E / 1e9 << " GPa (paper 20.0), UCS " << peak / 1e6 << " MPa (paper 20.3)");
     // Issue 5 asks for E within 10% and the UCS within 15% of the paper. E is met
-    // (measured +1.5%); the UCS is 16% below the paper's (17.07 MPa, the three
-    // realizations within 3% of each other), so that target is missed by a point:
-    // docs/calibration.md says so. This guards the measured figure, 10–20% below.
+    // (measured +2.4%); the UCS is not: loaded quasi-statically (the servo holds
+    // the platen forces balanced once cracking starts) the trigon peaks at
+    // 15.69 MPa, 22.7% under the paper's (15.79 / 15.27 / 16.02); at the former
+    // crack-keyed servo it read 17.25 (−15%), a rate effect (the test below).
+    // docs/calibration.md says so; this guards the measured figure.
     CHECK(E == doctest::Approx(20.0e9).epsilon(0.10));
-    CHECK(peak < 0.90 * 20.3e6);
-    CHECK(peak > 0.80 * 20.3e6);
+    CHECK(peak < 0.85 * 20.3e6);
+    CHECK(peak > 0.71 * 20.3e6);
+}
+
+TEST_CASE("uniaxial compression, paper trigon specimen: the default loading gives the quasi-static peak") {
+    // The trigon fails in a cascade from its first sustained cracking: loaded
+    // faster than it can redistribute, it carries more than its strength (constant
+    // 5e-8 per step: 17.2 MPa; 2.5e-8: 16.6; 1e-8: 15.8; 4e-9: 15.56). The default
+    // servo, which holds the top and bottom platen forces within 2% of each other
+    // once cracking starts, must give the slow answer (measured 15.79, +1.5%) in a
+    // fraction of its steps (26,000 against 120,000).
+    auto o = LabTestOptions::paper_ucs();
+    o.pattern = meshing::PatternSpec::Kind::trigon;
+    o.joint.kn = 162e9;
+    o.joint.ks = 68e9;
+    LabTestResult fast, slow;
+    std::thread other([&] { fast = run_labtest(o); });
+    auto q = o;
+    q.servo = false;
+    q.strain_per_step = 4e-9;
+    slow = run_labtest(q);
+    other.join();
+    MESSAGE("trigon seed 1: default loading " << fast.peak_stress / 1e6 << " MPa in " << fast.steps << " steps, constant 4e-9 "
+                                              << slow.peak_stress / 1e6 << " MPa in " << slow.steps << " steps");
+    REQUIRE(fast.peak_passed);
+    REQUIRE(slow.peak_passed);
+    CHECK(fast.peak_stress == doctest::Approx(slow.peak_stress).epsilon(0.03));
+    CHECK(fast.steps < slow.steps / 3);
 }
 
 TEST_CASE("calibrate, paper specimen: targets E 20 GPa, nu 0.2, UCS 20 MPa, tensile 2.5 MPa hold on fresh seeds") {
