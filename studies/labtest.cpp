@@ -3,6 +3,7 @@
 #include "core/solver.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -142,10 +143,15 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
         bottom.vx = top.vx = 0.0;
         an.boundaries = {bottom, top};
     } else {
+        // Smooth platens leave the specimen free to slide sideways as a whole (a
+        // zero-stiffness mode: the preload's matrix is singular, and fragments
+        // drift after failure); the bottom face's middle blocks are held in x. A
+        // face block is selected by an edge wholly inside the box, so the box spans
+        // a few block sizes (a window of one size held none).
         BoundarySpec anchor = bottom;
         anchor.name = "anchor";
-        anchor.select.box->lo.x = 0.5 * o.width - band;
-        anchor.select.box->hi.x = 0.5 * o.width + band;
+        anchor.select.box->lo.x = 0.5 * o.width - 1.5 * o.size;
+        anchor.select.box->hi.x = 0.5 * o.width + 1.5 * o.size;
         anchor.vy.reset();
         anchor.omega.reset();
         anchor.vx = 0.0;
@@ -319,6 +325,12 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     const auto t0 = std::chrono::steady_clock::now();
     const auto blocks = meshing::generate_blocks(labtest_geometry(o));
     Solver s(blocks, labtest_analysis(o));
+    if (!o.rough_platens && !uses_platen_blocks(o)) {
+        const auto& fixed = s.blocks().fixed;
+        if (std::none_of(fixed.begin(), fixed.end(), [](auto f) { return (f & 1) != 0; }))
+            throw std::runtime_error("smooth platens: no block on the bottom face's middle to hold the specimen "
+                                     "horizontally; use --platens rough or a larger specimen");
+    }
     LabTestResult r;
     r.blocks = blocks.block_count();
     r.contacts = s.contacts().size();

@@ -271,3 +271,25 @@ TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, 
         CHECK(parallel[k].E == serial[k].E); // the preload: one implicit solve on the mesh
     }
 }
+
+TEST_CASE("smooth platens hold the bottom face's middle blocks horizontally: the preload's matrix is positive definite") {
+    // The anchor once selected no block (a face block is selected by an edge wholly
+    // inside its box, and the box was one block size wide): the specimen was free
+    // to slide sideways as a whole, CHOLMOD reported "not positive definite" and the
+    // preload fell back to LU with an arbitrary drift.
+    for (auto pattern : {meshing::PatternSpec::Kind::voronoi, meshing::PatternSpec::Kind::trigon}) {
+        auto o = LabTestOptions::paper_ucs();
+        o.pattern = pattern;
+        o.width = 2.0, o.height = 4.0;
+        o.rough_platens = false;
+        Solver s(meshing::generate_blocks(labtest_geometry(o)), labtest_analysis(o));
+        int held_x = 0, held_y = 0;
+        for (auto f : s.blocks().fixed) held_x += (f & 1) ? 1 : 0, held_y += (f & 2) ? 1 : 0;
+        CHECK(held_x >= 1);
+        CHECK(held_x <= 4);      // a few middle blocks, not the face
+        CHECK(held_y > held_x);  // both faces are held vertically
+        s.move_supports(s.timestep());
+        const auto report = s.solve_elastic();
+        CHECK(report.method == "cholmod-simplicial-cholesky");
+    }
+}
