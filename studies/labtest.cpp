@@ -3,10 +3,10 @@
 #include "core/solver.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 #include <tuple>
 
 namespace bbm {
