@@ -1,13 +1,20 @@
 // Checkpoints: the solver's evolving state as a flat binary dump.
 //
 // What is saved is everything a step reads that the model file does not
-// determine: block and node kinematics and (scaled) masses, contacts with their
-// full histories (detection adds and removes them), zone stresses, relaxation and
-// detection bookkeeping, time and counters. Geometry, property sets and boundary
-// conditions are rebuilt from the model file, which generates the same assembly
-// every time; a checkpoint carries the state hash of its source at save time and
-// the number of blocks, nodes and zones, and refuses to load into a solver built
-// from a different model.
+// determine: block and node kinematics and (scaled) masses, contacts in their
+// order with their full histories (detection adds and removes them), the count of
+// contacts created since the last renumbering (it decides when the next one
+// happens, and the numbering fixes the order of every sum), zone stresses,
+// relaxation and detection bookkeeping, loads and support velocities that a study
+// may have changed (a lab test's servo, a confinement ramp), time and counters.
+// Geometry, property sets and the initial boundary conditions are rebuilt from
+// the model file, which generates the same assembly every time; a checkpoint
+// carries its format version, the fingerprint of the model it belongs to, the
+// number of blocks, nodes and zones and the state hash at save time, and refuses
+// to load into a solver built from another model or into another format.
+// Not saved, on purpose: the broad-phase grid of detection (a conservative
+// superset of the pairs within the tolerance, rebuilt on load: which pairs it
+// offers never changes which contacts form) and per-step scratch.
 #include "core/solver.hpp"
 
 #include <istream>
@@ -18,7 +25,11 @@
 namespace bbm {
 
 namespace {
-constexpr std::uint64_t magic = 0x62626d2d63687032ull; // "bbm-chp2"
+// "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
+// count (a resumed run renumbered its contacts at another step: issue 27).
+constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
+constexpr std::uint64_t format = '3';
+constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
 void put(std::ostream& o, const T& v) {
@@ -48,9 +59,10 @@ void get(std::istream& i, std::vector<T>& v) {
 }
 } // namespace
 
-std::uint64_t Solver::model_fingerprint() const {
+std::uint64_t Solver::compute_model_fingerprint() const {
     // What the model file fixes: initial geometry, masses (materials), supports,
-    // loads and property sets.
+    // loads and property sets. Taken when the solver is built, before a study
+    // changes loads or support velocities.
     std::uint64_t h = 1469598103934665603ull;
     auto mix = [&](const void* p, std::size_t n) {
         const auto* c = static_cast<const unsigned char*>(p);
@@ -80,13 +92,17 @@ void Solver::visit_state(Self& s, Visit&& v) {
     v(s.dt_), v(s.time_), v(s.ratio_), v(s.work_), v(s.steps_);
     v(s.boundary_force_);
     v(s.detected_at_), v(s.detected_theta_), v(s.detected_vertex_), v(s.active_);
-    v(s.detection_totals_);
+    v(s.detection_totals_), v(s.unsorted_contacts_), v(s.first_dt_);
+    // Loads and support velocities: constant in a model file's stages, moved by
+    // lab tests (the servo's platen speed, the confinement ramp).
+    v(s.b_.fixed_velocity), v(s.b_.fixed_omega), v(s.b_.applied), v(s.b_.applied_moment);
+    v(s.n_.fixed_velocity), v(s.n_.applied);
 }
 
 void Solver::save_state(std::ostream& o) const {
     put(o, magic);
     put(o, std::int64_t(b_.count())), put(o, std::int64_t(n_.count())), put(o, std::int64_t(z_.size()));
-    put(o, model_fingerprint());
+    put(o, fingerprint_);
     visit_state(*this, [&](const auto& x) { put(o, x); });
     put(o, state_hash());
     if (!o) throw std::runtime_error("cannot write the checkpoint");
@@ -95,7 +111,11 @@ void Solver::save_state(std::ostream& o) const {
 void Solver::load_state(std::istream& i) {
     std::uint64_t m = 0;
     get(i, m);
-    if (m != magic) throw std::runtime_error("not a bbm checkpoint");
+    if ((m & ~std::uint64_t(0xff)) != magic_base) throw std::runtime_error("not a bbm checkpoint");
+    if (m != magic)
+        throw std::runtime_error("the solver state is of checkpoint format " + std::string(1, char(m & 0xff)) +
+                                 "; this bbm reads format " + std::string(1, char(format)) +
+                                 " only (start the run again)");
     std::int64_t nb = 0, nn = 0, nz = 0;
     get(i, nb), get(i, nn), get(i, nz);
     if (nb != b_.count() || nn != n_.count() || nz != z_.size())
@@ -105,7 +125,7 @@ void Solver::load_state(std::istream& i) {
                                  std::to_string(z_.size()) + ")");
     std::uint64_t fingerprint = 0;
     get(i, fingerprint);
-    if (fingerprint != model_fingerprint())
+    if (fingerprint != fingerprint_)
         throw std::runtime_error("checkpoint is of a different model (same counts, but the geometry, materials, "
                                  "joint properties or boundaries differ: was the model file edited?)");
     visit_state(*this, [&](auto& x) { get(i, x); });

@@ -264,6 +264,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     apply_boundaries(an, a);
     update_vertices();
     update_timestep();
+    fingerprint_ = compute_model_fingerprint();
 }
 
 std::vector<int> Solver::select_blocks(const SelectionSpec& s) const {

@@ -103,7 +103,7 @@ public:
     void load_state(std::istream& in);
     /// Hash of what the model file determines (initial geometry, masses, supports,
     /// loads, property sets): a checkpoint records it and refuses another model.
-    std::uint64_t model_fingerprint() const;
+    std::uint64_t model_fingerprint() const { return fingerprint_; }
 
     // --- measures -------------------------------------------------------------
     double unbalanced_ratio() const { return ratio_; }
@@ -204,6 +204,7 @@ private:
     double force_scale() const;
     template <class Self, class Visit>
     static void visit_state(Self& self, Visit&& visit); ///< core/checkpoint.cpp
+    std::uint64_t compute_model_fingerprint() const;    ///< core/checkpoint.cpp
     void integrate();
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
@@ -254,7 +255,10 @@ private:
     std::vector<contact::Junction> junctions_; ///< vertices touching a block they have no joint with (detection.hpp)
     contact::DetectionResult detection_totals_;
     contact::Detector detector_;
-    int unsorted_contacts_ = 0; ///< created since the contacts were last sorted by block
+    /// Created since the contacts were last sorted by block: it decides when they
+    /// are renumbered next, so it is state (a checkpoint saves it).
+    int unsorted_contacts_ = 0;
+    std::uint64_t fingerprint_ = 0; ///< model_fingerprint(), taken at construction
     long steps_ = 0;
 };
 
