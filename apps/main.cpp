@@ -10,7 +10,8 @@
 // models, sweep runs) are spread over the ranks; rank 0 writes the summaries.
 // Exit status: 0 success, 2 bad input (the message names file, line and key),
 // 3 stopped by a numerical health check, 4 calibration not converged, 130
-// interrupted, 1 any other failure. Earlier output in DIR is only replaced by
+// interrupted (SIGINT, SIGTERM or SIGUSR1; `bbm run` writes a checkpoint), 1 any
+// other failure. Earlier output in DIR is only replaced by
 // complete files.
 #include "base/error.hpp"
 #include "io/model_input.hpp"
@@ -77,11 +78,17 @@ int run_cli(int argc, char** argv) {
                     "Threads of the loop (the result is the same, bit for bit, on any number)")
         ->check(cli::positive())
         ->capture_default_str();
-    run->add_option("--checkpoint-every", run_options.checkpoint_every,
-                    "Write DIR/checkpoint.bin every N steps (0: only when interrupted)")
-        ->check(cli::non_negative())
-        ->capture_default_str();
-    run->add_flag("--resume", run_options.resume, "Continue the run whose checkpoint is in --out");
+    std::string checkpoint_every;
+    run->add_option("--checkpoint-every", checkpoint_every,
+                    "Write DIR/checkpoint.bin every N steps (5000) or every stretch of wall time (30min, 2h, 90s), "
+                    "as well as when interrupted (SIGINT, SIGTERM, SIGUSR1)");
+    run->add_option("--stop-at-step", run_options.stop_at_step,
+                    "Stop after this step as if interrupted: checkpoint, output, exit status 130 (an exact "
+                    "interruption, for tests and scripted runs)")
+        ->check(cli::positive());
+    run->add_flag("--resume", run_options.resume,
+                  "Continue the run whose checkpoint is in --out (the model file is the checkpoint's; exit 0 if the "
+                  "run had already finished)");
     run->add_option("--max-elements", run_options.max_elements, studies::max_elements_help)->check(cli::positive());
 
     std::vector<std::string> compare_models;
@@ -184,6 +191,7 @@ int run_cli(int argc, char** argv) {
             if (run_options.model.empty() && !run_options.resume)
                 throw InputError("bbm run", 0, "", "give a model file, or --resume with the --out of a run to continue");
             run_options.out = run_out;
+            if (!checkpoint_every.empty()) run_options.checkpoint_every = studies::parse_checkpoint_interval(checkpoint_every);
             run_options.quiet = quiet;
             run_options.check_only = check_only;
             return studies::run_model(run_options);

@@ -148,7 +148,9 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
 
 namespace {
 
-const char* const checkpoint_magic = "bbm-model-checkpoint-1";
+// The tag of a model checkpoint; its last character is the format version (1
+// lacked the solver's renumbering count: issue 27).
+const char* const checkpoint_magic = "bbm-model-checkpoint-2";
 
 
 /// Passes steps to a Progress callback; stops when it says so.
@@ -300,6 +302,11 @@ Model Model::resume(const fs::path& file, int threads) {
     if (!in) throw InputError(file.string(), 0, "", "cannot open the checkpoint");
     std::string magic(std::char_traits<char>::length(checkpoint_magic), '\0');
     in.read(magic.data(), std::streamsize(magic.size()));
+    const std::string tag(checkpoint_magic);
+    if (in && magic.substr(0, tag.size() - 1) == tag.substr(0, tag.size() - 1) && magic != tag)
+        throw InputError(file.string(), 0, "",
+                         std::string("checkpoint format ") + magic.back() + ", written by another bbm; this one reads format " +
+                             tag.back() + " only: run the model again from the start");
     if (!in || magic != checkpoint_magic) throw InputError(file.string(), 0, "", "not a bbm model checkpoint");
     const std::string name = get_string(in, 1u << 20);
     const std::string text = get_string(in, 1u << 30);
@@ -314,7 +321,11 @@ Model Model::resume(const fs::path& file, int threads) {
         m.reports_.push_back(r);
     }
     m.run_seconds_ = get<double>(in);
-    m.solver_->load_state(in);
+    try {
+        m.solver_->load_state(in);
+    } catch (const std::runtime_error& e) {
+        throw InputError(file.string(), 0, "", e.what());
+    }
     return m;
 }
 

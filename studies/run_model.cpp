@@ -19,10 +19,13 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 
 namespace bbm::studies {
 using namespace bbm::io;
@@ -31,15 +34,82 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::atomic<bool> interrupted{false};
+/// The signal that asked the run to stop (SIGINT, SIGTERM, SIGUSR1), or −1 for
+/// --stop-at-step; 0 while none has. The handler only stores it: the stage loop
+/// ends after the current step and the checkpoint is written outside the handler.
+std::atomic<int> interrupted{0};
 
-const char* checkpoint_magic = "bbm-run-checkpoint-1";
+// A run checkpoint starts with this tag and the format version. Format 1 (no
+// version, model hash or stage reports; its solver state lacked the renumbering
+// count) is refused with a reason. Format 2: docs/theory.md §10.1.
+constexpr std::string_view checkpoint_tag = "bbm-run-checkpoint-";
+constexpr std::uint32_t checkpoint_format = 2;
+
+/// FNV-1a of a model file's bytes: a checkpoint resumes only the text it ran.
+std::uint64_t text_hash(std::string_view text) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+    return h;
+}
+
+std::string read_file_text(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file.string(), 0, "", "cannot open the model file");
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+/// What a run checkpoint says it is (read before the model is rebuilt).
+struct CheckpointHeader {
+    std::uint32_t format = checkpoint_format;
+    std::string bbm_version;
+    std::string model;           ///< absolute path of the model file
+    std::uint64_t model_hash = 0; ///< text_hash of its bytes when the run started
+    int threads = 1;             ///< informational: results do not depend on it
+    long step = 0;               ///< total steps taken
+    StageCursor cursor;
+    std::string stage;           ///< name of the stage the cursor is in ("" past the last)
+    double wall_seconds = 0.0;   ///< run time before this checkpoint
+};
+
+void write_header(std::ostream& o, const CheckpointHeader& h) {
+    o.write(checkpoint_tag.data(), std::streamsize(checkpoint_tag.size()));
+    put(o, 'v'), put(o, h.format);
+    put_string(o, h.bbm_version), put_string(o, h.model), put(o, h.model_hash), put(o, h.threads);
+    put(o, h.step), put(o, h.cursor.stage), put(o, h.cursor.started), put(o, h.cursor.step);
+    put_string(o, h.stage), put(o, h.wall_seconds);
+}
+
+CheckpointHeader read_header(std::istream& i, const fs::path& file) {
+    std::string tag(checkpoint_tag.size(), '\0');
+    i.read(tag.data(), std::streamsize(tag.size()));
+    if (!i || tag != checkpoint_tag) throw InputError(file.string(), 0, "", "not a bbm run checkpoint");
+    CheckpointHeader h;
+    const char mark = get<char>(i);
+    if (mark == '1')
+        throw InputError(file.string(), 0, "",
+                         "checkpoint format 1, written by an older bbm; this bbm reads format " +
+                             std::to_string(checkpoint_format) + " only: run the model again from the start");
+    if (mark != 'v') throw InputError(file.string(), 0, "", "not a bbm run checkpoint");
+    h.format = get<std::uint32_t>(i);
+    if (h.format != checkpoint_format)
+        throw InputError(file.string(), 0, "",
+                         "checkpoint format " + std::to_string(h.format) + "; this bbm (" BBM_VERSION ") reads format " +
+                             std::to_string(checkpoint_format) + " only: resume it with the bbm that wrote it, or "
+                             "run the model again from the start");
+    h.bbm_version = get_string(i), h.model = get_string(i), h.model_hash = get<std::uint64_t>(i);
+    h.threads = get<int>(i);
+    h.step = get<long>(i), h.cursor.stage = get<int>(i), h.cursor.started = get<bool>(i), h.cursor.step = get<long>(i);
+    h.stage = get_string(i), h.wall_seconds = get<double>(i);
+    return h;
+}
 
 /// Writes the ParaView series, the history, progress and checkpoints of a run.
 class RunOutput : public StageObserver {
 public:
-    RunOutput(const fs::path& out, const AnalysisSpec& an, const Solver& s, const RunOptions& o, std::string model)
-        : out_(out), settings_(an.solver), recorder_(s, an.histories), options_(o), model_(std::move(model)) {
+    RunOutput(const fs::path& out, const AnalysisSpec& an, const Solver& s, const RunOptions& o, std::string model,
+              std::uint64_t model_hash)
+        : out_(out), settings_(an.solver), stages_(an.stages), recorder_(s, an.histories), options_(o),
+          model_(std::move(model)), model_hash_(model_hash) {
         make_output_directory(out_);
         fs::create_directories(out_ / "vtk");
     }
@@ -70,10 +140,19 @@ public:
     }
     void at(const Solver& s, const StageCursor& c) override {
         cursor_ = c;
-        if (options_.checkpoint_every > 0 && c.step > 0 && s.steps() % options_.checkpoint_every == 0)
-            write_checkpoint(s);
+        if (c.step == 0) return;
+        if (options_.stop_at_step > 0 && s.steps() >= options_.stop_at_step) interrupted = -1;
+        const auto& every = options_.checkpoint_every;
+        bool due = every.steps > 0 && s.steps() % every.steps == 0;
+        if (every.seconds > 0 && s.steps() % 16 == 0) {
+            const auto now = std::chrono::steady_clock::now();
+            due = due || std::chrono::duration<double>(now - last_checkpoint_).count() >= every.seconds;
+        }
+        // The interrupted run writes its checkpoint once, at the end.
+        if (due && interrupted == 0) write_checkpoint(s);
     }
     void stage_done(const Solver& s, const StageReport& r) override {
+        reports_.push_back(r);
         record(s);
         snapshot(s);
         flush_history();
@@ -82,14 +161,30 @@ public:
                          r.kind.c_str(), r.steps, r.ratio, r.seconds, r.converged ? "" : "  (step limit reached)",
                          r.method.empty() ? "" : ("  " + r.method).c_str(), std::string(50, ' ').c_str());
     }
-    bool stop_requested() override { return interrupted.load(); }
+    bool stop_requested() override { return interrupted.load() != 0; }
+
+    /// Wall seconds of the run so far, including those before a resume.
+    double wall_seconds() const {
+        return earlier_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    }
+    /// Every stage report of the run, those finished before a resume first.
+    const std::vector<StageReport>& reports() const { return reports_; }
 
     void write_checkpoint(const Solver& s) {
         std::ostringstream o(std::ios::binary);
-        o.write(checkpoint_magic, std::streamsize(std::char_traits<char>::length(checkpoint_magic)));
-        put_string(o, model_);
-        put(o, options_.threads);
-        put(o, cursor_.stage), put(o, cursor_.started), put(o, cursor_.step);
+        CheckpointHeader h;
+        h.bbm_version = BBM_VERSION;
+        h.model = model_, h.model_hash = model_hash_, h.threads = options_.threads;
+        // A stop that came while a stage's end was written: that stage is done.
+        const StageCursor cursor = int(reports_.size()) > cursor_.stage ? StageCursor{int(reports_.size()), false, 0} : cursor_;
+        h.step = s.steps(), h.cursor = cursor, h.wall_seconds = wall_seconds();
+        h.stage = cursor.stage < int(stages_.size()) ? stages_[cursor.stage].name : "";
+        write_header(o, h);
+        put(o, std::uint64_t(reports_.size()));
+        for (const auto& r : reports_) {
+            put_string(o, r.name), put_string(o, r.kind), put_string(o, r.method);
+            put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged);
+        }
         put(o, std::uint64_t(rows_.size()));
         for (std::size_t r = 0; r < rows_.size(); ++r) {
             put(o, rows_[r].first), put(o, times_[r]), put(o, std::uint64_t(rows_[r].second.size()));
@@ -101,28 +196,34 @@ public:
         s.save_state(o);
         flush_history();
         write_text_atomically(out_ / "checkpoint.bin", o.str());
+        last_checkpoint_ = std::chrono::steady_clock::now();
     }
-    /// Reads the run part of a checkpoint; the solver part follows in the stream.
-    /// (The thread count it records is informational: results do not depend on it.)
-    static std::string read_model_name(std::istream& i) {
-        std::string magic(std::char_traits<char>::length(checkpoint_magic), '\0');
-        i.read(magic.data(), std::streamsize(magic.size()));
-        if (!i || magic != checkpoint_magic) throw std::runtime_error("not a bbm checkpoint");
-        std::string model = get_string(i);
-        (void)get<int>(i);
-        return model;
-    }
-    void restore(std::istream& i) {
-        cursor_.stage = get<int>(i), cursor_.started = get<bool>(i), cursor_.step = get<long>(i);
+    /// Reads the run part of a checkpoint after its header; the solver part follows.
+    void restore(std::istream& i, const CheckpointHeader& h) {
+        cursor_ = h.cursor;
+        earlier_seconds_ = h.wall_seconds;
+        const auto reports = get<std::uint64_t>(i);
+        if (reports > 100000) throw std::runtime_error("checkpoint is corrupt (stage reports)");
+        for (std::uint64_t k = 0; k < reports; ++k) {
+            StageReport r;
+            r.name = get_string(i), r.kind = get_string(i), r.method = get_string(i);
+            r.steps = get<long>(i), r.ratio = get<double>(i), r.seconds = get<double>(i), r.converged = get<bool>(i);
+            reports_.push_back(r);
+        }
         const auto rows = get<std::uint64_t>(i);
+        if (rows > (std::uint64_t(1) << 32)) throw std::runtime_error("checkpoint is corrupt (history rows)");
         for (std::uint64_t r = 0; r < rows; ++r) {
             const long step = get<long>(i);
             times_.push_back(get<double>(i));
-            std::vector<double> v(get<std::uint64_t>(i));
+            const auto columns = get<std::uint64_t>(i);
+            if (columns != recorder_.histories().size())
+                throw std::runtime_error("checkpoint is corrupt (history columns)");
+            std::vector<double> v(columns);
             for (double& x : v) x = get<double>(i);
             rows_.push_back({step, std::move(v)});
         }
         const auto n = get<std::uint64_t>(i);
+        if (n > (std::uint64_t(1) << 32)) throw std::runtime_error("checkpoint is corrupt (snapshots)");
         for (std::uint64_t k = 0; k < n; ++k) {
             const double t = get<double>(i);
             series_.push_back({t, get_string(i)});
@@ -173,9 +274,14 @@ public:
 private:
     fs::path out_;
     SolverSpec settings_;
+    std::vector<StageSpec> stages_;
     HistoryRecorder recorder_;
     RunOptions options_;
     std::string model_;
+    std::uint64_t model_hash_ = 0;
+    std::vector<StageReport> reports_;
+    double earlier_seconds_ = 0.0;
+    std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), last_checkpoint_ = started_;
     std::vector<std::pair<long, std::vector<double>>> rows_;
     std::vector<double> times_;
     std::vector<std::pair<double, std::string>> series_;
@@ -208,16 +314,84 @@ void draw_history(const RunOutput& out, const fs::path& file) {
 
 } // namespace
 
+namespace {
+
+/// With --resume: the checkpoint's header, or why there is nothing to resume.
+/// Returns false (and says so) when the run in DIR had already finished.
+bool open_checkpoint(const RunOptions& opt, std::ifstream& in, CheckpointHeader& header) {
+    const fs::path file = opt.out / "checkpoint.bin", summary_file = opt.out / "summary.json";
+    // A finished run: its summary says complete, and no checkpoint is newer.
+    long finished_at = -1;
+    if (fs::exists(summary_file)) {
+        std::ifstream f(summary_file);
+        const auto j = nlohmann::json::parse(f, nullptr, false);
+        if (!j.is_discarded() && j.value("complete", false)) finished_at = j.value("steps", 0L);
+    }
+    in.open(file, std::ios::binary);
+    try {
+        if (in) header = read_header(in, file);
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::runtime_error& e) {
+        throw InputError(file.string(), 0, "", e.what());
+    }
+    if (finished_at >= 0 && (!in || header.step <= finished_at)) {
+        if (!opt.quiet)
+            std::fprintf(stderr, "%s: the run finished (step %ld; %s says complete): nothing to resume\n",
+                         opt.out.string().c_str(), finished_at, summary_file.string().c_str());
+        return false;
+    }
+    if (!in)
+        throw InputError(file.string(), 0, "",
+                         "no checkpoint to resume from (run with --checkpoint-every N, or stop a run with Ctrl-C)");
+    return true;
+}
+
+} // namespace
+
+CheckpointInterval parse_checkpoint_interval(const std::string& text) {
+    CheckpointInterval every;
+    std::size_t used = 0;
+    double value = -1.0;
+    try {
+        value = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    const std::string unit = text.substr(used);
+    const double scale = unit.empty() ? 0.0
+                       : (unit == "s" || unit == "sec")                   ? 1.0
+                       : (unit == "m" || unit == "min")                   ? 60.0
+                       : (unit == "h")                                    ? 3600.0
+                                                                          : -1.0;
+    if (used == 0 || !(value >= 0.0) || !std::isfinite(value) || scale < 0.0 ||
+        (unit.empty() && value != std::floor(value)))
+        throw InputError("bbm run", 0, "--checkpoint-every",
+                         "'" + text + "' is not an interval: give steps (5000) or wall time (30min, 2h, 90s)");
+    if (unit.empty()) every.steps = long(value);
+    else every.seconds = value * scale;
+    return every;
+}
+
 int run_model(const RunOptions& opt) {
-    const auto t0 = std::chrono::steady_clock::now();
     std::string model_path = opt.model;
     std::ifstream checkpoint;
+    CheckpointHeader header;
     if (opt.resume) {
-        checkpoint.open(opt.out / "checkpoint.bin", std::ios::binary);
-        if (!checkpoint)
-            throw InputError((opt.out / "checkpoint.bin").string(), 0, "",
-                             "no checkpoint to resume from (run with --checkpoint-every N, or stop a run with Ctrl-C)");
-        model_path = RunOutput::read_model_name(checkpoint);
+        if (!open_checkpoint(opt, checkpoint, header)) return 0;
+        const fs::path file = opt.out / "checkpoint.bin";
+        if (!opt.model.empty() && fs::absolute(opt.model).lexically_normal() != fs::path(header.model).lexically_normal())
+            throw InputError(file.string(), 0, "",
+                             "the checkpoint is of the model " + header.model + ", not " + opt.model +
+                                 " (resume without a model file, or run " + opt.model + " into another --out)");
+        model_path = header.model;
+        if (!fs::exists(model_path))
+            throw InputError(file.string(), 0, "", "the checkpoint's model file " + model_path + " is gone");
+        if (text_hash(read_file_text(model_path)) != header.model_hash)
+            throw InputError(model_path, 0, "",
+                             "the model file changed since " + file.string() +
+                                 " was written (its text no longer matches the checkpoint's model hash): resume "
+                                 "with the file as it was, or run the edited model from the start");
     }
     io::ModelFile model = io::read_model(model_path);
     model.analysis.solver.threads = opt.threads;
@@ -245,35 +419,53 @@ int run_model(const RunOptions& opt) {
                      model_path.c_str(), rigid, blocks.block_count() - rigid, solver->zones().size(),
                      solver->contacts().size(), solver->timestep(),
                      model.analysis.solver.mode == SolverSpec::Mode::quasi_static ? "quasi-static" : "dynamic");
-    RunOutput output(opt.out, model.analysis, *solver, opt, fs::absolute(model_path).string());
+    RunOutput output(opt.out, model.analysis, *solver, opt, fs::absolute(model_path).lexically_normal().string(),
+                     text_hash(read_file_text(model_path)));
     StageCursor start;
     if (opt.resume) {
-        output.restore(checkpoint);
-        solver->load_state(checkpoint);
+        const fs::path file = opt.out / "checkpoint.bin";
+        try {
+            output.restore(checkpoint, header);
+            solver->load_state(checkpoint);
+        } catch (const std::runtime_error& e) {
+            // A checkpoint that does not fit this model or this bbm is bad input, not a crash.
+            throw InputError(file.string(), 0, "", e.what());
+        }
         start = output.cursor();
         if (!opt.quiet)
-            std::fprintf(stderr, "resuming at step %ld (stage %d, step %ld in it)\n", solver->steps(), start.stage + 1,
-                         start.step);
+            std::fprintf(stderr,
+                         "resuming %s at step %ld (stage %d '%s', step %ld in it; checkpoint format %u, written by bbm %s "
+                         "on %d thread%s)\n",
+                         model_path.c_str(), solver->steps(), start.stage + 1, header.stage.c_str(), start.step,
+                         header.format, header.bbm_version.c_str(), header.threads, header.threads == 1 ? "" : "s");
     }
-    interrupted = false;
-    std::signal(SIGINT, [](int) { interrupted = true; });
-    std::signal(SIGTERM, [](int) { interrupted = true; });
-    std::vector<StageReport> reports;
+    interrupted = 0;
+    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, [](int signal) { interrupted = signal; });
     std::string health;
+    std::vector<StageReport> this_part;
     try {
-        reports = run_stages(*solver, model.analysis.stages, output, start);
+        this_part = run_stages(*solver, model.analysis.stages, output, start);
     } catch (const NumericalError& e) {
         health = e.what();
     }
-    if (interrupted) {
+    const int stop_signal = interrupted.load();
+    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, SIG_DFL);
+    if (stop_signal != 0) {
         output.write_checkpoint(*solver);
         if (!opt.quiet)
-            std::fprintf(stderr, "\ninterrupted at step %ld: wrote %s; continue with: bbm run --resume --out %s\n",
+            std::fprintf(stderr, "\n%s at step %ld: wrote %s; continue with: bbm run --resume --out %s\n",
+                         stop_signal < 0 ? "stopped (--stop-at-step)"
+                         : stop_signal == SIGINT ? "interrupted (SIGINT)"
+                         : stop_signal == SIGTERM ? "interrupted (SIGTERM)" : "interrupted (SIGUSR1)",
                          solver->steps(), (opt.out / "checkpoint.bin").string().c_str(), opt.out.string().c_str());
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, interrupted.load(),
-                                         health.empty() && !interrupted.load());
+    // The stages finished (before a resume too) and, if the run stopped inside one, that stage so far.
+    std::vector<StageReport> reports = output.reports();
+    if (stop_signal != 0 && !this_part.empty() && int(reports.size()) == output.cursor().stage)
+        reports.push_back(this_part.back());
+    const double seconds = output.wall_seconds();
+    nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, stop_signal != 0,
+                                         health.empty() && stop_signal == 0);
     const auto& rep = model.analysis.report;
     FailurePlotOptions fo;
     fo.title = model_path;
@@ -312,7 +504,7 @@ int run_model(const RunOptions& opt) {
         std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
                      opt.out.string().c_str());
     }
-    return interrupted ? 130 : 0;
+    return stop_signal != 0 ? 130 : 0;
 }
 
 int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet) {

@@ -6,8 +6,9 @@
 // history.png, and checkpoint.bin when asked for or interrupted. Every file is
 // written atomically, so a run killed at any moment leaves the previous good
 // version of each file. `--resume DIR` rebuilds the model from the file named in
-// the checkpoint and continues; the result is identical (same state hash) to an
-// uninterrupted run with the same thread count.
+// the checkpoint (refusing it if the file changed since) and continues; the result
+// is identical (same state hash) to an uninterrupted run, on any thread count.
+// What a checkpoint holds: docs/theory.md §10.1.
 #pragma once
 
 #include <filesystem>
@@ -17,19 +18,35 @@
 namespace bbm::studies {
 
 
+/// How often a run writes its checkpoint: every `steps` steps, or every
+/// `seconds` of wall time (the first that is due), besides when interrupted.
+struct CheckpointInterval {
+    long steps = 0;
+    double seconds = 0.0;
+};
+/// "5000" (steps), "30min" or "30m" (wall minutes), "2h", "90s": throws InputError
+/// naming `--checkpoint-every` for anything else.
+CheckpointInterval parse_checkpoint_interval(const std::string& text);
+
 struct RunOptions {
-    std::string model;              ///< model file (ignored with resume)
+    std::string model;              ///< model file (with resume: checked against the checkpoint's)
     std::filesystem::path out = "out";
     int threads = 1;
     bool quiet = false;
-    long checkpoint_every = 0;      ///< steps between checkpoints; 0 = only on Ctrl-C
+    CheckpointInterval checkpoint_every; ///< none set: only when interrupted
+    /// Stop after this total step as if interrupted (checkpoint, output, exit 130):
+    /// an exact, repeatable interruption for tests and scripted runs. 0 = never.
+    long stop_at_step = 0;
     bool resume = false;            ///< continue from out/checkpoint.bin
     double max_elements = 0;        ///< overrides [model] max_elements when > 0
     bool check_only = false;        ///< read, generate and set up the model, then stop (--check)
 };
 
-/// Exit status: 0 done, 130 interrupted (a checkpoint was written), 3 stopped by a
-/// numerical health check (the message names the cause and what to change).
+/// Exit status: 0 done (with resume: also when the run had already finished), 130
+/// interrupted (SIGINT, SIGTERM, SIGUSR1 or --stop-at-step; a checkpoint was
+/// written), 3 stopped by a numerical health check (the message names the cause
+/// and what to change), 2 (InputError) a checkpoint of another model, format or
+/// thread-independent state that cannot be resumed.
 /// Throws InputError for bad input, std::runtime_error for other failures.
 int run_model(const RunOptions& options);
 

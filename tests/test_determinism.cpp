@@ -9,6 +9,7 @@
 #include "core/stages.hpp"
 #include "studies/labtest.hpp"
 #include "core/solver.hpp"
+#include "tests/restart.hpp"
 
 #include <doctest/doctest.h>
 
@@ -148,4 +149,15 @@ TEST_CASE("lab tests give the same curve and cracks on 1, 2, 3 and 4 threads") {
             CHECK(same_curve);
         }
     }
+}
+
+// Exact restart on another thread count (issue 27; tests/restart.hpp): stopped on
+// one thread, resumed on 2 and 3, the run ends in the uninterrupted state.
+TEST_CASE("a run stopped on 1 thread and resumed on 2 or 3 ends in the same state: trigon tunnel, deformable lab test") {
+    auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/tunnel_trigon.toml");
+    file.analysis.stages.back().max_steps = 6000; // failure stage cut: 9,000 steps in all
+    test::check_exact_restart({meshing::generate_blocks(file.geometry), file.analysis}, {1901, 5969}, {2, 3});
+    auto o = LabTestOptions::paper_ucs();
+    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.deformable_fraction = 0.95;
+    test::check_exact_restart(test::labtest_model(o, 13000), {7000, 10500}, {2, 3});
 }

@@ -1,8 +1,11 @@
 // The long validation runs (minutes each; CTest label `long`, so `ctest -LE long`
 // leaves them out): the paper's trigon specimen, the calibration of issue 5 and
-// the post-peak targets of issue 12 over three seeds.
+// the post-peak targets of issue 12 over three seeds, exact restart of the
+// deformable tunnel (issue 27).
+#include "io/model_input.hpp"
 #include "studies/calibrate.hpp"
 #include "studies/labtest.hpp"
+#include "tests/restart.hpp"
 #include "tests/specimens.hpp"
 
 #include <doctest/doctest.h>
@@ -172,4 +175,10 @@ TEST_CASE("post-peak, 3 seeds: rigid and deformable blocks (f = 0.5 and 0.95, 4 
         for (int k = 0; k < 3; ++k)
             CHECK(deformable[k].peak_stress == doctest::Approx(rigid[k].peak_stress).epsilon(0.15));
     }
+}
+
+TEST_CASE("restart: the deformable tunnel (f = 0.95) stopped in its excavation and in its failure resumes exactly") {
+    // The whole run on 2 threads (33,000 steps), resumed on 1 (issue 27).
+    auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/compare_rigid_deformable/deformable_f095.toml");
+    test::check_exact_restart({meshing::generate_blocks(file.geometry), file.analysis}, {2000, 9000}, {1}, 2);
 }

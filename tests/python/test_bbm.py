@@ -153,6 +153,35 @@ def test_step_callback_checkpoint_and_resume(tmp_path):
     assert m.steps == 45
 
 
+def test_trigon_tunnel_checkpoint_mid_excavation_resumes_exactly(tmp_path):
+    """Issue 27: stopped while contacts are born and renumbered, the trigon
+    tunnel resumed through Model.resume (on another thread count) ends in the
+    state of the uninterrupted run (its failure stage cut to 6,000 steps)."""
+    d = tomllib.loads((SOURCE / "examples/tunnel_trigon.toml").read_text())
+    for stage in d["stage"]:
+        if stage["name"] == "failure":
+            stage["max_steps"] = 6000
+    ref = bbm.Model.from_dict(d)
+    ref.run()
+    m = bbm.Model.from_dict(d)
+    m.run(callback=lambda model: model.steps < 1901, every=1)
+    assert m.steps == 1901
+    m.checkpoint(tmp_path / "trigon.bin")
+    resumed = bbm.Model.resume(str(tmp_path / "trigon.bin"), threads=2)
+    resumed.run()
+    s, r = resumed.summary(), ref.summary()
+    assert s["steps"] == r["steps"] == 9000
+    assert s["cracks"] == r["cracks"]
+    assert s["state_hash"] == r["state_hash"]
+
+
+def test_checkpoint_of_an_older_format_is_refused(tmp_path):
+    old = tmp_path / "old.bin"
+    old.write_bytes(b"bbm-model-checkpoint-1" + bytes(64))
+    with pytest.raises(bbm.InputError, match="format 1"):
+        bbm.Model.resume(str(old))
+
+
 def test_callback_exception_stops_and_propagates():
     m = bbm.Model(str(INSITU))
 
