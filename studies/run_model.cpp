@@ -374,6 +374,15 @@ CheckpointInterval parse_checkpoint_interval(const std::string& text) {
 }
 
 int run_model(const RunOptions& opt) {
+    // From the start: a scheduler's signal during meshing or the elastic solve
+    // must not kill the run either (it stops after the first step).
+    interrupted = 0;
+    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, [](int signal) { interrupted = signal; });
+    struct DefaultSignals {
+        ~DefaultSignals() {
+            for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, SIG_DFL);
+        }
+    } restore_signals;
     std::string model_path = opt.model;
     std::ifstream checkpoint;
     CheckpointHeader header;
@@ -439,8 +448,6 @@ int run_model(const RunOptions& opt) {
                          model_path.c_str(), solver->steps(), start.stage + 1, header.stage.c_str(), start.step,
                          header.format, header.bbm_version.c_str(), header.threads, header.threads == 1 ? "" : "s");
     }
-    interrupted = 0;
-    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, [](int signal) { interrupted = signal; });
     std::string health;
     std::vector<StageReport> this_part;
     try {
@@ -449,7 +456,6 @@ int run_model(const RunOptions& opt) {
         health = e.what();
     }
     const int stop_signal = interrupted.load();
-    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, SIG_DFL);
     if (stop_signal != 0) {
         output.write_checkpoint(*solver);
         if (!opt.quiet)
