@@ -109,8 +109,9 @@ int main(int argc, char** argv) {
     };
     Solver *whole = nullptr, *resumed = nullptr;
     const auto [ha, hb] = run(last, whole, resumed);
-    std::printf("stopped at step %ld; continued to %ld (whole) and %ld (resumed)\n", stop,
-                ha.empty() ? stop : ha.back().first, hb.empty() ? stop : hb.back().first);
+    std::printf("stopped at step %ld; continued to %ld (whole) and %ld (resumed); contacts created by the end: %d\n", stop,
+                ha.empty() ? stop : ha.back().first, hb.empty() ? stop : hb.back().first,
+                whole->detection_totals().created);
     long first = -1;
     for (std::size_t k = 0; k < std::min(ha.size(), hb.size()) && first < 0; ++k)
         if (ha[k] != hb[k]) first = ha[k].first;
