@@ -527,7 +527,12 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
     // The models over ranks under mpirun (one after another within a rank, each on
     // `threads` threads); rank 0 tabulates them.
     const bool parallel = Ranks::size() > 1;
+    // Interrupted (Ctrl-C, a scheduler's signal): the model running checkpoints and
+    // the rest of this rank's models are not started; `bbm run --resume --out
+    // DIR/<model>` continues each.
+    bool stopped = false;
     const auto codes = run_spread(int(models.size()), 1, [&](int k) {
+        if (stopped) return std::string("not started");
         const std::string name = fs::path(models[k]).stem().string();
         RunOptions o;
         o.model = models[k];
@@ -535,7 +540,9 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         o.threads = threads;
         o.quiet = quiet || parallel;
         if (!o.quiet) std::fprintf(stderr, "== %s\n", name.c_str());
-        return std::to_string(run_model(o));
+        const int rc = run_model(o);
+        stopped = stopped || rc == 130;
+        return std::to_string(rc);
     });
     if (!Ranks::root()) return 0;
     for (std::size_t m = 0; m < models.size(); ++m) {
@@ -543,6 +550,7 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         const std::string name = fs::path(model).stem().string();
         RunOptions o;
         o.out = out / name;
+        if (codes[m] == "not started") continue; // the comparison was interrupted before it
         const int rc = std::stoi(codes[m]);
         if (rc != 0 && status == 0) status = rc;
         std::ifstream f(o.out / "summary.json");
@@ -558,8 +566,9 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
                       get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
                       int(get("cracks_crown_sector")));
         csv << row;
+        const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
         std::snprintf(row, sizeof row, "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d |\n",
-                      name.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
+                      shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
                       1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
