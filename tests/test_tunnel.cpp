@@ -5,6 +5,7 @@
 #include "core/stages.hpp"
 #include "studies/opening.hpp"
 #include "core/solver.hpp"
+#include "tests/restart.hpp"
 
 #include <doctest/doctest.h>
 
@@ -40,19 +41,6 @@ TunnelRun run_tunnel(const std::string& name, long max_steps = 0) {
     return {measure_opening(s, {0, 0}, {4, 0}, {0, 4}), s.cracks(contact::JointState::broken_tension),
             s.cracks(contact::JointState::broken_shear)};
 }
-
-/// Stops the run after `stop_at` steps, keeping the cursor reached.
-struct StopAt : StageObserver {
-    long stop_at;
-    StageCursor cursor;
-    bool stop = false;
-    explicit StopAt(long n) : stop_at(n) {}
-    void at(const Solver& s, const StageCursor& c) override {
-        cursor = c;
-        stop = s.steps() >= stop_at;
-    }
-    bool stop_requested() override { return stop; }
-};
 
 // Kirsch, plane strain, infinite plate, vertical p = 15 MPa and horizontal 7.5 MPa
 // (SPEC §8): hoop stress (compression positive, MPa) on the springline and crown lines.
@@ -98,37 +86,21 @@ TEST_CASE("tunnel: elastic Voronoi model — hoop stress within 15% of Kirsch at
 
 TEST_CASE("tunnel: a run resumed from a checkpoint ends in the same state as an uninterrupted one") {
     // The Voronoi tunnel through excavation into the failure stage (detection,
-    // cracking, deformable far field), stopped mid-stage and resumed in a new solver.
+    // cracking, deformable far field), stopped mid-stage and resumed in a new
+    // solver (more models and stops: test_restart.cpp).
     auto file = read_example("tunnel_voronoi.toml");
     file.analysis.stages.back().max_steps = 1500;
     file.analysis.stages.back().ratio = 1e-9;
-    file.analysis.solver.threads = 1;
     const auto blocks = meshing::generate_blocks(file.geometry);
-    Solver whole(blocks, file.analysis);
-    Quiet q;
-    run_stages(whole, file.analysis.stages, q);
-
-    Solver first(blocks, file.analysis);
-    StopAt stop(3700); // inside the last stage (excavation relaxes over 3000 steps)
-    run_stages(first, file.analysis.stages, stop);
-    REQUIRE(first.steps() == 3700);
-    std::stringstream checkpoint;
-    first.save_state(checkpoint);
-
-    Solver resumed(blocks, file.analysis);
-    resumed.load_state(checkpoint);
-    CHECK(resumed.state_hash() == first.state_hash());
-    run_stages(resumed, file.analysis.stages, q, stop.cursor);
-    CHECK(resumed.steps() == whole.steps());
-    CHECK(resumed.state_hash() == whole.state_hash());
-    CHECK(resumed.cracks(contact::JointState::broken_tension) == whole.cracks(contact::JointState::broken_tension));
+    test::check_exact_restart({blocks, file.analysis}, {3700}, {1}); // excavation relaxes over 3000 steps
 
     // A checkpoint of another model is refused with a reason.
+    Solver first(blocks, file.analysis);
+    std::stringstream checkpoint;
+    first.save_state(checkpoint);
     auto other = read_example("verification/stack.toml");
     Solver wrong(meshing::generate_blocks(other.geometry), other.analysis);
-    std::stringstream again;
-    first.save_state(again);
-    CHECK_THROWS_WITH_AS(wrong.load_state(again), doctest::Contains("different model"), std::runtime_error);
+    CHECK_THROWS_WITH_AS(wrong.load_state(checkpoint), doctest::Contains("different model"), std::runtime_error);
 }
 
 TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown") {
