@@ -4,6 +4,7 @@
 //   bbm run MODEL.toml --out DIR    generate it and run the model file's stages
 //   bbm compare A.toml B.toml ...   run several models, tabulate and plot them
 //   bbm ucs | tension | biaxial | brazilian [flags]   numerical lab tests (SPEC §8)
+//   bbm envelope [flags]            the strength envelope: UCS, tension, biaxial; Hoek-Brown and Mohr-Coulomb fits
 //   bbm calibrate [flags]           micro-properties from macro targets
 //   bbm sweep MODEL --set KEY=V1,V2 --seeds S   runs over key values and seeds
 // Under mpirun the independent runs (realizations, calibration runs, compared
@@ -17,6 +18,7 @@
 #include "io/model_input.hpp"
 #include "studies/cli_checks.hpp"
 #include "studies/commands.hpp"
+#include "studies/envelope.hpp"
 #include "studies/ranks.hpp"
 #include "studies/run_model.hpp"
 #include "studies/sweep.hpp"
@@ -148,6 +150,15 @@ int run_cli(int argc, char** argv) {
                      "Exit status 4 if not converged.");
     studies::add_calibrate_options(calibrate_cmd, calibrate_values, quiet);
 
+    studies::EnvelopeOptions envelope_values;
+    auto* envelope_cmd = app.add_subcommand(
+        "envelope", "The strength envelope of a block model as a laboratory measures it: uniaxial compression, a "
+                    "tension test and biaxial tests at several confinements (--confinements), --realizations seeds "
+                    "each; fits Hoek-Brown (sigma_ci, mi) and Mohr-Coulomb (c, phi) to the peaks, and reports "
+                    "sigma_ci and sigma_cd at each confinement. Writes envelope.json, envelope.csv and envelope.png "
+                    "in --out.");
+    studies::add_envelope_options(envelope_cmd, envelope_values, quiet);
+
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     const std::pair<const char*, const char*> labtests[] = {
         {"ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, the paper's calibration run "
@@ -196,6 +207,7 @@ int run_cli(int argc, char** argv) {
             run_options.check_only = check_only;
             return studies::run_model(run_options);
         }
+        if (*envelope_cmd) return studies::run_envelope(envelope_values, quiet, check_only);
         if (*calibrate_cmd) {
             studies::note_given_joint_values(*calibrate_cmd, calibrate_values);
             return studies::run_calibrate(calibrate_values, quiet, check_only);

@@ -252,7 +252,7 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
 }
 
 void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
-                 const std::filesystem::path& file, const std::string& title, bool log_y) {
+                 const std::filesystem::path& file, const std::string& title, bool log_y, bool legend_left) {
     const int w = 900, h = 600;
     const double left = 100, right = 30, top = 50, bottom = 70;
     Canvas canvas(file, w, h);
@@ -304,25 +304,39 @@ void draw_curves(const std::vector<Series>& series, const std::string& x_label, 
     text(cr, 0, 0, y_label, 14, true);
     cairo_restore(cr);
     if (!title.empty()) text(cr, 0.5 * w, 30, title, 16, true);
-    constexpr std::array<Rgb, 4> colours{{{0.1, 0.2, 0.7}, {0.8, 0.1, 0.1}, {0.1, 0.55, 0.2}, {0.5, 0.3, 0.6}}};
+    constexpr std::array<Rgb, 6> colours{
+        {{0.1, 0.2, 0.7}, {0.8, 0.1, 0.1}, {0.1, 0.55, 0.2}, {0.5, 0.3, 0.6}, {0.9, 0.55, 0.0}, {0.3, 0.3, 0.3}}};
+    auto marker = [&](double x, double y) {
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, x, y, 3.5, 0, 2 * M_PI);
+    };
     for (std::size_t k = 0; k < series.size(); ++k) {
         const auto& s = series[k];
         const Rgb col = colours[k % colours.size()];
+        const bool points = s.style == Series::Style::points;
         cairo_set_source_rgb(cr, col.r, col.g, col.b);
         cairo_set_line_width(cr, 1.8);
         bool pen = false;
         for (std::size_t i = 0; i < s.x.size(); ++i) {
             if (log_y && !(s.y[i] > 0)) { pen = false; continue; }
-            if (pen) cairo_line_to(cr, px(s.x[i]), py(s.y[i]));
+            if (points) marker(px(s.x[i]), py(s.y[i]));
+            else if (pen) cairo_line_to(cr, px(s.x[i]), py(s.y[i]));
             else cairo_move_to(cr, px(s.x[i]), py(s.y[i]));
             pen = true;
         }
-        cairo_stroke(cr);
+        if (points) cairo_fill(cr);
+        else cairo_stroke(cr);
         if (series.size() > 1) {
-            cairo_move_to(cr, w - right - 200, top + 20 + 18 * k), cairo_line_to(cr, w - right - 175, top + 20 + 18 * k);
-            cairo_stroke(cr);
+            const double ly = top + 20 + 18 * k, lx = legend_left ? left + 215 : w - right;
+            if (points) {
+                marker(lx - 187.5, ly);
+                cairo_fill(cr);
+            } else {
+                cairo_move_to(cr, lx - 200, ly), cairo_line_to(cr, lx - 175, ly);
+                cairo_stroke(cr);
+            }
             cairo_set_source_rgb(cr, 0, 0, 0);
-            text(cr, w - right - 168, top + 25 + 18 * k, s.label, 12);
+            text(cr, lx - 168, ly + 5, s.label, 12);
         }
     }
     canvas.finish();

@@ -44,10 +44,15 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
 struct Series {
     std::string label;
     std::vector<double> x, y;
+    /// Joined by a line, or each point a marker (measurements beside a fitted curve).
+    enum class Style { line, points } style = Style::line;
 };
 
-/// Line plot of one or more series with axes, ticks and labels.
+/// Plot of one or more series (lines or markers) with axes, ticks, labels and,
+/// for several series, a legend.
+/// The legend goes top right, or top left with `legend_left` (curves that rise to the right).
 void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
-                 const std::filesystem::path& file, const std::string& title = {}, bool log_y = false);
+                 const std::filesystem::path& file, const std::string& title = {}, bool log_y = false,
+                 bool legend_left = false);
 
 } // namespace bbm::io

@@ -15,6 +15,7 @@
 // 1,000 steps, takes it back.
 #include "base/error.hpp"
 #include "studies/commands.hpp"
+#include "studies/envelope.hpp"
 #include "studies/model.hpp"
 
 #include <nlohmann/json.hpp>
@@ -440,6 +441,14 @@ PYBIND11_MODULE(_bbm, mod) {
         }
         return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), curves);
     }, py::arg("command"), py::arg("args"), py::arg("quiet"), py::arg("callback") = py::none());
+    mod.def("_envelope", [](const std::vector<std::string>& args, bool quiet) {
+        std::string json;
+        {
+            py::gil_scoped_release release;
+            json = studies::run_envelope_args(args, quiet).summary_json;
+        }
+        return py::module_::import("json").attr("loads")(json);
+    });
     mod.def("_calibrate", [](const std::vector<std::string>& args, bool quiet) {
         std::string json;
         {

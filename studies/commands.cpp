@@ -423,8 +423,7 @@ void check_specimen_size(const LabTestCli& c) {
 
 } // namespace
 
-int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bool check_only, LabTestStudy* study) {
-    const char* name = labtest_name(kind);
+void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind) {
     auto& o = c.o;
     o.kind = kind;
     apply_pattern_flags(c);
@@ -432,9 +431,21 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
     o.rough_platens = c.platens == "rough";
     if (o.platen_friction >= 0.0 && (kind == LabTestOptions::Kind::tension || kind == LabTestOptions::Kind::brazilian))
         throw InputError("--platen-friction", 0, "",
-                         std::string("applies to ucs and biaxial only: ") + name +
+                         std::string("applies to ucs and biaxial only: ") + labtest_name(kind) +
                              " needs platens that hold the specimen (use --platens rough or smooth)");
     check_specimen_size(c);
+}
+
+std::string labtest_record_text(const LabTestResult& r) { return labtest_record(r).dump(); }
+
+LabTestResult labtest_from_record_text(const std::string& text) {
+    return labtest_from_record(nlohmann::json::parse(text));
+}
+
+int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bool check_only, LabTestStudy* study) {
+    const char* name = labtest_name(kind);
+    auto& o = c.o;
+    prepare_labtest(c, kind);
     if (check_only) return 0;
     const fs::path out = c.out;
     const bool write = c.write_files;

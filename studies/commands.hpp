@@ -71,6 +71,15 @@ int run_labtest_command(LabTestCli& values, LabTestOptions::Kind kind, bool quie
 LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,
                               const std::function<void(const Solver&, const StressStrainPoint&, int)>& on_frame = {});
 
+/// For the studies built on lab tests (calibrate, envelope): the flags' values
+/// applied to c.o for a test of this kind (pattern, softening curves, platens),
+/// and the specimen checked before anything is generated. Throws InputError
+/// naming the flag.
+void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind);
+/// A result as it travels between ranks (JSON text; doubles round-trip exactly), and back.
+std::string labtest_record_text(const LabTestResult& r);
+LabTestResult labtest_from_record_text(const std::string& text);
+
 /// `bbm calibrate`'s values.
 struct CalibrateCli {
     LabTestCli lab;

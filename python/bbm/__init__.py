@@ -28,7 +28,7 @@ from ._bbm import (  # noqa: F401  (re-exported)
     NumericalError,
     ZoneArrays,
 )
-from ._bbm import _calibrate, _labtest
+from ._bbm import _calibrate, _envelope, _labtest
 
 __all__ = [
     "Model", "InputError", "NumericalError", "ucs", "tension", "biaxial", "brazilian", "calibrate", "to_toml",
@@ -179,6 +179,18 @@ def biaxial(quiet=True, callback=None, **options):
 def brazilian(quiet=True, callback=None, **options):
     """Brazilian test of a disc of diameter ``width``; options as ``bbm brazilian`` (see ucs())."""
     return _run_labtest("brazilian", quiet, callback, options)
+
+
+def envelope(quiet=True, **options):
+    """The strength envelope of a block model, as ``bbm envelope``: uniaxial
+    compression, a tension test and biaxial tests at ``confinements`` (Pa; default
+    0.1-0.5 x the UCS), ``realizations`` seeds each, with the lab-test options
+    (``size=0.3, pattern="trigon"``...). Returns the dict of envelope.json:
+    ``ucs``, ``tension``, ``levels`` (peak, sigma_ci, sigma_cd per confinement),
+    ``hoek_brown`` (sigma_ci, mi, rms), ``mohr_coulomb`` (cohesion, friction_deg),
+    the crack-initiation and crack-damage lines and every run. Files are written
+    only with ``out``."""
+    return _envelope(_option_args(options), quiet)
 
 
 def calibrate(quiet=True, **options):

@@ -1,0 +1,435 @@
+#include "studies/envelope.hpp"
+
+#include "base/error.hpp"
+#include "io/picture.hpp"
+#include "io/vtk_output.hpp"
+#include "studies/cli_checks.hpp"
+#include "studies/ranks.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <thread>
+
+namespace bbm::studies {
+
+namespace fs = std::filesystem;
+
+// --- fits ----------------------------------------------------------------------
+
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
+    LineFit f;
+    const std::size_t n = std::min(x.size(), y.size());
+    if (n < 2) return f;
+    double mx = 0.0, my = 0.0;
+    for (std::size_t i = 0; i < n; ++i) mx += x[i], my += y[i];
+    mx /= double(n), my /= double(n);
+    double sxx = 0.0, sxy = 0.0;
+    for (std::size_t i = 0; i < n; ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+    if (!(sxx > 0.0)) return f; // one abscissa: no line
+    f.slope = sxy / sxx;
+    f.intercept = my - f.slope * mx;
+    double ss = 0.0;
+    for (std::size_t i = 0; i < n; ++i) ss += std::pow(f.intercept + f.slope * x[i] - y[i], 2);
+    f.rms = std::sqrt(ss / double(n));
+    f.valid = true;
+    return f;
+}
+
+double HoekBrownFit::sigma1(double s3) const {
+    const double inner = mi * s3 / sigma_ci + 1.0;
+    return s3 + sigma_ci * std::sqrt(std::max(0.0, inner));
+}
+
+double HoekBrownFit::tensile_strength() const { return 0.5 * sigma_ci * (std::sqrt(mi * mi + 4.0) - mi); }
+
+HoekBrownFit fit_hoek_brown(const std::vector<double>& s3, const std::vector<double>& s1) {
+    // In A = σci², B = mi σci the criterion is σ1 = σ3 + √(A + B σ3): Hoek's
+    // linearisation (σ1 − σ3)² = A + B σ3 starts, Gauss–Newton on the σ1
+    // residuals finishes (the linearised fit weighs the high-confinement points
+    // by (σ1 − σ3)², not as a laboratory's least squares on σ1 would).
+    HoekBrownFit f;
+    const std::size_t n = std::min(s3.size(), s1.size());
+    std::vector<double> y(n);
+    for (std::size_t i = 0; i < n; ++i) y[i] = (s1[i] - s3[i]) * (s1[i] - s3[i]);
+    const LineFit start = fit_line(s3, y);
+    if (!start.valid || !(start.intercept > 0.0)) return f;
+    double A = start.intercept, B = start.slope;
+    auto cost = [&](double a, double b) {
+        double ss = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double q = a + b * s3[i];
+            if (!(q > 0.0)) return double(INFINITY);
+            ss += std::pow(s3[i] + std::sqrt(q) - s1[i], 2);
+        }
+        return ss;
+    };
+    double current = cost(A, B);
+    for (int iteration = 0; iteration < 100 && std::isfinite(current); ++iteration) {
+        // Normal equations of the 2 × 2 Gauss–Newton step.
+        double jaa = 0.0, jab = 0.0, jbb = 0.0, ga = 0.0, gb = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double root = std::sqrt(A + B * s3[i]);
+            const double r = s3[i] + root - s1[i], da = 0.5 / root, db = 0.5 * s3[i] / root;
+            jaa += da * da, jab += da * db, jbb += db * db, ga += da * r, gb += db * r;
+        }
+        const double det = jaa * jbb - jab * jab;
+        if (!(std::abs(det) > 0.0)) break;
+        const double stepA = -(jbb * ga - jab * gb) / det, stepB = -(jaa * gb - jab * ga) / det;
+        double t = 1.0, next = cost(A + stepA, B + stepB);
+        while (!(next <= current) && t > 1e-6) t *= 0.5, next = cost(A + t * stepA, B + t * stepB);
+        if (!(next <= current)) break;
+        A += t * stepA, B += t * stepB;
+        const bool done = current - next <= 1e-15 * current;
+        current = next;
+        if (done) break;
+    }
+    f.sigma_ci = std::sqrt(A);
+    f.mi = B / f.sigma_ci;
+    f.rms = std::sqrt(current / double(n));
+    f.valid = std::isfinite(f.rms);
+    return f;
+}
+
+MohrCoulombFit fit_mohr_coulomb(const std::vector<double>& s3, const std::vector<double>& s1) {
+    MohrCoulombFit f;
+    const LineFit line = fit_line(s3, s1);
+    if (!line.valid || !(line.slope >= 1.0)) return f;
+    f.sigma_c = line.intercept, f.slope = line.slope, f.rms = line.rms;
+    const double sin_phi = (line.slope - 1.0) / (line.slope + 1.0);
+    const double phi = std::asin(sin_phi);
+    f.friction_deg = phi * 180.0 / std::numbers::pi;
+    f.cohesion = line.intercept * (1.0 - sin_phi) / (2.0 * std::cos(phi));
+    f.valid = true;
+    return f;
+}
+
+std::vector<std::pair<double, double>> read_strength_record(const std::string& file) {
+    std::ifstream in(file);
+    if (!in) throw InputError(file, 0, "", "cannot open the strength record");
+    std::vector<std::pair<double, double>> out;
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+        if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') continue;
+        std::replace(line.begin(), line.end(), ',', ' ');
+        std::istringstream fields(line);
+        double s3 = 0.0, s1 = 0.0;
+        if (!(fields >> s3 >> s1)) {
+            if (out.empty() && number == 1) continue; // a header
+            throw InputError(file, number, "", "expected two numbers, sigma3 and sigma1 in MPa");
+        }
+        if (!std::isfinite(s3) || !std::isfinite(s1) || s1 < s3)
+            throw InputError(file, number, "", "sigma1 must be finite and at least sigma3 (MPa)");
+        out.push_back({s3 * 1e6, s1 * 1e6});
+    }
+    if (out.empty()) throw InputError(file, 0, "", "no sigma3, sigma1 pairs in the record");
+    return out;
+}
+
+// --- the study -----------------------------------------------------------------
+
+namespace {
+
+struct Job {
+    LabTestOptions::Kind kind;
+    double confinement;
+    int realization;
+};
+
+const char* test_name(LabTestOptions::Kind k) {
+    switch (k) {
+    case LabTestOptions::Kind::ucs: return "ucs";
+    case LabTestOptions::Kind::tension: return "tension";
+    case LabTestOptions::Kind::biaxial: return "biaxial";
+    case LabTestOptions::Kind::brazilian: return "brazilian";
+    }
+    return "?";
+}
+
+nlohmann::json stats(const std::vector<double>& v) {
+    double m = 0.0, s = 0.0;
+    for (double x : v) m += x;
+    m /= std::max<std::size_t>(1, v.size());
+    for (double x : v) s += (x - m) * (x - m);
+    return {{"mean", m}, {"std", v.size() > 1 ? std::sqrt(s / double(v.size() - 1)) : 0.0}, {"n", v.size()}};
+}
+
+} // namespace
+
+int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
+    quiet = quiet || !Ranks::root();
+    LabTestCli& c = e.lab;
+    for (double s3 : e.confinements)
+        if (!(s3 > 0.0) || !std::isfinite(s3))
+            throw InputError("--confinements", 0, "", "each confinement must be a positive stress in Pa");
+    std::vector<std::pair<double, double>> record;
+    if (!e.target_record.empty()) record = read_strength_record(e.target_record);
+    if ((e.target_sigma_ci > 0.0) != (e.target_mi > 0.0))
+        throw InputError(e.target_mi > 0.0 ? "--target-sigma-ci" : "--target-mi", 0, "",
+                         "--target-sigma-ci and --target-mi go together (the Hoek-Brown record to draw)");
+    // The tests' options: compression as given; tension loaded like `bbm tension`
+    // (ten times slower: it peaks at a tenth of the strain), Brazilian like `bbm brazilian`.
+    const bool brazilian = e.tension_test == "brazilian";
+    LabTestCli compression = c, tension = c;
+    prepare_labtest(compression, LabTestOptions::Kind::ucs);
+    const auto tension_kind = brazilian ? LabTestOptions::Kind::brazilian : LabTestOptions::Kind::tension;
+    if (brazilian) tension.o.width = e.brazilian_diameter;
+    tension.o.strain_per_step = c.o.strain_per_step * (brazilian ? 0.2 : 0.1);
+    tension.o.platen_friction = -1.0;
+    prepare_labtest(tension, tension_kind);
+    if (check_only) return 0;
+    const fs::path out = c.out;
+    if (c.write_files && Ranks::root()) io::make_output_directory(out);
+
+    const int n = c.realizations;
+    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
+    const bool one_at_a_time = c.o.deformable_fraction > 0.0;
+    std::vector<EnvelopeRun> runs;
+    auto run_jobs = [&](const std::vector<Job>& jobs) {
+        const int side_by_side = one_at_a_time ? 1 : std::max(1, std::min(int(jobs.size()), available));
+        const auto texts = run_spread(int(jobs.size()), side_by_side, [&](int k) {
+            const Job& job = jobs[k];
+            LabTestOptions o = job.kind == tension_kind ? tension.o : compression.o;
+            o.kind = job.kind;
+            o.confinement = job.confinement;
+            o.seed = c.o.seed + std::uint64_t(job.realization);
+            o.frame_every = 0;
+            o.threads = side_by_side == 1 ? available : 1;
+            try {
+                return labtest_record_text(run_labtest(o));
+            } catch (const GeometryError& error) {
+                throw InputError("--size", 0, "", error.what());
+            }
+        });
+        for (std::size_t k = 0; k < jobs.size(); ++k) {
+            EnvelopeRun r{test_name(jobs[k].kind), jobs[k].confinement, c.o.seed + std::uint64_t(jobs[k].realization),
+                          labtest_from_record_text(texts[k])};
+            if (!quiet)
+                std::fprintf(stderr, "  %-9s sigma3 %6.2f MPa seed %3llu: peak %8.2f MPa  sigma_ci %7.2f  sigma_cd %7.2f  "
+                                     "%ld steps %6.1f s\n",
+                             r.test.c_str(), r.confinement / 1e6, static_cast<unsigned long long>(r.seed),
+                             r.result.peak_stress / 1e6, r.result.crack_initiation_stress / 1e6,
+                             r.result.crack_damage_stress / 1e6, r.result.steps, r.result.wall_seconds);
+            runs.push_back(std::move(r));
+        }
+    };
+    if (!quiet)
+        std::fprintf(stderr, "bbm envelope: %s blocks of %.3g m, %g m x %g m, %d realization%s of each test on %d thread%s\n",
+                     c.pattern.c_str(), c.o.size, c.o.width, c.o.height, n, n > 1 ? "s" : "", available,
+                     available > 1 ? "s" : "");
+    // Uniaxial compression and tension first: the default confinements follow the UCS.
+    std::vector<Job> first;
+    for (int k = 0; k < n; ++k) first.push_back({LabTestOptions::Kind::ucs, 0.0, k});
+    for (int k = 0; k < n; ++k) first.push_back({tension_kind, 0.0, k});
+    run_jobs(first);
+    std::vector<double> ucs, strength_t;
+    for (const auto& r : runs)
+        (r.test == "ucs" ? ucs : strength_t)
+            .push_back(r.test == "ucs" ? r.result.peak_stress
+                                       : (brazilian ? r.result.tensile_strength : r.result.peak_stress));
+    double ucs_mean = 0.0;
+    for (double v : ucs) ucs_mean += v / double(ucs.size());
+    std::vector<double> confinements = e.confinements;
+    if (confinements.empty())
+        for (double f : {0.1, 0.2, 0.3, 0.4, 0.5}) confinements.push_back(std::round(f * ucs_mean / 1e5) * 1e5);
+    std::sort(confinements.begin(), confinements.end());
+    confinements.erase(std::unique(confinements.begin(), confinements.end()), confinements.end());
+    std::vector<Job> second;
+    for (double s3 : confinements)
+        for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});
+    run_jobs(second);
+
+    // Fits over every compression peak (σ3 = 0 and the biaxial tests).
+    std::vector<double> s3, s1, ci_x, ci_y, cd_x, cd_y;
+    for (const auto& r : runs) {
+        if (r.test != "ucs" && r.test != "biaxial") continue;
+        s3.push_back(r.confinement), s1.push_back(r.result.peak_stress);
+        if (r.result.crack_initiation_stress > 0.0)
+            ci_x.push_back(r.confinement), ci_y.push_back(r.result.crack_initiation_stress);
+        if (r.result.crack_damage_stress > 0.0)
+            cd_x.push_back(r.confinement), cd_y.push_back(r.result.crack_damage_stress);
+    }
+    const HoekBrownFit hb = fit_hoek_brown(s3, s1);
+    const MohrCoulombFit mc = fit_mohr_coulomb(s3, s1);
+    const LineFit ci_line = fit_line(ci_x, ci_y), cd_line = fit_line(cd_x, cd_y);
+
+    nlohmann::json levels = nlohmann::json::array();
+    std::vector<double> levels_s3{0.0};
+    levels_s3.insert(levels_s3.end(), confinements.begin(), confinements.end());
+    for (double level : levels_s3) {
+        std::vector<double> peak, ci, cd, ci_ratio, cd_ratio, E, nu;
+        for (const auto& r : runs) {
+            if ((r.test != "ucs" && r.test != "biaxial") || r.confinement != level) continue;
+            const auto& x = r.result;
+            peak.push_back(x.peak_stress), E.push_back(x.E), nu.push_back(x.nu);
+            if (x.crack_initiation_stress > 0) ci.push_back(x.crack_initiation_stress), ci_ratio.push_back(x.crack_initiation_stress / x.peak_stress);
+            if (x.crack_damage_stress > 0) cd.push_back(x.crack_damage_stress), cd_ratio.push_back(x.crack_damage_stress / x.peak_stress);
+        }
+        levels.push_back({{"sigma3", level}, {"peak", stats(peak)}, {"sigma_ci", stats(ci)}, {"sigma_cd", stats(cd)},
+                          {"sigma_ci_over_peak", stats(ci_ratio)}, {"sigma_cd_over_peak", stats(cd_ratio)},
+                          {"E", stats(E)}, {"nu", stats(nu)},
+                          {"hoek_brown_sigma1", hb.valid ? hb.sigma1(level) : 0.0},
+                          {"mohr_coulomb_sigma1", mc.valid ? mc.sigma_c + mc.slope * level : 0.0}});
+    }
+    nlohmann::json per_run = nlohmann::json::array();
+    std::ostringstream csv;
+    csv << "test,sigma3_Pa,seed,peak_Pa,sigma_ci_Pa,sigma_cd_Pa,tensile_strength_Pa,E_Pa,nu,cracks_tensile,cracks_shear,"
+           "steps,post_peak_locking\n";
+    csv.precision(10);
+    for (const auto& r : runs) {
+        const auto& x = r.result;
+        per_run.push_back({{"test", r.test}, {"sigma3", r.confinement}, {"seed", r.seed}, {"peak", x.peak_stress},
+                           {"sigma_ci", x.crack_initiation_stress}, {"sigma_cd", x.crack_damage_stress},
+                           {"tensile_strength", x.tensile_strength}, {"E", x.E}, {"nu", x.nu},
+                           {"cracks", {{"tensile", x.cracks_tensile}, {"shear", x.cracks_shear}}},
+                           {"steps", x.steps}, {"wall_seconds", x.wall_seconds},
+                           {"post_peak_locking", x.post_peak_locking}});
+        csv << r.test << ',' << r.confinement << ',' << r.seed << ',' << x.peak_stress << ','
+            << x.crack_initiation_stress << ',' << x.crack_damage_stress << ',' << x.tensile_strength << ',' << x.E
+            << ',' << x.nu << ',' << x.cracks_tensile << ',' << x.cracks_shear << ',' << x.steps << ','
+            << x.post_peak_locking << '\n';
+    }
+    const auto ucs_stats = stats(ucs), t_stats = stats(strength_t);
+    const double t_over_c = ucs_stats["mean"].get<double>() > 0
+                                ? t_stats["mean"].get<double>() / ucs_stats["mean"].get<double>() : 0.0;
+    nlohmann::json summary{
+        {"specimen", {{"pattern", c.pattern}, {"size", c.o.size}, {"width", c.o.width}, {"height", c.o.height},
+                      {"deformable_fraction", c.o.deformable_fraction}, {"seed", c.o.seed}, {"realizations", n}}},
+        {"ucs", ucs_stats},
+        {"tension", {{"test", brazilian ? "brazilian" : "direct"}, {"strength", t_stats}, {"over_ucs", t_over_c}}},
+        {"confinements", confinements},
+        {"levels", levels},
+        {"hoek_brown", {{"valid", hb.valid}, {"sigma_ci", hb.sigma_ci}, {"mi", hb.mi}, {"a", 0.5}, {"rms", hb.rms},
+                        {"tensile_strength", hb.valid ? hb.tensile_strength() : 0.0}}},
+        {"mohr_coulomb", {{"valid", mc.valid}, {"cohesion", mc.cohesion}, {"friction_deg", mc.friction_deg},
+                          {"sigma_c", mc.sigma_c}, {"slope", mc.slope}, {"rms", mc.rms}}},
+        {"crack_initiation_line", {{"valid", ci_line.valid}, {"intercept", ci_line.intercept}, {"slope", ci_line.slope}, {"rms", ci_line.rms}}},
+        {"crack_damage_line", {{"valid", cd_line.valid}, {"intercept", cd_line.intercept}, {"slope", cd_line.slope}, {"rms", cd_line.rms}}},
+        {"runs", per_run}};
+    if (e.target_sigma_ci > 0.0) summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
+    if (!record.empty()) {
+        nlohmann::json pairs = nlohmann::json::array();
+        for (const auto& [a, b] : record) pairs.push_back({a, b});
+        summary["target_record"] = {{"file", e.target_record}, {"pairs", pairs}};
+    }
+
+    if (c.write_files && Ranks::root()) {
+        io::write_text_atomically(out / "envelope.json", summary.dump(2) + "\n");
+        io::write_text_atomically(out / "envelope.csv", csv.str());
+        // σ1 against σ3 (MPa): every realization's peak (the tension tests at
+        // σ3 = −T, σ1 = 0), σci and σcd, the fitted curves and the target record.
+        using Style = io::Series::Style;
+        io::Series peaks{"peaks (each realization)", {}, {}, Style::points};
+        io::Series cis{"sigma_ci", {}, {}, Style::points}, cds{"sigma_cd", {}, {}, Style::points};
+        for (const auto& r : runs) {
+            const auto& x = r.result;
+            if (r.test == "ucs" || r.test == "biaxial") {
+                peaks.x.push_back(r.confinement / 1e6), peaks.y.push_back(x.peak_stress / 1e6);
+                if (x.crack_initiation_stress > 0) cis.x.push_back(r.confinement / 1e6), cis.y.push_back(x.crack_initiation_stress / 1e6);
+                if (x.crack_damage_stress > 0) cds.x.push_back(r.confinement / 1e6), cds.y.push_back(x.crack_damage_stress / 1e6);
+            } else {
+                const double t = brazilian ? x.tensile_strength : x.peak_stress;
+                peaks.x.push_back(-t / 1e6), peaks.y.push_back(0.0);
+            }
+        }
+        std::vector<io::Series> series{peaks, cis, cds};
+        double top = confinements.empty() ? 0.0 : confinements.back();
+        for (const auto& [a, b] : record) top = std::max(top, a);
+        auto curve = [&](const std::string& label, auto sigma1, double from) {
+            io::Series s{label, {}, {}};
+            for (int k = 0; k <= 60; ++k) {
+                const double x = from + (top - from) * k / 60.0;
+                s.x.push_back(x / 1e6), s.y.push_back(sigma1(x) / 1e6);
+            }
+            return s;
+        };
+        char label[160];
+        if (hb.valid) {
+            std::snprintf(label, sizeof label, "Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", hb.sigma_ci / 1e6, hb.mi);
+            series.push_back(curve(label, [&](double x) { return hb.sigma1(x); }, 0.0));
+        }
+        if (mc.valid) {
+            std::snprintf(label, sizeof label, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg", mc.cohesion / 1e6, mc.friction_deg);
+            series.push_back(curve(label, [&](double x) { return mc.sigma_c + mc.slope * x; }, 0.0));
+        }
+        if (!record.empty()) {
+            io::Series r{"laboratory record", {}, {}, Style::points};
+            for (const auto& [a, b] : record) r.x.push_back(a / 1e6), r.y.push_back(b / 1e6);
+            series.push_back(r);
+        }
+        if (e.target_sigma_ci > 0.0) {
+            const HoekBrownFit target{e.target_sigma_ci, e.target_mi, 0.0, true};
+            std::snprintf(label, sizeof label, "target Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", target.sigma_ci / 1e6, target.mi);
+            series.push_back(curve(label, [&](double x) { return target.sigma1(x); }, 0.0));
+        }
+        std::snprintf(label, sizeof label, "strength envelope, %s blocks of %.2g m, %d realization%s", c.pattern.c_str(),
+                      c.o.size, n, n > 1 ? "s" : "");
+        io::draw_curves(series, "sigma3 (MPa; tension at -T)", "sigma1 (MPa)", out / "envelope.png", label, false, true);
+    }
+    if (!quiet) {
+        std::fprintf(stderr, "UCS %.2f +- %.2f MPa; %s tension %.2f MPa (T/UCS %.3f)\n", ucs_stats["mean"].get<double>() / 1e6,
+                     ucs_stats["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
+                     t_stats["mean"].get<double>() / 1e6, t_over_c);
+        if (hb.valid)
+            std::fprintf(stderr, "Hoek-Brown: sigma_ci %.2f MPa, mi %.2f (rms %.2f MPa)\n", hb.sigma_ci / 1e6, hb.mi, hb.rms / 1e6);
+        if (mc.valid)
+            std::fprintf(stderr, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg (rms %.2f MPa)\n", mc.cohesion / 1e6, mc.friction_deg,
+                         mc.rms / 1e6);
+        if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
+    }
+    if (study) {
+        study->runs = std::move(runs);
+        study->summary_json = summary.dump();
+    }
+    return 0;
+}
+
+void add_envelope_options(CLI::App* cmd, EnvelopeOptions& e, bool& quiet) {
+    add_labtest_options(cmd, e.lab, quiet);
+    cmd->add_option("--confinements", e.confinements,
+                    "Lateral stresses of the biaxial tests, Pa, comma-separated (default: 0.1, 0.2, 0.3, 0.4 and 0.5 "
+                    "times the measured UCS)")
+        ->delimiter(',');
+    cmd->add_option("--tension-test", e.tension_test, "The tension test: direct, or brazilian (a disc)")
+        ->check(CLI::IsMember({"direct", "brazilian"}))
+        ->capture_default_str();
+    cmd->add_option("--brazilian-diameter", e.brazilian_diameter, "Disc diameter of the Brazilian test (m)")
+        ->check(cli::positive())
+        ->capture_default_str();
+    cmd->add_option("--target-record", e.target_record,
+                    "A laboratory record to draw beside the envelope: CSV of sigma3, sigma1 in MPa")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--target-sigma-ci", e.target_sigma_ci, "A Hoek-Brown record to draw: sigma_ci (Pa)")
+        ->check(cli::positive());
+    cmd->add_option("--target-mi", e.target_mi, "A Hoek-Brown record to draw: mi")->check(cli::positive());
+}
+
+EnvelopeStudy run_envelope_args(const std::vector<std::string>& args, bool quiet) {
+    CLI::App app{"envelope", "envelope"};
+    EnvelopeOptions e;
+    e.lab.write_files = false;
+    bool q = quiet;
+    add_envelope_options(&app, e, q);
+    bool has_out = false;
+    for (const auto& a : args) has_out = has_out || a == "--out" || a == "-o";
+    std::vector<std::string> reversed(args.rbegin(), args.rend());
+    try {
+        app.parse(reversed);
+    } catch (const CLI::ParseError& error) {
+        throw InputError("envelope", 0, "", error.what());
+    }
+    e.lab.write_files = has_out;
+    EnvelopeStudy study;
+    run_envelope(e, q, false, &study);
+    return study;
+}
+
+} // namespace bbm::studies

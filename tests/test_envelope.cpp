@@ -1,0 +1,120 @@
+// The strength envelope (issue 23): the Hoek–Brown and Mohr–Coulomb fits checked
+// exactly on synthetic points and as least squares on scattered ones, the record
+// reader's errors, and a small envelope end to end.
+#include "studies/envelope.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <vector>
+
+using namespace bbm;
+using namespace bbm::studies;
+
+namespace {
+
+std::vector<double> hoek_brown_points(double sigma_ci, double mi, const std::vector<double>& s3) {
+    std::vector<double> s1;
+    for (double x : s3) s1.push_back(x + sigma_ci * std::sqrt(mi * x / sigma_ci + 1.0));
+    return s1;
+}
+
+double hb_cost(const std::vector<double>& s3, const std::vector<double>& s1, double sigma_ci, double mi) {
+    double ss = 0.0;
+    for (std::size_t i = 0; i < s3.size(); ++i)
+        ss += std::pow(s3[i] + sigma_ci * std::sqrt(mi * s3[i] / sigma_ci + 1.0) - s1[i], 2);
+    return ss;
+}
+
+} // namespace
+
+TEST_CASE("envelope fits: Hoek-Brown recovers sigma_ci and mi exactly from points on the criterion") {
+    // Lac du Bonnet-like numbers: sigma_ci 213 MPa, mi 30, sigma3 up to a third of it.
+    const std::vector<double> s3{0.0, 5e6, 10e6, 20e6, 40e6, 70e6};
+    const auto s1 = hoek_brown_points(213e6, 30.0, s3);
+    const auto f = fit_hoek_brown(s3, s1);
+    REQUIRE(f.valid);
+    CHECK(f.sigma_ci == doctest::Approx(213e6).epsilon(1e-10));
+    CHECK(f.mi == doctest::Approx(30.0).epsilon(1e-10));
+    CHECK(f.rms < 1e-6 * 213e6);
+    // The criterion's tensile strength: sigma_ci (sqrt(mi^2 + 4) - mi) / 2 = 7.09 MPa.
+    CHECK(f.tensile_strength() == doctest::Approx(0.5 * 213e6 * (std::sqrt(904.0) - 30.0)).epsilon(1e-12));
+    CHECK(f.sigma1(10e6) == doctest::Approx(s1[2]).epsilon(1e-12));
+}
+
+TEST_CASE("envelope fits: on scattered points Hoek-Brown is the least squares of sigma1 (no better neighbour)") {
+    const std::vector<double> s3{0.0, 0.0, 0.0, 2e6, 2e6, 5e6, 5e6, 10e6, 10e6};
+    auto s1 = hoek_brown_points(20e6, 12.0, s3);
+    const double noise[] = {1.2e6, -0.8e6, 0.3e6, -1.1e6, 0.9e6, 0.5e6, -0.6e6, 1.4e6, -1.0e6};
+    for (std::size_t i = 0; i < s1.size(); ++i) s1[i] += noise[i];
+    const auto f = fit_hoek_brown(s3, s1);
+    REQUIRE(f.valid);
+    const double best = hb_cost(s3, s1, f.sigma_ci, f.mi);
+    CHECK(f.rms == doctest::Approx(std::sqrt(best / double(s3.size()))).epsilon(1e-9));
+    for (double da : {-1e-3, 1e-3})
+        for (double db : {-1e-3, 1e-3}) {
+            CHECK(hb_cost(s3, s1, f.sigma_ci * (1 + da), f.mi) >= best);
+            CHECK(hb_cost(s3, s1, f.sigma_ci, f.mi * (1 + db)) >= best);
+        }
+    // Close to the generating criterion, as the noise is small.
+    CHECK(f.sigma_ci == doctest::Approx(20e6).epsilon(0.1));
+    CHECK(f.mi == doctest::Approx(12.0).epsilon(0.3));
+}
+
+TEST_CASE("envelope fits: Mohr-Coulomb gives c and phi from sigma1 = sigma_c + k sigma3") {
+    // phi 30 deg: k = 3; c 5 MPa: sigma_c = 2 c cos(phi) / (1 - sin(phi)) = 17.32 MPa.
+    const double phi = std::numbers::pi / 6.0, c = 5e6;
+    const double k = (1 + std::sin(phi)) / (1 - std::sin(phi)), sc = 2 * c * std::cos(phi) / (1 - std::sin(phi));
+    const std::vector<double> s3{0.0, 2e6, 5e6, 10e6};
+    std::vector<double> s1;
+    for (double x : s3) s1.push_back(sc + k * x);
+    const auto f = fit_mohr_coulomb(s3, s1);
+    REQUIRE(f.valid);
+    CHECK(f.friction_deg == doctest::Approx(30.0).epsilon(1e-10));
+    CHECK(f.cohesion == doctest::Approx(5e6).epsilon(1e-10));
+    CHECK(f.sigma_c == doctest::Approx(sc).epsilon(1e-12));
+    CHECK(f.rms < 1e-6);
+    // One confinement only: no envelope.
+    CHECK_FALSE(fit_mohr_coulomb({5e6, 5e6}, {30e6, 31e6}).valid);
+    CHECK_FALSE(fit_hoek_brown({5e6, 5e6}, {30e6, 31e6}).valid);
+}
+
+TEST_CASE("envelope: a strength record is read in MPa with its header; a bad line is named") {
+    const auto dir = std::filesystem::temp_directory_path() / "bbm_envelope_record";
+    std::filesystem::create_directories(dir);
+    {
+        std::ofstream(dir / "good.csv") << "sigma3_MPa,sigma1_MPa\n0,213\n# a comment\n10, 380.5\n";
+        std::ofstream(dir / "bad.csv") << "sigma3,sigma1\n0,213\n10;abc\n";
+    }
+    const auto r = read_strength_record((dir / "good.csv").string());
+    REQUIRE(r.size() == 2);
+    CHECK(r[1].first == doctest::Approx(10e6));
+    CHECK(r[1].second == doctest::Approx(380.5e6));
+    CHECK_THROWS_WITH(read_strength_record((dir / "bad.csv").string()), doctest::Contains("bad.csv:3"));
+}
+
+TEST_CASE("envelope of a small Voronoi specimen: strength rises with confinement, the fits and ratios are reported") {
+    EnvelopeStudy study = run_envelope_args(
+        {"--width", "2", "--height", "4", "--confinements", "2e6,5e6", "--threads", "1", "--realizations", "1"}, true);
+    const auto& runs = study.runs;
+    REQUIRE(runs.size() == 4); // ucs, tension, two biaxial
+    double ucs = 0, t = 0, b2 = 0, b5 = 0;
+    for (const auto& r : runs) {
+        if (r.test == "ucs") ucs = r.result.peak_stress;
+        if (r.test == "tension") t = r.result.peak_stress;
+        if (r.test == "biaxial" && r.confinement == 2e6) b2 = r.result.peak_stress;
+        if (r.test == "biaxial" && r.confinement == 5e6) b5 = r.result.peak_stress;
+    }
+    MESSAGE("UCS " << ucs / 1e6 << ", T " << t / 1e6 << ", sigma1 at 2 MPa " << b2 / 1e6 << ", at 5 MPa " << b5 / 1e6
+                   << " MPa");
+    CHECK(ucs > 10e6);
+    CHECK(t > 0.02 * ucs);
+    CHECK(t < 0.3 * ucs);
+    CHECK(b2 > ucs);
+    CHECK(b5 > b2);
+    CHECK(study.summary_json.find("\"hoek_brown\"") != std::string::npos);
+    CHECK(study.summary_json.find("\"mohr_coulomb\"") != std::string::npos);
+}
