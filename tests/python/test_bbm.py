@@ -182,6 +182,17 @@ def test_checkpoint_of_an_older_format_is_refused(tmp_path):
         bbm.Model.resume(str(old))
 
 
+def test_envelope_small_specimen():
+    """bbm.envelope() returns envelope.json as a dict: the fits and every run."""
+    e = bbm.envelope(width=2.0, height=4.0, confinements=[2e6, 5e6], realizations=1, threads=1)
+    assert [r["test"] for r in e["runs"]] == ["ucs", "tension", "biaxial", "biaxial"]
+    peaks = {r["sigma3"]: r["peak"] for r in e["runs"] if r["test"] in ("ucs", "biaxial")}
+    assert peaks[0.0] < peaks[2e6] < peaks[5e6]
+    assert e["hoek_brown"]["valid"] and e["hoek_brown"]["mi"] > 0
+    assert e["mohr_coulomb"]["valid"] and 0 < e["mohr_coulomb"]["friction_deg"] < 90
+    assert 0 < e["tension"]["over_ucs"] < 0.3
+
+
 def test_callback_exception_stops_and_propagates():
     m = bbm.Model(str(INSITU))
 
