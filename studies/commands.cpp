@@ -239,6 +239,10 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
                     "Steps between frames of the failure series in result.pvd (0: the final state only)")
         ->check(cli::non_negative())->capture_default_str();
     sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(cli::positive())->capture_default_str();
+    sub->add_option("--post-peak-strain", o.post_peak_strain,
+                    "Confined tests: stop this much axial strain past the peak once the specimen has failed (0: go on "
+                    "to --max-strain or --stop-fraction; bbm envelope uses 1e-3)")
+        ->check(cli::non_negative());
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--threads", c.threads,

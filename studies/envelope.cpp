@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -60,8 +61,26 @@ HoekBrownFit fit_hoek_brown(const std::vector<double>& s3, const std::vector<dou
     std::vector<double> y(n);
     for (std::size_t i = 0; i < n; ++i) y[i] = (s1[i] - s3[i]) * (s1[i] - s3[i]);
     const LineFit start = fit_line(s3, y);
-    if (!start.valid || !(start.intercept > 0.0)) return f;
+    if (!start.valid) return f; // fewer than two confinements
     double A = start.intercept, B = start.slope;
+    if (!(A > 0.0) || !(B > 0.0)) {
+        // An envelope that rises faster than the criterion's square root at low
+        // confinement (a lattice that interlocks) puts the linearised intercept
+        // below zero: start instead from the points at the lowest σ3 and the
+        // chord to the highest.
+        double lo = INFINITY, hi = -INFINITY;
+        for (std::size_t i = 0; i < n; ++i) lo = std::min(lo, s3[i]), hi = std::max(hi, s3[i]);
+        double y_lo = 0.0, y_hi = 0.0;
+        int n_lo = 0, n_hi = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (s3[i] == lo) y_lo += y[i], ++n_lo;
+            if (s3[i] == hi) y_hi += y[i], ++n_hi;
+        }
+        y_lo /= n_lo, y_hi /= n_hi;
+        B = std::max((y_hi - y_lo) / (hi - lo), 1e-12 * y_lo / std::max(hi, 1.0));
+        A = std::max(y_lo - B * lo, 1e-6 * y_lo);
+        if (!(A > 0.0)) return f;
+    }
     auto cost = [&](double a, double b) {
         double ss = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
@@ -161,11 +180,144 @@ nlohmann::json stats(const std::vector<double>& v) {
     return {{"mean", m}, {"std", v.size() > 1 ? std::sqrt(s / double(v.size() - 1)) : 0.0}, {"n", v.size()}};
 }
 
+
+/// The fits of an envelope from its runs (every compression peak, σ3 ≥ 0), into
+/// the summary: hoek_brown, mohr_coulomb, the σci and σcd lines, and each level's
+/// fitted σ1.
+void add_fits(nlohmann::json& e) {
+    std::vector<double> s3, s1, ci_x, ci_y, cd_x, cd_y;
+    for (const auto& r : e["runs"]) {
+        const std::string test = r["test"];
+        if (test != "ucs" && test != "biaxial") continue;
+        const double x = r["sigma3"];
+        s3.push_back(x), s1.push_back(r["peak"].get<double>());
+        if (r["sigma_ci"].get<double>() > 0.0) ci_x.push_back(x), ci_y.push_back(r["sigma_ci"].get<double>());
+        if (r["sigma_cd"].get<double>() > 0.0) cd_x.push_back(x), cd_y.push_back(r["sigma_cd"].get<double>());
+    }
+    const HoekBrownFit hb = fit_hoek_brown(s3, s1);
+    const MohrCoulombFit mc = fit_mohr_coulomb(s3, s1);
+    const LineFit ci = fit_line(ci_x, ci_y), cd = fit_line(cd_x, cd_y);
+    e["hoek_brown"] = {{"valid", hb.valid}, {"sigma_ci", hb.sigma_ci}, {"mi", hb.mi}, {"a", 0.5}, {"rms", hb.rms},
+                       {"tensile_strength", hb.valid ? hb.tensile_strength() : 0.0}};
+    e["mohr_coulomb"] = {{"valid", mc.valid}, {"cohesion", mc.cohesion}, {"friction_deg", mc.friction_deg},
+                         {"sigma_c", mc.sigma_c}, {"slope", mc.slope}, {"rms", mc.rms}};
+    auto line = [](const LineFit& f) {
+        return nlohmann::json{{"valid", f.valid}, {"intercept", f.intercept}, {"slope", f.slope}, {"rms", f.rms}};
+    };
+    e["crack_initiation_line"] = line(ci);
+    e["crack_damage_line"] = line(cd);
+    for (auto& level : e["levels"]) {
+        const double x = level["sigma3"];
+        level["hoek_brown_sigma1"] = hb.valid ? hb.sigma1(x) : 0.0;
+        level["mohr_coulomb_sigma1"] = mc.valid ? mc.sigma_c + mc.slope * x : 0.0;
+    }
+}
+
+void print_fits(const nlohmann::json& e) {
+    const auto& hb = e["hoek_brown"];
+    const auto& mc = e["mohr_coulomb"];
+    if (hb["valid"].get<bool>())
+        std::fprintf(stderr, "Hoek-Brown: sigma_ci %.2f MPa, mi %.2f (rms %.2f MPa)\n", hb["sigma_ci"].get<double>() / 1e6,
+                     hb["mi"].get<double>(), hb["rms"].get<double>() / 1e6);
+    if (mc["valid"].get<bool>())
+        std::fprintf(stderr, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg (rms %.2f MPa)\n", mc["cohesion"].get<double>() / 1e6,
+                     mc["friction_deg"].get<double>(), mc["rms"].get<double>() / 1e6);
+}
+
+/// envelope.png from envelope.json's content: σ1 against σ3 (MPa) — σci and σcd
+/// of every compression test, every realization's peak drawn over them (the
+/// tension tests at σ3 = −T, σ1 = 0), the fitted curves and the target record.
+void draw_envelope(const nlohmann::json& e, const fs::path& file) {
+    using Style = io::Series::Style;
+    io::Series peaks{"peaks (each realization)", {}, {}, Style::points};
+    io::Series cis{"sigma_ci", {}, {}, Style::points}, cds{"sigma_cd", {}, {}, Style::points};
+    const bool brazilian = e["tension"]["test"] == "brazilian";
+    for (const auto& r : e["runs"]) {
+        const std::string test = r["test"];
+        const double s3 = r["sigma3"].get<double>() / 1e6;
+        if (test == "ucs" || test == "biaxial") {
+            peaks.x.push_back(s3), peaks.y.push_back(r["peak"].get<double>() / 1e6);
+            if (r["sigma_ci"].get<double>() > 0) cis.x.push_back(s3), cis.y.push_back(r["sigma_ci"].get<double>() / 1e6);
+            if (r["sigma_cd"].get<double>() > 0) cds.x.push_back(s3), cds.y.push_back(r["sigma_cd"].get<double>() / 1e6);
+        } else {
+            const double t = (brazilian ? r["tensile_strength"] : r["peak"]).get<double>();
+            peaks.x.push_back(-t / 1e6), peaks.y.push_back(0.0);
+        }
+    }
+    std::vector<io::Series> series{cis, cds, peaks};
+    double top = 0.0;
+    for (double s3 : e["confinements"]) top = std::max(top, s3);
+    if (e.contains("target_record"))
+        for (const auto& pair : e["target_record"]["pairs"]) top = std::max(top, pair[0].get<double>());
+    auto curve = [&](const std::string& label, auto sigma1) {
+        io::Series c{label, {}, {}};
+        for (int k = 0; k <= 60; ++k) {
+            const double x = top * k / 60.0;
+            c.x.push_back(x / 1e6), c.y.push_back(sigma1(x) / 1e6);
+        }
+        return c;
+    };
+    char label[160];
+    if (e["hoek_brown"]["valid"].get<bool>()) {
+        const HoekBrownFit hb{e["hoek_brown"]["sigma_ci"], e["hoek_brown"]["mi"], 0.0, true};
+        std::snprintf(label, sizeof label, "Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", hb.sigma_ci / 1e6, hb.mi);
+        series.push_back(curve(label, [&](double x) { return hb.sigma1(x); }));
+    }
+    if (e["mohr_coulomb"]["valid"].get<bool>()) {
+        const double sc = e["mohr_coulomb"]["sigma_c"], k = e["mohr_coulomb"]["slope"];
+        std::snprintf(label, sizeof label, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg",
+                      e["mohr_coulomb"]["cohesion"].get<double>() / 1e6, e["mohr_coulomb"]["friction_deg"].get<double>());
+        series.push_back(curve(label, [&](double x) { return sc + k * x; }));
+    }
+    if (e.contains("target_record")) {
+        io::Series r{"laboratory record", {}, {}, Style::points};
+        for (const auto& pair : e["target_record"]["pairs"])
+            r.x.push_back(pair[0].get<double>() / 1e6), r.y.push_back(pair[1].get<double>() / 1e6);
+        series.push_back(r);
+    }
+    if (e.contains("target_hoek_brown")) {
+        const HoekBrownFit target{e["target_hoek_brown"]["sigma_ci"], e["target_hoek_brown"]["mi"], 0.0, true};
+        std::snprintf(label, sizeof label, "target Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", target.sigma_ci / 1e6, target.mi);
+        series.push_back(curve(label, [&](double x) { return target.sigma1(x); }));
+    }
+    const auto& sp = e["specimen"];
+    std::snprintf(label, sizeof label, "strength envelope, %s blocks of %.2g m%s, %d realization%s",
+                  sp["pattern"].get<std::string>().c_str(), sp["size"].get<double>(),
+                  sp["deformable_fraction"].get<double>() > 0
+                      ? (", deformable f = " + std::to_string(sp["deformable_fraction"].get<double>()).substr(0, 4)).c_str()
+                      : "",
+                  sp["realizations"].get<int>(), sp["realizations"].get<int>() > 1 ? "s" : "");
+    io::draw_curves(series, "sigma3 (MPa; tension at -T)", "sigma1 (MPa)", file, label, false, true);
+}
+
 } // namespace
 
 int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
     quiet = quiet || !Ranks::root();
     LabTestCli& c = e.lab;
+    if (e.replot) {
+        // envelope.png again from envelope.json (another record to compare, a new style), no test run.
+        const fs::path file = fs::path(c.out) / "envelope.json";
+        std::ifstream in(file);
+        if (!in) throw InputError(file.string(), 0, "", "no envelope.json to draw from (run bbm envelope first)");
+        auto summary = nlohmann::json::parse(in, nullptr, false);
+        if (summary.is_discarded() || !summary.contains("runs"))
+            throw InputError(file.string(), 0, "", "not an envelope.json written by bbm envelope");
+        if (!e.target_record.empty()) {
+            nlohmann::json pairs = nlohmann::json::array();
+            for (const auto& [a, b] : read_strength_record(e.target_record)) pairs.push_back({a, b});
+            summary["target_record"] = {{"file", e.target_record}, {"pairs", pairs}};
+        }
+        if (e.target_sigma_ci > 0.0 && e.target_mi > 0.0)
+            summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
+        if (check_only) return 0;
+        add_fits(summary); // this bbm's fits of the same runs
+        io::write_text_atomically(file, summary.dump(2) + "\n");
+        draw_envelope(summary, fs::path(c.out) / "envelope.png");
+        if (!quiet) print_fits(summary);
+        if (!quiet) std::fprintf(stderr, "wrote %s and envelope.png\n", file.string().c_str());
+        return 0;
+    }
     for (double s3 : e.confinements)
         if (!(s3 > 0.0) || !std::isfinite(s3))
             throw InputError("--confinements", 0, "", "each confinement must be a positive stress in Pa");
@@ -193,6 +345,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
     const bool one_at_a_time = c.o.deformable_fraction > 0.0;
     std::vector<EnvelopeRun> runs;
+    std::mutex print;
     auto run_jobs = [&](const std::vector<Job>& jobs) {
         const int side_by_side = one_at_a_time ? 1 : std::max(1, std::min(int(jobs.size()), available));
         const auto texts = run_spread(int(jobs.size()), side_by_side, [&](int k) {
@@ -202,24 +355,32 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
             o.confinement = job.confinement;
             o.seed = c.o.seed + std::uint64_t(job.realization);
             o.frame_every = 0;
+            // The peak is what an envelope needs: a confined specimen that has failed
+            // stops 0.1% strain later, not at --max-strain (rigid trigon blocks keep
+            // most of their strength under confinement and would run to 1% strain).
+            if (o.post_peak_strain <= 0.0) o.post_peak_strain = 1e-3;
             o.threads = side_by_side == 1 ? available : 1;
+            LabTestResult result;
             try {
-                return labtest_record_text(run_labtest(o));
+                result = run_labtest(o);
             } catch (const GeometryError& error) {
                 throw InputError("--size", 0, "", error.what());
             }
-        });
-        for (std::size_t k = 0; k < jobs.size(); ++k) {
-            EnvelopeRun r{test_name(jobs[k].kind), jobs[k].confinement, c.o.seed + std::uint64_t(jobs[k].realization),
-                          labtest_from_record_text(texts[k])};
-            if (!quiet)
+            if (!quiet) {
+                // As each run ends (a long envelope shows its progress).
+                std::lock_guard lock(print);
                 std::fprintf(stderr, "  %-9s sigma3 %6.2f MPa seed %3llu: peak %8.2f MPa  sigma_ci %7.2f  sigma_cd %7.2f  "
-                                     "%ld steps %6.1f s\n",
-                             r.test.c_str(), r.confinement / 1e6, static_cast<unsigned long long>(r.seed),
-                             r.result.peak_stress / 1e6, r.result.crack_initiation_stress / 1e6,
-                             r.result.crack_damage_stress / 1e6, r.result.steps, r.result.wall_seconds);
-            runs.push_back(std::move(r));
-        }
+                                     "%ld steps %6.1f s%s\n",
+                             test_name(job.kind), job.confinement / 1e6, static_cast<unsigned long long>(o.seed),
+                             result.peak_stress / 1e6, result.crack_initiation_stress / 1e6,
+                             result.crack_damage_stress / 1e6, result.steps, result.wall_seconds,
+                             result.post_peak_locking ? "  (fragments jammed after failure)" : "");
+            }
+            return labtest_record_text(result);
+        });
+        for (std::size_t k = 0; k < jobs.size(); ++k)
+            runs.push_back({test_name(jobs[k].kind), jobs[k].confinement, c.o.seed + std::uint64_t(jobs[k].realization),
+                            labtest_from_record_text(texts[k])});
     };
     if (!quiet)
         std::fprintf(stderr, "bbm envelope: %s blocks of %.3g m, %g m x %g m, %d realization%s of each test on %d thread%s\n",
@@ -247,20 +408,6 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});
     run_jobs(second);
 
-    // Fits over every compression peak (σ3 = 0 and the biaxial tests).
-    std::vector<double> s3, s1, ci_x, ci_y, cd_x, cd_y;
-    for (const auto& r : runs) {
-        if (r.test != "ucs" && r.test != "biaxial") continue;
-        s3.push_back(r.confinement), s1.push_back(r.result.peak_stress);
-        if (r.result.crack_initiation_stress > 0.0)
-            ci_x.push_back(r.confinement), ci_y.push_back(r.result.crack_initiation_stress);
-        if (r.result.crack_damage_stress > 0.0)
-            cd_x.push_back(r.confinement), cd_y.push_back(r.result.crack_damage_stress);
-    }
-    const HoekBrownFit hb = fit_hoek_brown(s3, s1);
-    const MohrCoulombFit mc = fit_mohr_coulomb(s3, s1);
-    const LineFit ci_line = fit_line(ci_x, ci_y), cd_line = fit_line(cd_x, cd_y);
-
     nlohmann::json levels = nlohmann::json::array();
     std::vector<double> levels_s3{0.0};
     levels_s3.insert(levels_s3.end(), confinements.begin(), confinements.end());
@@ -275,9 +422,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         }
         levels.push_back({{"sigma3", level}, {"peak", stats(peak)}, {"sigma_ci", stats(ci)}, {"sigma_cd", stats(cd)},
                           {"sigma_ci_over_peak", stats(ci_ratio)}, {"sigma_cd_over_peak", stats(cd_ratio)},
-                          {"E", stats(E)}, {"nu", stats(nu)},
-                          {"hoek_brown_sigma1", hb.valid ? hb.sigma1(level) : 0.0},
-                          {"mohr_coulomb_sigma1", mc.valid ? mc.sigma_c + mc.slope * level : 0.0}});
+                          {"E", stats(E)}, {"nu", stats(nu)}});
     }
     nlohmann::json per_run = nlohmann::json::array();
     std::ostringstream csv;
@@ -307,13 +452,8 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         {"tension", {{"test", brazilian ? "brazilian" : "direct"}, {"strength", t_stats}, {"over_ucs", t_over_c}}},
         {"confinements", confinements},
         {"levels", levels},
-        {"hoek_brown", {{"valid", hb.valid}, {"sigma_ci", hb.sigma_ci}, {"mi", hb.mi}, {"a", 0.5}, {"rms", hb.rms},
-                        {"tensile_strength", hb.valid ? hb.tensile_strength() : 0.0}}},
-        {"mohr_coulomb", {{"valid", mc.valid}, {"cohesion", mc.cohesion}, {"friction_deg", mc.friction_deg},
-                          {"sigma_c", mc.sigma_c}, {"slope", mc.slope}, {"rms", mc.rms}}},
-        {"crack_initiation_line", {{"valid", ci_line.valid}, {"intercept", ci_line.intercept}, {"slope", ci_line.slope}, {"rms", ci_line.rms}}},
-        {"crack_damage_line", {{"valid", cd_line.valid}, {"intercept", cd_line.intercept}, {"slope", cd_line.slope}, {"rms", cd_line.rms}}},
         {"runs", per_run}};
+    add_fits(summary);
     if (e.target_sigma_ci > 0.0) summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
     if (!record.empty()) {
         nlohmann::json pairs = nlohmann::json::array();
@@ -324,65 +464,13 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     if (c.write_files && Ranks::root()) {
         io::write_text_atomically(out / "envelope.json", summary.dump(2) + "\n");
         io::write_text_atomically(out / "envelope.csv", csv.str());
-        // σ1 against σ3 (MPa): every realization's peak (the tension tests at
-        // σ3 = −T, σ1 = 0), σci and σcd, the fitted curves and the target record.
-        using Style = io::Series::Style;
-        io::Series peaks{"peaks (each realization)", {}, {}, Style::points};
-        io::Series cis{"sigma_ci", {}, {}, Style::points}, cds{"sigma_cd", {}, {}, Style::points};
-        for (const auto& r : runs) {
-            const auto& x = r.result;
-            if (r.test == "ucs" || r.test == "biaxial") {
-                peaks.x.push_back(r.confinement / 1e6), peaks.y.push_back(x.peak_stress / 1e6);
-                if (x.crack_initiation_stress > 0) cis.x.push_back(r.confinement / 1e6), cis.y.push_back(x.crack_initiation_stress / 1e6);
-                if (x.crack_damage_stress > 0) cds.x.push_back(r.confinement / 1e6), cds.y.push_back(x.crack_damage_stress / 1e6);
-            } else {
-                const double t = brazilian ? x.tensile_strength : x.peak_stress;
-                peaks.x.push_back(-t / 1e6), peaks.y.push_back(0.0);
-            }
-        }
-        std::vector<io::Series> series{peaks, cis, cds};
-        double top = confinements.empty() ? 0.0 : confinements.back();
-        for (const auto& [a, b] : record) top = std::max(top, a);
-        auto curve = [&](const std::string& label, auto sigma1, double from) {
-            io::Series s{label, {}, {}};
-            for (int k = 0; k <= 60; ++k) {
-                const double x = from + (top - from) * k / 60.0;
-                s.x.push_back(x / 1e6), s.y.push_back(sigma1(x) / 1e6);
-            }
-            return s;
-        };
-        char label[160];
-        if (hb.valid) {
-            std::snprintf(label, sizeof label, "Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", hb.sigma_ci / 1e6, hb.mi);
-            series.push_back(curve(label, [&](double x) { return hb.sigma1(x); }, 0.0));
-        }
-        if (mc.valid) {
-            std::snprintf(label, sizeof label, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg", mc.cohesion / 1e6, mc.friction_deg);
-            series.push_back(curve(label, [&](double x) { return mc.sigma_c + mc.slope * x; }, 0.0));
-        }
-        if (!record.empty()) {
-            io::Series r{"laboratory record", {}, {}, Style::points};
-            for (const auto& [a, b] : record) r.x.push_back(a / 1e6), r.y.push_back(b / 1e6);
-            series.push_back(r);
-        }
-        if (e.target_sigma_ci > 0.0) {
-            const HoekBrownFit target{e.target_sigma_ci, e.target_mi, 0.0, true};
-            std::snprintf(label, sizeof label, "target Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", target.sigma_ci / 1e6, target.mi);
-            series.push_back(curve(label, [&](double x) { return target.sigma1(x); }, 0.0));
-        }
-        std::snprintf(label, sizeof label, "strength envelope, %s blocks of %.2g m, %d realization%s", c.pattern.c_str(),
-                      c.o.size, n, n > 1 ? "s" : "");
-        io::draw_curves(series, "sigma3 (MPa; tension at -T)", "sigma1 (MPa)", out / "envelope.png", label, false, true);
+        draw_envelope(summary, out / "envelope.png");
     }
     if (!quiet) {
         std::fprintf(stderr, "UCS %.2f +- %.2f MPa; %s tension %.2f MPa (T/UCS %.3f)\n", ucs_stats["mean"].get<double>() / 1e6,
                      ucs_stats["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
                      t_stats["mean"].get<double>() / 1e6, t_over_c);
-        if (hb.valid)
-            std::fprintf(stderr, "Hoek-Brown: sigma_ci %.2f MPa, mi %.2f (rms %.2f MPa)\n", hb.sigma_ci / 1e6, hb.mi, hb.rms / 1e6);
-        if (mc.valid)
-            std::fprintf(stderr, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg (rms %.2f MPa)\n", mc.cohesion / 1e6, mc.friction_deg,
-                         mc.rms / 1e6);
+        print_fits(summary);
         if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
     }
     if (study) {
@@ -410,6 +498,9 @@ void add_envelope_options(CLI::App* cmd, EnvelopeOptions& e, bool& quiet) {
     cmd->add_option("--target-sigma-ci", e.target_sigma_ci, "A Hoek-Brown record to draw: sigma_ci (Pa)")
         ->check(cli::positive());
     cmd->add_option("--target-mi", e.target_mi, "A Hoek-Brown record to draw: mi")->check(cli::positive());
+    cmd->add_flag("--replot", e.replot,
+                  "Draw envelope.png again from --out's envelope.json (with --target-record or --target-sigma-ci/"
+                  "--target-mi to compare), running no test");
 }
 
 EnvelopeStudy run_envelope_args(const std::vector<std::string>& args, bool quiet) {

@@ -60,6 +60,7 @@ struct EnvelopeOptions {
     /// MPa (a header line allowed), and/or a Hoek–Brown (σci, mi) to draw.
     std::string target_record;
     double target_sigma_ci = 0.0, target_mi = 0.0;
+    bool replot = false; ///< envelope.png again from DIR/envelope.json, no test run
 };
 
 /// One lab test of the envelope.

@@ -547,6 +547,11 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             r.peak_passed = true;
             break;
         }
+        if (failed && o.confinement > 0.0 && o.post_peak_strain > 0.0 &&
+            p.axial_strain >= strain_at_peak + o.post_peak_strain) {
+            r.peak_passed = true;
+            break;
+        }
         if (p.axial_strain >= o.max_strain) break;
     }
     r.steps = s.steps();

@@ -95,6 +95,11 @@ struct LabTestOptions {
     /// strength, and the run stops if the stress climbs back above it.
     double failure_drop = 0.1;
     double max_strain = 0.01;
+    /// Confined tests (biaxial): stop this much axial strain past the peak once the
+    /// specimen has failed (0: go on to max_strain or stop_fraction). Exact for the
+    /// peak: under confinement a failed specimen's peak is final (a climb back
+    /// above it is the locking rule's stop). The envelope sets 1e-3.
+    double post_peak_strain = 0.0;
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
     long frame_every = 4000;            ///< steps between frames of the failure series (0: none)

@@ -64,6 +64,21 @@ TEST_CASE("envelope fits: on scattered points Hoek-Brown is the least squares of
     CHECK(f.mi == doctest::Approx(12.0).epsilon(0.3));
 }
 
+TEST_CASE("envelope fits: Hoek-Brown fits an envelope whose linearisation has a negative intercept") {
+    // The hexagonal lattice's envelope (bbm envelope --pattern hexagonal, MPa): it
+    // interlocks, rising faster than the criterion at low confinement.
+    const std::vector<double> s3{0.0, 4.3e6, 8.6e6, 12.9e6, 17.2e6, 21.5e6};
+    const std::vector<double> s1{43.05e6, 81.76e6, 121.56e6, 164.13e6, 230.04e6, 236.88e6};
+    const auto f = fit_hoek_brown(s3, s1);
+    REQUIRE(f.valid);
+    const double best = hb_cost(s3, s1, f.sigma_ci, f.mi);
+    for (double d : {-1e-3, 1e-3}) {
+        CHECK(hb_cost(s3, s1, f.sigma_ci * (1 + d), f.mi) >= best);
+        CHECK(hb_cost(s3, s1, f.sigma_ci, f.mi * (1 + d)) >= best);
+    }
+    MESSAGE("sigma_ci " << f.sigma_ci / 1e6 << " MPa, mi " << f.mi << ", rms " << f.rms / 1e6 << " MPa");
+}
+
 TEST_CASE("envelope fits: Mohr-Coulomb gives c and phi from sigma1 = sigma_c + k sigma3") {
     // phi 30 deg: k = 3; c 5 MPa: sigma_c = 2 c cos(phi) / (1 - sin(phi)) = 17.32 MPa.
     const double phi = std::numbers::pi / 6.0, c = 5e6;
