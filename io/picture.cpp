@@ -265,6 +265,11 @@ void draw_curves(const std::vector<Series>& series, const std::string& x_label, 
             x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
             y0 = std::min(y0, ty(s.y[i])), y1 = std::max(y1, ty(s.y[i]));
         }
+    // Nothing to draw (a run stopped at its first record: one ratio of 0, which a
+    // log axis leaves out) gives empty unit axes; infinite bounds made the tick
+    // loop below endless (a run stopped by a signal hung drawing history.png).
+    if (!std::isfinite(x0) || !std::isfinite(x1)) x0 = 0, x1 = 1;
+    if (!std::isfinite(y0) || !std::isfinite(y1)) y0 = 0, y1 = 1;
     if (!(x1 > x0)) x1 = x0 + 1;
     if (!(y1 > y0)) y1 = y0 + 1;
     if (!log_y) y0 = std::min(y0, 0.0);
@@ -284,12 +289,16 @@ void draw_curves(const std::vector<Series>& series, const std::string& x_label, 
         return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
     };
     const double xs = nice_step(x1 - x0), ys = log_y ? 1.0 : nice_step(y1 - y0);
-    for (double xv = std::ceil(x0 / xs) * xs; xv <= x1 + 1e-9 * xs; xv += xs) {
+    // At most a few dozen ticks whatever the values (a huge range over a tiny step
+    // would not advance xv).
+    int ticks = 0;
+    for (double xv = std::ceil(x0 / xs) * xs; xv <= x1 + 1e-9 * xs && ticks < 50; xv += xs, ++ticks) {
         cairo_move_to(cr, px(xv), h - bottom), cairo_line_to(cr, px(xv), h - bottom + 5), cairo_stroke(cr);
         std::snprintf(buf, sizeof buf, "%g", std::abs(xv) < 1e-12 * xs ? 0.0 : xv);
         text(cr, px(xv), h - bottom + 20, buf, 12, true);
     }
-    for (double yv = std::ceil(y0 / ys) * ys; yv <= y1 + 1e-9 * ys; yv += ys) {
+    ticks = 0;
+    for (double yv = std::ceil(y0 / ys) * ys; yv <= y1 + 1e-9 * ys && ticks < 50; yv += ys, ++ticks) {
         cairo_move_to(cr, left - 5, py_raw(yv)), cairo_line_to(cr, left, py_raw(yv)), cairo_stroke(cr);
         std::snprintf(buf, sizeof buf, log_y ? "1e%g" : "%g", std::abs(yv) < 1e-12 * ys ? 0.0 : yv);
         cairo_text_extents_t e;

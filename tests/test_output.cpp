@@ -1,6 +1,7 @@
 // Tests of io/vtk_output: what is written is read back by VTK's own reader and
 // compared with the hand-built assembly, value by value; the atomic writers leave
 // either the new file or the old one, never a .tmp.
+#include "io/picture.hpp"
 #include "io/vtk_output.hpp"
 
 #include <doctest/doctest.h>
@@ -355,4 +356,17 @@ TEST_CASE("write_pvd names each file with its time step") {
 
     CHECK_THROWS_AS(io::write_pvd(file, {{std::nan(""), "x.vtu"}}), std::invalid_argument);
     CHECK(contains(slurp(file), "step_0001/joints.vtu")); // the refused write left the old file
+}
+
+TEST_CASE("a plot with nothing to draw on its log axis is written (a run stopped at its first record)") {
+    // A run stopped by a signal at its first history record has one ratio, 0,
+    // which a log axis leaves out: the bounds stayed infinite and the tick loop
+    // never ended (the program hung writing history.png).
+    TempDir dir;
+    const std::vector<bbm::io::Series> zeros{{"ratio", {0.0}, {0.0}}};
+    bbm::io::draw_curves(zeros, "step", "unbalanced-force ratio", dir.path / "empty_log.png", "convergence", true);
+    CHECK(fs::file_size(dir.path / "empty_log.png") > 0);
+    const std::vector<bbm::io::Series> none{{"nothing", {}, {}}};
+    bbm::io::draw_curves(none, "step", "cracks", dir.path / "empty.png");
+    CHECK(fs::file_size(dir.path / "empty.png") > 0);
 }
