@@ -2,10 +2,11 @@
 # for srun (runs bbm and sends it SIGUSR1 after a while, as --signal=USR1@300
 # does before the time limit) and scontrol (records the requeue): the job is run
 # again while it asks to be requeued, and the pieces must end in the state hash
-# of an uninterrupted run.
+# of an uninterrupted run. Piece k runs k x 0.5 s before its signal, so a slow
+# machine (whose start-up alone may outlast a fixed short piece) still advances.
 file(REMOVE_RECURSE ${DIR})
 file(MAKE_DIRECTORY ${DIR}/bin)
-file(WRITE ${DIR}/bin/srun "#!/bin/bash\nexec timeout --preserve-status -s USR1 0.8 \"$@\"\n")
+file(WRITE ${DIR}/bin/srun "#!/bin/bash\nexec timeout --preserve-status -s USR1 \"$PIECE_SECONDS\" \"$@\"\n")
 file(WRITE ${DIR}/bin/scontrol "#!/bin/bash\necho \"$@\" >> ${DIR}/requeued\n")
 execute_process(COMMAND chmod +x ${DIR}/bin/srun ${DIR}/bin/scontrol)
 execute_process(COMMAND ${BBM} run ${MODEL} --out ${DIR}/whole --quiet RESULT_VARIABLE status)
@@ -16,7 +17,10 @@ set(env PATH=${DIR}/bin:$ENV{PATH} BBM=${BBM} MODEL=${MODEL} OUT=${DIR}/job SLUR
 set(pieces 0)
 foreach(attempt RANGE 1 40)
   file(REMOVE ${DIR}/requeued)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E env ${env} bash ${SCRIPT} RESULT_VARIABLE status OUTPUT_VARIABLE out
+  math(EXPR whole "${attempt} / 2")
+  math(EXPR half "${attempt} % 2 * 5")
+  set(piece_seconds "${whole}.${half}")
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env ${env} PIECE_SECONDS=${piece_seconds} bash ${SCRIPT} RESULT_VARIABLE status OUTPUT_VARIABLE out
                   ERROR_VARIABLE err)
   if(NOT status EQUAL 0)
     message(FATAL_ERROR "job piece ${attempt}: status ${status}: ${out} ${err}")
@@ -32,6 +36,9 @@ string(REGEX MATCH "\"state_hash\": \"[0-9]+\"" hash_whole "${whole}")
 string(REGEX MATCH "\"state_hash\": \"[0-9]+\"" hash_job "${job}")
 if(NOT job MATCHES "\"complete\": true")
   message(FATAL_ERROR "the job did not finish in ${pieces} pieces")
+endif()
+if(pieces LESS 2)
+  message(FATAL_ERROR "the job finished in one piece: nothing was resumed")
 endif()
 if(NOT hash_whole STREQUAL hash_job)
   message(FATAL_ERROR "the requeued job (${pieces} pieces) ends in ${hash_job}, the uninterrupted run in ${hash_whole}")

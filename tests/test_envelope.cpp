@@ -97,7 +97,7 @@ TEST_CASE("envelope fits: Mohr-Coulomb gives c and phi from sigma1 = sigma_c + k
     CHECK_FALSE(fit_hoek_brown({5e6, 5e6}, {30e6, 31e6}).valid);
 }
 
-TEST_CASE("envelope: a strength record is read in MPa with its header; a bad line is named") {
+TEST_CASE("envelope: a strength record is read in MPa with its header, and a bad line is named") {
     const auto dir = std::filesystem::temp_directory_path() / "bbm_envelope_record";
     std::filesystem::create_directories(dir);
     {

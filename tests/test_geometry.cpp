@@ -367,7 +367,7 @@ TEST_CASE("delaunay: triangles of the target mean size with no short edges") {
     CHECK(min_edge(a) >= 0.04);
 }
 
-TEST_CASE("real joints cut first; no inner block crosses them") {
+TEST_CASE("real joints cut first, and no inner block crosses them") {
     auto r = rect_region("rock", {0, 0}, {10, 10}, PatternSpec::Kind::voronoi, 0.5, 2);
     r.joints.push_back({{-1, 2}, {11, 7.5}});   // persistent: crosses the region
     r.joints.push_back({{2, 8}, {6, 9}});       // ends inside: a finite trace

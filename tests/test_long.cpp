@@ -155,10 +155,32 @@ LabTestOptions small(double deformable_fraction) {
 TEST_CASE("post-peak, 3 seeds: area-sized trigon 3 x 6 m and 8 x 16 m soften without locking") {
     // Issue 12: the area-sized trigon hardened to 176 MPa at 1% strain; after the
     // four fixes of docs/calibration.md ("After the peak") every seed softens.
+    // These runs are also the regression tests of mechanisms 2-4 (mechanism 1, a
+    // small rigid specimen, is in test_labtest.cpp):
+    // - 2 and 3, the 3 x 6 m specimen of seed 3: contacts formed past the end of an
+    //   edge started with the gap to the edge's line, not to the rounded corner the
+    //   law then measures against: a vertex beside a corner, outside the block, was
+    //   born compressed (up to 379 MPa), and new corner contacts came to carry 16% of
+    //   the compression, wedging the side fragments; and a single record of a crack
+    //   burst's dynamic transient (14.2 -> 18.1 MPa, unbalanced ratio 22) above the
+    //   peak stopped the run as "locking". Now new corner contacts start at their
+    //   corner gap, and locking must hold for 10 records with the load on broken or
+    //   new contacts. Checked: without the corner gap (the lock rules as now) this
+    //   specimen still locks; with it but one record enough, it stops on the transient.
+    // - 4, the 8 x 16 m specimen of seed 2: the rounded corner a new contact is
+    //   measured against past an edge's end is a circle tangent to that edge only,
+    //   which beside the triangles' acute corners reaches past the block; vertices
+    //   there, outside the block, were born in overlap (344 of 515 contacts born below
+    //   -0.1 mm in the 3 x 6 m specimen) and pushed fragments apart with forces nothing
+    //   justified. This seed locked at 3.26e-3 strain after 90,860 steps and 23,106
+    //   cracks; now such a vertex's contact is with the edge across the corner, which
+    //   it faces, and starts open: the specimen softens (23,660 steps) before 0.4%.
     auto o = test::area_trigon_ucs();
     o.width = 3.0, o.height = 6.0;
     check_softens(three_seeds(o), "area trigon 3 x 6 m");
-    check_softens(three_seeds(test::area_trigon_ucs()), "area trigon 8 x 16 m");
+    const auto full = three_seeds(test::area_trigon_ucs());
+    check_softens(full, "area trigon 8 x 16 m");
+    CHECK(full[1].curve.back().axial_strain < 0.004);
 }
 
 TEST_CASE("post-peak, 3 seeds: rigid and deformable blocks (f = 0.5 and 0.95, 4 x 8 m) soften, deformable peaks within 15% of the rigid ones") {
