@@ -6,7 +6,8 @@
 // contacts created since the last renumbering (it decides when the next one
 // happens, and the numbering fixes the order of every sum), zone stresses,
 // relaxation and detection bookkeeping, loads and support velocities that a study
-// may have changed (a lab test's servo, a confinement ramp), time and counters.
+// may have changed (a lab test's servo, a confinement ramp), time and counters,
+// and the stage monitor's samples (core/verdict.hpp) that the verdict is taken from.
 // Geometry, property sets and the initial boundary conditions are rebuilt from
 // the model file, which generates the same assembly every time; a checkpoint
 // carries its format version, the fingerprint of the model it belongs to, the
@@ -26,9 +27,10 @@ namespace bbm {
 
 namespace {
 // "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
-// count (a resumed run renumbered its contacts at another step: issue 27).
+// count (a resumed run renumbered its contacts at another step: issue 27); 3 the
+// stage monitor's samples (a resumed run's verdict).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '3';
+constexpr std::uint64_t format = '4';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -97,6 +99,8 @@ void Solver::visit_state(Self& s, Visit&& v) {
     // lab tests (the servo's platen speed, the confinement ramp).
     v(s.b_.fixed_velocity), v(s.b_.fixed_omega), v(s.b_.applied), v(s.b_.applied_moment);
     v(s.n_.fixed_velocity), v(s.n_.applied);
+    // What the stage did so far, for its verdict (not physics: not in the state hash).
+    v(s.monitor_.samples_);
 }
 
 void Solver::save_state(std::ostream& o) const {

@@ -113,6 +113,11 @@ struct StageSpec {
     StressFieldSpec stress;            ///< initialize
     double ratio = 1e-5;               ///< solve: target unbalanced-force ratio
     long max_steps = 200000;           ///< solve: step limit
+    /// solve: also stop once the rock mass is at rest (core/verdict.hpp): no crack
+    /// in the last quiet_steps and the ratio of the rock mass, fragments left out,
+    /// at `ratio` (until = "rest"; "ratio", the default, waits for the model's ratio).
+    bool until_rest = false;
+    long quiet_steps = 2000;
     long steps = 0;                    ///< cycle
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps

@@ -43,6 +43,7 @@
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
 #include "core/model_spec.hpp"
+#include "core/verdict.hpp"
 #include "fem/cst.hpp"
 #include "meshing/blocks.hpp"
 
@@ -114,6 +115,12 @@ public:
     /// that collapses means a sliver block or a runaway contact stiffness).
     double initial_timestep() const { return first_dt_; }
     double kinetic_energy() const;
+    /// The scale of the unbalanced-force ratio: the RMS contact (and zone nodal) force.
+    double force_scale() const;
+    /// What the rock did in the current stage, for its verdict (core/verdict.hpp);
+    /// sampled by run_stages, saved with the state.
+    StageMonitor& monitor() { return monitor_; }
+    const StageMonitor& monitor() const { return monitor_; }
     double strain_energy() const;
     double dissipated_energy() const;
     double external_work() const { return work_; }
@@ -201,7 +208,6 @@ private:
     /// Boundary reactions (boundary_force) from the forces of the last evaluation.
     void sum_boundary_forces();
     void release_relaxation();
-    double force_scale() const;
     template <class Self, class Visit>
     static void visit_state(Self& self, Visit&& visit); ///< core/checkpoint.cpp
     std::uint64_t compute_model_fingerprint() const;    ///< core/checkpoint.cpp
@@ -214,6 +220,7 @@ private:
     fem::Zones z_;
     mutable contact::Contacts c_; ///< mutable: its normals are a cache (refresh_normals)
     mutable bool normals_stale_ = true;
+    StageMonitor monitor_;
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
     std::vector<std::string> region_names_;

@@ -29,19 +29,33 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         r.kind = to_string(st.kind);
         StageCursor cursor{index, true, resumed ? start.step : 0};
         r.steps = cursor.step;
-        auto run = [&](long max_steps, double target) {
+        // Solve and cycle stages are judged (core/verdict.hpp): the monitor samples
+        // at fixed steps of the run, so a resumed stage samples where the
+        // uninterrupted one does.
+        const bool judged = st.kind == StageSpec::Kind::solve || st.kind == StageSpec::Kind::cycle;
+        // Where a solve stage ends: its ratio reached (after a few steps: at rest
+        // the ratio is 0 before anything moves), or, asked for, the rock at rest.
+        auto solved = [&](long k) {
+            if (k >= 10 && s.unbalanced_ratio() <= st.ratio) return true;
+            return st.until_rest && s.steps() % StageMonitor::sample_every == 0 &&
+                   s.monitor().at_rest(st.ratio, st.quiet_steps);
+        };
+        auto run = [&](long max_steps, bool solve) {
             for (long k = cursor.step + 1; k <= max_steps; ++k) {
                 s.step();
                 ++r.steps;
                 cursor.step = k;
+                if (judged && s.steps() % StageMonitor::sample_every == 0) s.monitor().sample(s);
                 obs.step_done(s, st, k);
                 obs.at(s, cursor);
-                if (obs.stop_requested()) return;
-                // A few steps first: at rest the ratio is 0 before anything moves.
-                if (target > 0 && k >= 10 && s.unbalanced_ratio() <= target) return;
+                if (obs.stop_requested() || (solve && solved(k))) return;
             }
         };
         if (!resumed) {
+            if (judged) {
+                s.monitor().start_stage();
+                s.monitor().sample(s);
+            }
             obs.stage_started(s, st);
             switch (st.kind) {
             case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
@@ -54,17 +68,22 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         }
         switch (st.kind) {
         case StageSpec::Kind::solve:
-            if (!(resumed && cursor.step >= 10 && s.unbalanced_ratio() <= st.ratio)) run(st.max_steps, st.ratio);
+            if (!(resumed && solved(cursor.step))) run(st.max_steps, true);
             r.converged = s.unbalanced_ratio() <= st.ratio;
             break;
-        case StageSpec::Kind::excavate: run(st.relax_steps, 0.0); break;
-        case StageSpec::Kind::cycle: run(st.steps, 0.0); break;
+        case StageSpec::Kind::excavate: run(st.relax_steps, false); break;
+        case StageSpec::Kind::cycle: run(st.steps, false); break;
         case StageSpec::Kind::initialize:
         case StageSpec::Kind::elastic: break;
         }
         r.ratio = s.unbalanced_ratio();
         r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const bool stopped = obs.stop_requested();
+        if (judged && !stopped) {
+            const auto& samples = s.monitor().samples();
+            if (samples.empty() || samples.back().step != s.steps()) s.monitor().sample(s);
+            r.verdict = s.monitor().verdict(st.kind == StageSpec::Kind::solve ? st.ratio : StageSpec{}.ratio);
+        }
         if (!stopped) obs.stage_done(s, r);
         reports.push_back(r);
         // A stop asked for at the stage's end (by the observer) holds too.

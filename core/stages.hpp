@@ -20,6 +20,9 @@ struct StageReport {
     double seconds = 0.0;
     bool converged = true; ///< solve: reached the ratio within the step limit
     std::string method;    ///< elastic: the factorisation used
+    /// solve, cycle: what the rock did at the end (core/verdict.hpp); the target
+    /// ratio of a cycle stage is the solve stage's default.
+    Verdict verdict;
 };
 
 /// Where a run stands: the stage, whether its action (initialise, excavate, the

@@ -7,6 +7,8 @@
 // reported as such (with a suggestion), not as the required key it failed to be.
 #include "io/model_input.hpp"
 
+#include "core/verdict.hpp"
+
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -1112,13 +1114,14 @@ HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& nam
 
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
                      const Names& regions) {
-    static constexpr std::array<std::string_view, 14> all_keys{
-        "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy",
-        "dsyy_dy", "dsxy_dy", "ratio", "max_steps", "regions", "relax_steps", "steps"};
+    static constexpr std::array<std::string_view, 16> all_keys{
+        "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy", "dsyy_dy",
+        "dsxy_dy", "ratio", "max_steps", "until", "quiet_steps", "regions", "relax_steps", "steps"};
     static constexpr std::array<std::string_view, 9> initialize_keys{
         "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
-    static constexpr std::array<std::string_view, 4> solve_keys{"name", "type", "ratio",
-                                                                "max_steps"};
+    static constexpr std::array<std::string_view, 6> solve_keys{"name",  "type",       "ratio",
+                                                                "max_steps", "until", "quiet_steps"};
+    static constexpr std::array<std::string_view, 2> until_options{"ratio", "rest"};
     static constexpr std::array<std::string_view, 4> excavate_keys{"name", "type", "regions",
                                                                    "relax_steps"};
     static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
@@ -1155,6 +1158,9 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
                          Range{.lo = 0, .hi = 1, .lo_open = true, .hi_open = true, .unit = ""})
                       .value_or(s.ratio);
         s.max_steps = integer(c, t, p, "max_steps", 1, long_max).value_or(s.max_steps);
+        if (const toml::node* n = find(c, t, p, "until"))
+            s.until_rest = to_choice(c, *n, p.key("until"), until_options, "stopping rule") == 1;
+        s.quiet_steps = integer(c, t, p, "quiet_steps", StageMonitor::sample_every, long_max).value_or(s.quiet_steps);
         break;
     case Kind::excavate:
         s.regions = name_list(c, t, p, "regions", regions, "");

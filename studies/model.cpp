@@ -80,6 +80,23 @@ void check_run_health(const Solver& s) {
     }
 }
 
+nlohmann::json verdict_json(const Verdict& v) {
+    return {{"kind", to_string(v.kind)},
+            {"evidence", describe(v)},
+            {"window_steps", v.window_steps},
+            {"cracks_in_window", v.cracks_in_window},
+            {"cracks_per_1000_steps", v.crack_rate},
+            {"unbalanced_ratio", v.ratio},
+            {"rock_mass_ratio", v.rock_ratio},
+            {"target_ratio", v.target_ratio},
+            {"rock_kinetic_energy_trend", v.kinetic_trend},
+            {"rock_speed_trend", v.speed_trend},
+            {"fastest_rock_mm_per_1000_steps", 1000.0 * v.rock_speed},
+            {"fragments", v.fragments},
+            {"fragment_blocks", v.fragment_blocks},
+            {"fragment_mass_t_per_m", v.fragment_mass / 1000.0}};
+}
+
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
                            const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
                            const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,
@@ -91,6 +108,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
                          {"seconds", r.seconds}, {"converged", r.converged}};
         if (!r.method.empty()) j["method"] = r.method;
+        if (r.verdict.kind != Verdict::Kind::none) j["verdict"] = verdict_json(r.verdict);
         stages.push_back(j);
     }
     nlohmann::json summary{
@@ -116,6 +134,13 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         // last good state, not the end of the model's stages.
         {"complete", complete},
         {"stages", stages}};
+    // The run's verdict: that of its last judged (solve or cycle) stage.
+    for (auto r = reports.rbegin(); r != reports.rend(); ++r)
+        if (r->verdict.kind != Verdict::Kind::none) {
+            summary["verdict"] = verdict_json(r->verdict);
+            summary["verdict"]["stage"] = r->name;
+            break;
+        }
     const auto& rep = file.analysis.report;
     if (rep.opening) {
         const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);
@@ -149,8 +174,8 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
 namespace {
 
 // The tag of a model checkpoint; its last character is the format version (1
-// lacked the solver's renumbering count: issue 27).
-const char* const checkpoint_magic = "bbm-model-checkpoint-2";
+// lacked the solver's renumbering count: issue 27; 2 the stage verdicts).
+const char* const checkpoint_magic = "bbm-model-checkpoint-3";
 
 
 /// Passes steps to a Progress callback; stops when it says so.
@@ -290,7 +315,7 @@ void Model::checkpoint(const fs::path& file) const {
     put(o, std::uint64_t(reports_.size()));
     for (const auto& r : reports_) {
         put_string(o, r.name), put_string(o, r.kind), put_string(o, r.method);
-        put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged);
+        put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged), put(o, r.verdict);
     }
     put(o, run_seconds_);
     solver_->save_state(o);
@@ -318,6 +343,8 @@ Model Model::resume(const fs::path& file, int threads) {
         StageReport r;
         r.name = get_string(in, 1u << 20), r.kind = get_string(in, 1u << 20), r.method = get_string(in, 1u << 20);
         r.steps = get<long>(in), r.ratio = get<double>(in), r.seconds = get<double>(in), r.converged = get<bool>(in);
+        r.verdict = get<Verdict>(in);
+        if (!r.verdict.valid()) throw std::runtime_error("checkpoint is corrupt");
         m.reports_.push_back(r);
     }
     m.run_seconds_ = get<double>(in);

@@ -96,6 +96,8 @@ void check_run_health(const Solver& solver);
 /// cracks, energies, state hash, the stages, and with a [report] the opening's
 /// measures and hoop-stress profiles. `wall_seconds`, `interrupted` and
 /// `complete` describe how the run went.
+/// A stage verdict (core/verdict.hpp) as summary.json gives it.
+nlohmann::json verdict_json(const Verdict& v);
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
                            const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
                            const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,

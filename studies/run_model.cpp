@@ -41,9 +41,10 @@ std::atomic<int> interrupted{0};
 
 // A run checkpoint starts with this tag and the format version. Format 1 (no
 // version, model hash or stage reports; its solver state lacked the renumbering
-// count) is refused with a reason. Format 2: docs/theory.md §10.1.
+// count) is refused with a reason; so is format 2 (no verdicts in its stage
+// reports, and a solver state without the stage monitor). Format 3: docs/theory.md §10.1.
 constexpr std::string_view checkpoint_tag = "bbm-run-checkpoint-";
-constexpr std::uint32_t checkpoint_format = 2;
+constexpr std::uint32_t checkpoint_format = 3;
 
 /// FNV-1a of a model file's bytes: a checkpoint resumes only the text it ran.
 std::uint64_t text_hash(std::string_view text) {
@@ -156,10 +157,15 @@ public:
         record(s);
         snapshot(s);
         flush_history();
-        if (!options_.quiet)
-            std::fprintf(stderr, "\r  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s%s\n", r.name.c_str(),
-                         r.kind.c_str(), r.steps, r.ratio, r.seconds, r.converged ? "" : "  (step limit reached)",
-                         r.method.empty() ? "" : ("  " + r.method).c_str(), std::string(50, ' ').c_str());
+        if (options_.quiet) return;
+        // A solve stage ends at its ratio, at rest (until = "rest") or at its step limit.
+        const char* end = r.converged || r.kind != "solve" ? ""
+                        : r.verdict.at_rest()               ? "  (rock at rest)"
+                                                            : "  (step limit reached)";
+        std::fprintf(stderr, "\r  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s%s\n", r.name.c_str(),
+                     r.kind.c_str(), r.steps, r.ratio, r.seconds, end, r.method.empty() ? "" : ("  " + r.method).c_str(),
+                     std::string(50, ' ').c_str());
+        if (r.verdict.kind != Verdict::Kind::none) std::fprintf(stderr, "  %-12s %s\n", "", describe(r.verdict).c_str());
     }
     bool stop_requested() override { return interrupted.load() != 0; }
 
@@ -183,7 +189,7 @@ public:
         put(o, std::uint64_t(reports_.size()));
         for (const auto& r : reports_) {
             put_string(o, r.name), put_string(o, r.kind), put_string(o, r.method);
-            put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged);
+            put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged), put(o, r.verdict);
         }
         put(o, std::uint64_t(rows_.size()));
         for (std::size_t r = 0; r < rows_.size(); ++r) {
@@ -208,6 +214,8 @@ public:
             StageReport r;
             r.name = get_string(i), r.kind = get_string(i), r.method = get_string(i);
             r.steps = get<long>(i), r.ratio = get<double>(i), r.seconds = get<double>(i), r.converged = get<bool>(i);
+            r.verdict = get<Verdict>(i);
+        if (!r.verdict.valid()) throw std::runtime_error("checkpoint is corrupt");
             reports_.push_back(r);
         }
         const auto rows = get<std::uint64_t>(i);
@@ -518,10 +526,12 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
     std::ostringstream csv, md;
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
-           "cracks_springline_sector,cracks_crown_sector\n";
+           "cracks_springline_sector,cracks_crown_sector,verdict,cracks_per_1000_steps_at_end,fragments,"
+           "rock_mass_ratio\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
-          "failed depth springline m | failed depth crown m | sector cracks springline / crown |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "failed depth springline m | failed depth crown m | sector cracks springline / crown | verdict | "
+          "cracks / 1000 steps at the end | fragments | rock-mass ratio |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::vector<Series> curves;
     int status = 0;
     // The models over ranks under mpirun (one after another within a rank, each on
@@ -557,22 +567,28 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         const auto j = nlohmann::json::parse(f);
         const auto op = j.contains("opening") ? j["opening"] : nlohmann::json::object();
         auto get = [&](const char* k) { return op.contains(k) ? op[k].get<double>() : 0.0; };
+        const auto verdict = j.contains("verdict") ? j["verdict"] : nlohmann::json::object();
+        const std::string kind = verdict.value("kind", std::string("-"));
+        const double crack_rate = verdict.value("cracks_per_1000_steps", 0.0), rock_ratio = verdict.value("rock_mass_ratio", 0.0);
+        const int fragments = verdict.value("fragments", 0);
         char row[1024];
-        std::snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d\n", name.c_str(),
+        std::snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%s,%.3f,%d,%.3e\n", name.c_str(),
                       j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
                       j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
                       j["cracks"]["tensile"].get<int>(), j["cracks"]["shear"].get<int>(),
                       1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
                       get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
-                      int(get("cracks_crown_sector")));
+                      int(get("cracks_crown_sector")), kind.c_str(), crack_rate, fragments, rock_ratio);
         csv << row;
         const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
-        std::snprintf(row, sizeof row, "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d |\n",
+        std::snprintf(row, sizeof row,
+                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %s | %.2f | %d | %.2e |\n",
                       shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
                       1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
-                      int(get("cracks_springline_sector")), int(get("cracks_crown_sector")));
+                      int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), kind.c_str(), crack_rate,
+                      fragments, rock_ratio);
         md << row;
         // Cracks against step from the run's history (columns whose quantity is a crack count).
         Series ser{name, {}, {}};

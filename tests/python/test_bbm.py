@@ -173,6 +173,11 @@ def test_trigon_tunnel_checkpoint_mid_excavation_resumes_exactly(tmp_path):
     assert s["steps"] == r["steps"] == 9000
     assert s["cracks"] == r["cracks"]
     assert s["state_hash"] == r["state_hash"]
+    # The verdict of the resumed run is the uninterrupted one's (issue 24): the
+    # trigon tunnel cut at 6,000 failure steps is still breaking.
+    assert s["verdict"] == r["verdict"]
+    assert s["verdict"]["kind"] == "failing"
+    assert s["verdict"]["cracks_in_window"] > 0
 
 
 def test_checkpoint_of_an_older_format_is_refused(tmp_path):

@@ -1,0 +1,197 @@
+#include "core/verdict.hpp"
+
+#include "core/solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+namespace bbm {
+
+namespace {
+
+int find_root(std::vector<int>& parent, int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+} // namespace
+
+Fragments find_fragments(const Solver& s) {
+    const auto& b = s.blocks();
+    const auto& n = s.nodes();
+    const auto& c = s.contacts();
+    const int nb = b.count();
+    // Groups of bodies joined by contacts that carry force: bonded, or touching
+    // with a stress (a broken contact that has opened carries none).
+    std::vector<int> parent(nb);
+    std::iota(parent.begin(), parent.end(), 0);
+    for (int k = 0; k < c.size(); ++k) {
+        const auto& h = c.history[k];
+        if (!(h.bonded || h.sn != 0.0 || h.tau != 0.0)) continue;
+        const int ra = find_root(parent, c.vertex_block[k]), rb = find_root(parent, c.edge_block[k]);
+        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    // A group is the rock mass if a body of it is supported, or if it is the heaviest.
+    std::vector<std::uint8_t> anchored(nb, 0);
+    std::vector<double> mass(nb, 0.0);
+    for (int i = 0; i < nb; ++i) {
+        if (b.removed[i]) continue;
+        const int r = find_root(parent, i);
+        if (b.fixed[i]) anchored[r] = 1;
+        mass[r] += b.real_mass[i];
+    }
+    for (int k = 0; k < n.count(); ++k) {
+        const int i = n.block[k];
+        if (b.removed[i]) continue;
+        const int r = find_root(parent, i);
+        if (n.fixed[k]) anchored[r] = 1;
+        mass[r] += n.real_mass[k];
+    }
+    int heaviest = -1;
+    for (int i = 0; i < nb; ++i)
+        if (!b.removed[i] && parent[i] == i && (heaviest < 0 || mass[i] > mass[heaviest])) heaviest = i;
+    Fragments f;
+    f.detached.assign(nb, 0);
+    for (int i = 0; i < nb; ++i) {
+        if (b.removed[i]) continue;
+        const int r = find_root(parent, i);
+        if (anchored[r] || r == heaviest) continue;
+        f.detached[i] = 1;
+        ++f.blocks;
+        if (r == i) ++f.groups, f.mass += mass[i];
+    }
+    return f;
+}
+
+void StageMonitor::sample(const Solver& s) {
+    const auto fragments = find_fragments(s);
+    const auto& b = s.blocks();
+    const auto& n = s.nodes();
+    MonitorSample m;
+    m.step = s.steps();
+    m.cracks = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
+    m.ratio = s.unbalanced_ratio();
+    m.fragments = fragments.groups, m.fragment_blocks = fragments.blocks, m.fragment_mass = fragments.mass;
+    // The rock mass's largest unbalanced force over its free components, as the
+    // step measures the model's (Solver::integrate).
+    double unbalanced = 0.0, kinetic = 0.0, speed = 0.0;
+    for (int i = 0; i < b.count(); ++i) {
+        if (b.removed[i] || b.deformable[i] || fragments.detached[i]) continue;
+        if (!(b.fixed[i] & 1)) unbalanced = std::max(unbalanced, std::abs(b.force[i].x));
+        if (!(b.fixed[i] & 2)) unbalanced = std::max(unbalanced, std::abs(b.force[i].y));
+        kinetic += 0.5 * b.real_mass[i] * norm2(b.velocity[i]) + 0.5 * b.real_inertia[i] * b.omega[i] * b.omega[i];
+        speed = std::max(speed, norm(b.velocity[i]));
+    }
+    for (int k = 0; k < n.count(); ++k) {
+        const int i = n.block[k];
+        if (b.removed[i] || fragments.detached[i]) continue;
+        if (!(n.fixed[k] & 1)) unbalanced = std::max(unbalanced, std::abs(n.force[k].x));
+        if (!(n.fixed[k] & 2)) unbalanced = std::max(unbalanced, std::abs(n.force[k].y));
+        kinetic += 0.5 * n.real_mass[k] * norm2(n.velocity[k]);
+        speed = std::max(speed, norm(n.velocity[k]));
+    }
+    const double scale = s.force_scale();
+    m.rock_ratio = scale > 0.0 ? unbalanced / scale : 0.0;
+    m.rock_kinetic = kinetic;
+    m.rock_speed = speed * s.timestep();
+    samples_.push_back(m);
+}
+
+namespace {
+
+/// The window a verdict is taken over: the last quarter of the stage, between
+/// 1,000 and 5,000 steps (all of a shorter stage).
+long window_of(const std::vector<MonitorSample>& v) {
+    const long span = v.back().step - v.front().step;
+    return std::min(span, std::clamp(span / 4, 1000L, 5000L));
+}
+
+/// The first sample at or after `step`.
+std::size_t first_from(const std::vector<MonitorSample>& v, long step) {
+    return std::size_t(std::lower_bound(v.begin(), v.end(), step,
+                                        [](const MonitorSample& m, long s) { return m.step < s; }) -
+                       v.begin());
+}
+
+double mean_speed(const std::vector<MonitorSample>& v, std::size_t from, std::size_t to) {
+    double sum = 0.0;
+    for (std::size_t k = from; k < to; ++k) sum += v[k].rock_speed;
+    return to > from ? sum / double(to - from) : 0.0;
+}
+
+} // namespace
+
+Verdict StageMonitor::verdict(double target) const { return judge(samples_, target); }
+
+Verdict judge(const std::vector<MonitorSample>& samples, double target) {
+    Verdict v;
+    v.target_ratio = target;
+    // Fewer than 5 samples (500 steps) say nothing about a trend.
+    if (samples.size() < 5) return v;
+    const auto& last = samples.back();
+    v.window_steps = window_of(samples);
+    const std::size_t begin = first_from(samples, last.step - v.window_steps);
+    const auto& first = samples[begin];
+    v.cracks_in_window = last.cracks - first.cracks;
+    v.crack_rate = v.window_steps > 0 ? 1000.0 * double(v.cracks_in_window) / double(v.window_steps) : 0.0;
+    v.ratio = last.ratio, v.rock_ratio = last.rock_ratio;
+    v.fragments = last.fragments, v.fragment_blocks = last.fragment_blocks, v.fragment_mass = last.fragment_mass;
+    v.rock_speed = 1000.0 * last.rock_speed;
+    const double ke_first = first.rock_kinetic;
+    v.kinetic_trend = ke_first > 0.0 ? last.rock_kinetic / ke_first : (last.rock_kinetic > 0.0 ? INFINITY : 1.0);
+    // The rock's fastest body, averaged over each quarter of the window: a
+    // collapse accelerates through all four; a burst of cracks rises and falls.
+    double quarter[4];
+    bool rising = true;
+    for (int q = 0; q < 4; ++q) {
+        const std::size_t from = first_from(samples, last.step - v.window_steps + q * v.window_steps / 4);
+        const std::size_t to = q == 3 ? samples.size() : first_from(samples, last.step - v.window_steps + (q + 1) * v.window_steps / 4);
+        quarter[q] = mean_speed(samples, from, to);
+        if (q > 0 && !(quarter[q] > quarter[q - 1])) rising = false;
+    }
+    v.speed_trend = quarter[0] > 0.0 ? quarter[3] / quarter[0] : (quarter[3] > 0.0 ? INFINITY : 1.0);
+    using K = Verdict::Kind;
+    if (v.cracks_in_window == 0 && last.ratio <= target) v.kind = K::equilibrium;
+    else if (v.cracks_in_window == 0 && last.fragments > 0 && last.rock_ratio <= target) v.kind = K::equilibrium_with_fragments;
+    else if (rising && v.speed_trend > 1.1 && v.kinetic_trend > 1.0) v.kind = K::collapsing;
+    else if (v.cracks_in_window > 0) v.kind = K::failing;
+    else v.kind = K::not_converged;
+    return v;
+}
+
+bool StageMonitor::at_rest(double target, long quiet_steps) const {
+    if (samples_.empty()) return false;
+    const auto& last = samples_.back();
+    if (last.step - samples_.front().step < quiet_steps) return false;
+    const auto& then = samples_[first_from(samples_, last.step - quiet_steps)];
+    return last.cracks == then.cracks && last.rock_ratio <= target;
+}
+
+const char* to_string(Verdict::Kind k) {
+    switch (k) {
+    case Verdict::Kind::none: return "none";
+    case Verdict::Kind::equilibrium: return "equilibrium";
+    case Verdict::Kind::equilibrium_with_fragments: return "equilibrium with fragments";
+    case Verdict::Kind::not_converged: return "not converged";
+    case Verdict::Kind::failing: return "failing";
+    case Verdict::Kind::collapsing: return "collapsing";
+    }
+    return "?";
+}
+
+std::string describe(const Verdict& v) {
+    if (v.kind == Verdict::Kind::none) return "too short to judge";
+    char line[512];
+    int n = std::snprintf(line, sizeof line, "%s: %ld cracks in the last %ld steps (%.2f per 1000), ratio %.2e",
+                          to_string(v.kind), v.cracks_in_window, v.window_steps, v.crack_rate, v.ratio);
+    if (v.fragments > 0)
+        n += std::snprintf(line + n, sizeof line - std::size_t(n), " (rock mass %.2e; %d fragments of %d blocks, %.3g t/m)",
+                           v.rock_ratio, v.fragments, v.fragment_blocks, v.fragment_mass / 1000.0);
+    std::snprintf(line + n, sizeof line - std::size_t(n), ", fastest rock %.3g mm per 1000 steps, speed trend %.2f",
+                  1000.0 * v.rock_speed, v.speed_trend);
+    return line;
+}
+
+} // namespace bbm
