@@ -10,6 +10,8 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <sstream>
 
@@ -51,62 +53,18 @@ Built load(const std::string& name) {
     return l;
 }
 
-/// A bonded Voronoi base held at its foot, and a 1 m block `gap` m above it:
-/// the block falls freely until it lands.
+/// examples/verification/dropped_block.toml (a bonded Voronoi base held at its
+/// foot, a 1 m block above it) with the block `gap` m above the base, so that it
+/// falls freely until it lands, and `stage` in place of its stages.
 std::string base_and_block(double gap, const std::string& stage) {
-    std::ostringstream s;
-    s << R"(
-[solver]
-mode = "dynamic"
-damping = 0.3
-gravity = [0.0, -9.81]
-new_contact_property = "unbonded"
-detection_tolerance = 0.01
-
-[[material]]
-name = "rock"
-density = 2700.0
-
-[[region]]
-name = "base"
-outline = { type = "rectangle", min = [0.0, 0.0], max = [4.0, 1.0] }
-pattern = { type = "voronoi", size = 0.4, lloyd = 2, seed = 5 }
-
-[[region]]
-name = "block"
-outline = { type = "rectangle", min = [1.5, )" << 1.0 + gap << R"(], max = [2.5, )" << 2.0 + gap << R"(] }
-pattern = { type = "single" }
-
-[[joint_property]]
-name = "bond"
-law = "softening"
-kn = 10.0e9
-ks = 4.0e9
-tensile = 3.0e6
-cohesion = 9.5e6
-friction = 25.0
-tension_softening = [[1.7, 0.5], [4.0, 0.0]]
-shear_softening = [[1.3, 0.5], [2.1, 0.0]]
-
-[[joint_property]]
-name = "unbonded"
-law = "coulomb"
-kn = 10.0e9
-ks = 4.0e9
-friction = 30.0
-
-[[joint_assignment]]
-property = "bond"
-
-[[boundary]]
-name = "bottom"
-type = "velocity"
-box = { min = [-1.0, -1.0], max = [5.0, 0.3] }
-vx = 0.0
-vy = 0.0
-omega = 0.0
-)" << stage;
-    return s.str();
+    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/verification/dropped_block.toml");
+    std::string text{std::istreambuf_iterator<char>(in), {}};
+    const std::string block = "min = [1.5, 1.5], max = [2.5, 2.5]";
+    REQUIRE(text.find(block) != std::string::npos);
+    std::ostringstream moved;
+    moved << "min = [1.5, " << 1.0 + gap << "], max = [2.5, " << 2.0 + gap << "]";
+    text.replace(text.find(block), block.size(), moved.str());
+    return text.substr(0, text.find("[[stage]]")) + stage;
 }
 
 } // namespace
