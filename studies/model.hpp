@@ -92,12 +92,13 @@ private:
 /// and what to change.
 void check_run_health(const Solver& solver);
 
-/// The summary of a run, keys as in `bbm run`'s summary.json: counts, steps,
-/// cracks, energies, state hash, the stages, and with a [report] the opening's
-/// measures and hoop-stress profiles. `wall_seconds`, `interrupted` and
-/// `complete` describe how the run went.
 /// A stage verdict (core/verdict.hpp) as summary.json gives it.
 nlohmann::json verdict_json(const Verdict& v);
+
+/// The summary of a run, keys as in `bbm run`'s summary.json: counts, steps,
+/// cracks, energies, state hash, the stages with their verdicts and the run's
+/// verdict, and with a [report] the opening's measures and hoop-stress profiles.
+/// `wall_seconds`, `interrupted` and `complete` describe how the run went.
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
                            const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
                            const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,

@@ -215,7 +215,7 @@ public:
             r.name = get_string(i), r.kind = get_string(i), r.method = get_string(i);
             r.steps = get<long>(i), r.ratio = get<double>(i), r.seconds = get<double>(i), r.converged = get<bool>(i);
             r.verdict = get<Verdict>(i);
-        if (!r.verdict.valid()) throw std::runtime_error("checkpoint is corrupt");
+            if (!r.verdict.valid()) throw std::runtime_error("checkpoint is corrupt");
             reports_.push_back(r);
         }
         const auto rows = get<std::uint64_t>(i);
