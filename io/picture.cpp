@@ -231,6 +231,17 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
         cairo_line_to(cr, y.x, y.y);
         cairo_stroke(cr);
     }
+    if (!o.outline.empty()) {
+        cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+        cairo_set_line_width(cr, 2.0 * px);
+        const double dash[2] = {8.0 * px, 5.0 * px};
+        cairo_set_dash(cr, dash, 2, 0.0);
+        cairo_move_to(cr, o.outline.front().x, o.outline.front().y);
+        for (const Vec2& p : o.outline) cairo_line_to(cr, p.x, p.y);
+        cairo_close_path(cr);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, nullptr, 0, 0.0);
+    }
     cairo_restore(cr);
     // Legend.
     const double y0 = view.h - 0.5 * legend + 5;
@@ -244,9 +255,9 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s",
+    std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s",
                   s.cracks(contact::JointState::broken_shear), 1e3 * umax, 1e3 * umax_all,
-                  o.title.empty() ? "" : "   ", o.title.c_str());
+                  o.outline.empty() ? "" : "   dashed: failed zone", o.title.empty() ? "" : "   ", o.title.c_str());
     text(cr, 292, y0, buf);
     canvas.finish();
 }

@@ -35,6 +35,8 @@ struct FailurePlotOptions {
     int width_px = 1200;
     Box2 window; ///< empty = the whole model
     std::string title;
+    /// A closed outline drawn dashed over the cracks (the failed zone about an opening); empty: none.
+    std::vector<Vec2> outline;
 };
 
 /// Blocks shaded by displacement magnitude, with broken contacts drawn along their

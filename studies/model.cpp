@@ -155,6 +155,16 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             {"cracks_crown_sector", m.cracks_crown_sector},
             {"springline_sector_tensile", m.tensile_springline_sector},
             {"springline_sector_shear", m.shear_springline_sector}};
+        const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
+        summary["opening"]["failed_zone"] = {{"cell_m", zone.cell},
+                                             {"threshold_broken_fraction", zone.threshold},
+                                             {"sector_deg", 360.0 / double(zone.depth.size())},
+                                             {"depth_by_sector_m", zone.depth},
+                                             {"depth_springline", zone.depth_springline},
+                                             {"depth_crown", zone.depth_crown},
+                                             {"extent_springline_deg", zone.extent_springline_deg},
+                                             {"extent_crown_deg", zone.extent_crown_deg},
+                                             {"area_m2", zone.area}};
         // Hoop stress profiles from the wall outwards (compression positive, MPa).
         const auto stress = solver.block_stresses();
         const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);

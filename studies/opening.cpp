@@ -65,6 +65,103 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
     return m;
 }
 
+FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
+                               double threshold, int sectors) {
+    constexpr double pi = 3.141592653589793;
+    FailedZone z;
+    z.cell = cell, z.threshold = threshold, z.center = center;
+    z.radius = std::min(norm(springline - center), norm(crown - center));
+    z.depth.assign(std::size_t(sectors), 0.0);
+    const auto& b = s.blocks();
+    const auto& n = s.nodes();
+    const auto& c = s.contacts();
+    // Joint length, all and broken, per cell (ring-major) at the joints' initial position.
+    auto initial = [&](int v, int blk) {
+        const int node = b.vertex_node[v];
+        return node >= 0 ? n.position0[node] : b.centroid0[blk] + b.local[v];
+    };
+    int rings = 0;
+    std::vector<std::pair<int, bool>> where(std::size_t(c.size()), {-1, false});
+    std::vector<double> all, broken;
+    for (int i = 0; i < c.size(); ++i) {
+        const Vec2 r = initial(c.vertex_id[i], c.vertex_block[i]) - center;
+        const double d = norm(r);
+        if (d < z.radius) continue;
+        const int ring = int((d - z.radius) / cell);
+        double angle = std::atan2(r.y, r.x);
+        if (angle < 0) angle += 2 * pi;
+        const int sector = std::min(sectors - 1, int(angle / (2 * pi) * sectors));
+        rings = std::max(rings, ring + 1);
+        // Joints of the rock only: a contact formed unbonded during the run (between
+        // fragments, or a fragment and the wall) is neither intact rock nor a crack.
+        const auto& h = c.history[i];
+        const bool is_broken = h.broken == contact::JointState::broken_tension || h.broken == contact::JointState::broken_shear;
+        if (!h.bonded && !is_broken) continue;
+        where[std::size_t(i)] = {ring * sectors + sector, is_broken};
+    }
+    all.assign(std::size_t(rings * sectors), 0.0), broken.assign(all.size(), 0.0);
+    for (int i = 0; i < c.size(); ++i) {
+        const auto [cell_index, is_broken] = where[std::size_t(i)];
+        if (cell_index < 0) continue;
+        all[std::size_t(cell_index)] += c.length[i];
+        if (is_broken) broken[std::size_t(cell_index)] += c.length[i];
+    }
+    auto damaged = [&](int k) { return all[std::size_t(k)] > 0 && broken[std::size_t(k)] >= threshold * all[std::size_t(k)]; };
+    // Flood from the damaged cells of the first ring.
+    std::vector<std::uint8_t> in_zone(all.size(), 0);
+    std::vector<int> stack;
+    for (int k = 0; k < std::min(sectors, int(all.size())); ++k)
+        if (damaged(k)) in_zone[std::size_t(k)] = 1, stack.push_back(k);
+    while (!stack.empty()) {
+        const int k = stack.back();
+        stack.pop_back();
+        const int ring = k / sectors, sector = k % sectors;
+        const int next[4] = {ring > 0 ? k - sectors : -1, ring + 1 < rings ? k + sectors : -1,
+                             ring * sectors + (sector + 1) % sectors, ring * sectors + (sector + sectors - 1) % sectors};
+        for (int m : next)
+            if (m >= 0 && !in_zone[std::size_t(m)] && damaged(m)) in_zone[std::size_t(m)] = 1, stack.push_back(m);
+    }
+    for (std::size_t k = 0; k < in_zone.size(); ++k) {
+        if (!in_zone[k]) continue;
+        const int ring = int(k) / sectors, sector = int(k) % sectors;
+        z.depth[std::size_t(sector)] = std::max(z.depth[std::size_t(sector)], (ring + 1) * cell);
+        const double r0 = z.radius + ring * cell, r1 = r0 + cell;
+        z.area += pi * (r1 * r1 - r0 * r0) / sectors;
+    }
+    // Per direction: the deepest sector whose centre is within 15 deg, and the
+    // angular width of the zone within 45 deg.
+    auto about = [&](Vec2 towards, double& depth, double& extent) {
+        const Vec2 dir = (towards - center) / norm(towards - center);
+        for (int k = 0; k < sectors; ++k) {
+            const double mid = (k + 0.5) * 2 * pi / sectors;
+            const double off = std::acos(std::clamp(dir.x * std::cos(mid) + dir.y * std::sin(mid), -1.0, 1.0)) * 180 / pi;
+            if (off <= 15.0 + 1e-9) depth = std::max(depth, z.depth[std::size_t(k)]);
+            if (off <= 45.0 + 1e-9 && z.depth[std::size_t(k)] > 0) extent += 360.0 / sectors;
+        }
+    };
+    about(springline, z.depth_springline, z.extent_springline_deg);
+    about(crown, z.depth_crown, z.extent_crown_deg);
+    return z;
+}
+
+FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown) {
+    const auto& c = s.contacts();
+    double length = 0.0;
+    for (int i = 0; i < c.size(); ++i) length += c.length[i];
+    const double cell = c.size() > 0 ? 4.0 * length / c.size() : 0.3;
+    return measure_failed_zone(s, center, springline, crown, cell);
+}
+
+std::vector<Vec2> FailedZone::outline() const {
+    std::vector<Vec2> points;
+    const int sectors = int(depth.size());
+    for (int k = 0; k < sectors; ++k) {
+        const double mid = (k + 0.5) * 2 * 3.141592653589793 / sectors;
+        points.push_back(center + (radius + depth[std::size_t(k)]) * Vec2{std::cos(mid), std::sin(mid)});
+    }
+    return points;
+}
+
 double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,
                       Vec2 towards, double r, double band) {
     const Vec2 dir = (towards - center) / norm(towards - center), p = center + r * dir;

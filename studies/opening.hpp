@@ -26,6 +26,35 @@ struct OpeningMeasures {
 };
 OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
 
+/// The failed zone as engineers map it around an opening: the damaged rock that is
+/// connected to the wall. A polar grid about the centre — `sectors` equal sectors
+/// (36: 10 degrees), rings of `cell` metres from the opening's radius outwards —
+/// holds the joints at their initial position (where the rock was: a fragment that
+/// fell to the floor is mapped where it came from). A cell is damaged when at least
+/// `threshold` of its joint length is broken (the broken-contact density per unit
+/// area over that of the intact pattern: independent of the block size); the zone
+/// is the damaged cells connected through damaged neighbours (across rings and
+/// sectors) to a damaged cell of the first ring. Its depth in a sector is the outer
+/// edge of its deepest cell less the radius — a resolution of one cell. A scattered
+/// crack deep in the rock, not connected to the wall, is not in it (the deepest
+/// single crack is OpeningMeasures' failed depth).
+struct FailedZone {
+    double cell = 0, threshold = 0, radius = 0;
+    Vec2 center{};
+    std::vector<double> depth; ///< per sector, counter-clockwise from +x, m (0: none)
+    double depth_springline = 0, depth_crown = 0; ///< deepest within +/-15 deg of each direction
+    /// Angular width of the zone (sectors with a depth) within +/-45 deg of each direction.
+    double extent_springline_deg = 0, extent_crown_deg = 0;
+    double area = 0; ///< m^2, the cells of the zone
+    /// The zone's outer edge: per sector, its centre direction at radius + depth.
+    std::vector<Vec2> outline() const;
+};
+FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
+                               double threshold = 0.2, int sectors = 36);
+/// The failed zone with cells of four mean contact lengths (about one block: two
+/// contacts share each joint edge), as summary.json and failure.png give it.
+FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
+
 /// Hoop stress (tension positive) at distance r from `center` along the direction
 /// `towards`: the area-weighted mean of the block-averaged stress of rigid blocks
 /// and of the zone stresses whose centroids lie within `band` of that point (the

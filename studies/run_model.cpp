@@ -489,6 +489,8 @@ int run_model(const RunOptions& opt) {
         for (Vec2 p : blocks.points) all.add(p);
         fo.window.add({std::max(all.lo.x, rep.center.x - 2.2 * r), std::max(all.lo.y, rep.center.y - 2.2 * r)});
         fo.window.add({std::min(all.hi.x, rep.center.x + 2.2 * r), std::min(all.hi.y, rep.center.y + 2.2 * r)});
+        const auto zone = measure_failed_zone(*solver, rep.center, rep.springline, rep.crown);
+        if (zone.area > 0) fo.outline = zone.outline();
     }
     if (rep.window) fo.window = *rep.window;
     if (!health.empty()) {
@@ -526,12 +528,12 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
     std::ostringstream csv, md;
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
-           "cracks_springline_sector,cracks_crown_sector,verdict,cracks_per_1000_steps_at_end,fragments,"
-           "rock_mass_ratio\n";
+           "cracks_springline_sector,cracks_crown_sector,failed_zone_depth_springline_m,failed_zone_depth_crown_m,"
+           "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
-          "failed depth springline m | failed depth crown m | sector cracks springline / crown | verdict | "
-          "cracks / 1000 steps at the end | fragments | rock-mass ratio |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "crack depth (90%%) springline m | crack depth (90%%) crown m | sector cracks springline / crown | "
+          "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::vector<Series> curves;
     int status = 0;
     // The models over ranks under mpirun (one after another within a rank, each on
@@ -571,24 +573,29 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         const std::string kind = verdict.value("kind", std::string("-"));
         const double crack_rate = verdict.value("cracks_per_1000_steps", 0.0), rock_ratio = verdict.value("rock_mass_ratio", 0.0);
         const int fragments = verdict.value("fragments", 0);
+        const auto zone = op.contains("failed_zone") ? op["failed_zone"] : nlohmann::json::object();
+        const double zone_springline = zone.value("depth_springline", 0.0), zone_crown = zone.value("depth_crown", 0.0);
         char row[1024];
-        std::snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%s,%.3f,%d,%.3e\n", name.c_str(),
+        std::snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e\n",
+                      name.c_str(),
                       j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
                       j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
                       j["cracks"]["tensile"].get<int>(), j["cracks"]["shear"].get<int>(),
                       1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
                       get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
-                      int(get("cracks_crown_sector")), kind.c_str(), crack_rate, fragments, rock_ratio);
+                      int(get("cracks_crown_sector")), zone_springline, zone_crown, kind.c_str(), crack_rate, fragments,
+                      rock_ratio);
         csv << row;
         const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
         std::snprintf(row, sizeof row,
-                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %s | %.2f | %d | %.2e |\n",
+                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f | %s | %.2f | %d | "
+                      "%.2e |\n",
                       shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
                       1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
-                      int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), kind.c_str(), crack_rate,
-                      fragments, rock_ratio);
+                      int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), zone_springline, zone_crown,
+                      kind.c_str(), crack_rate, fragments, rock_ratio);
         md << row;
         // Cracks against step from the run's history (columns whose quantity is a crack count).
         Series ser{name, {}, {}};

@@ -142,3 +142,42 @@ TEST_CASE("tunnel: Voronoi blocks with joints calibrated in bbm (macro friction 
     CHECK(r.verdict.rock_ratio <= 1e-5);
     CHECK(r.steps < 20000);
 }
+
+TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and extent, and a deep crack cluster apart is not in it") {
+    // Issue 24: cracks written into the joints of the Voronoi tunnel at known
+    // places: every joint within 1.2 m of the wall and 20 degrees of the
+    // springline, and a cluster 3 to 3.6 m from the wall at the crown that the
+    // wall's intact rock separates from it.
+    const auto file = read_example("tunnel_voronoi.toml");
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    Solver s(blocks, file.analysis);
+    auto& c = s.contacts();
+    const auto& b = s.blocks();
+    const double a = 4.0, pi = 3.141592653589793;
+    for (int i = 0; i < c.size(); ++i) {
+        const Vec2 x = b.centroid0[c.vertex_block[i]] + b.local[c.vertex_id[i]];
+        const double r = norm(x), angle = std::atan2(x.y, x.x) * 180 / pi;
+        const bool wall = r - a < 1.2 && std::abs(angle) < 20.0;
+        const bool deep = r - a > 3.0 && r - a < 3.6 && std::abs(angle - 90.0) < 20.0;
+        if (wall || deep) c.history[i].broken = contact::JointState::broken_tension, c.history[i].bonded = false;
+    }
+    const auto z = measure_failed_zone(s, {0, 0}, {4, 0}, {0, 4});
+    MESSAGE("cell " << z.cell << " m; depth springline " << z.depth_springline << " m, crown " << z.depth_crown
+                    << " m; extent " << z.extent_springline_deg << " deg; area " << z.area << " m2");
+    // Depth: the outer edge of the deepest damaged cell, so 1.2 m to one cell more.
+    CHECK(z.depth_springline >= 1.2 - 1e-9);
+    CHECK(z.depth_springline <= 1.2 + z.cell + 1e-9);
+    // The crown cluster is not connected to the wall: no failed zone there.
+    CHECK(z.depth_crown == 0.0);
+    // +/-20 degrees: the four 10-degree sectors whose centres lie within it (and a
+    // sector cut by its edge where its cells still pass the threshold).
+    CHECK(z.extent_springline_deg >= 40.0);
+    CHECK(z.extent_springline_deg <= 60.0);
+    // The zone's area against the annular sector it covers.
+    const double sector_area = pi * (std::pow(a + 1.2, 2) - a * a) * 40.0 / 360.0;
+    CHECK(z.area >= 0.8 * sector_area);
+    CHECK(z.area <= 2.0 * sector_area);
+    // The deepest single crack (OpeningMeasures) sees the crown cluster.
+    const auto m = measure_opening(s, {0, 0}, {4, 0}, {0, 4});
+    CHECK(m.failed_depth_crown > 3.0);
+}
