@@ -107,11 +107,22 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
         if (is_broken) broken[std::size_t(cell_index)] += c.length[i];
     }
     auto damaged = [&](int k) { return all[std::size_t(k)] > 0 && broken[std::size_t(k)] >= threshold * all[std::size_t(k)]; };
-    // Flood from the damaged cells of the first ring.
+    // The wall in each sector: its innermost ring that holds rock (rings start at
+    // the smaller radius; an opening that is not a circle leaves the first rings of
+    // its longer directions empty). Flood from the damaged cells at the wall.
+    std::vector<int> wall(std::size_t(sectors), rings);
+    for (int sector = 0; sector < sectors; ++sector)
+        for (int ring = 0; ring < rings; ++ring)
+            if (all[std::size_t(ring * sectors + sector)] > 0) {
+                wall[std::size_t(sector)] = ring;
+                break;
+            }
     std::vector<std::uint8_t> in_zone(all.size(), 0);
     std::vector<int> stack;
-    for (int k = 0; k < std::min(sectors, int(all.size())); ++k)
-        if (damaged(k)) in_zone[std::size_t(k)] = 1, stack.push_back(k);
+    for (int sector = 0; sector < sectors; ++sector) {
+        const int k = wall[std::size_t(sector)] * sectors + sector;
+        if (wall[std::size_t(sector)] < rings && damaged(k)) in_zone[std::size_t(k)] = 1, stack.push_back(k);
+    }
     while (!stack.empty()) {
         const int k = stack.back();
         stack.pop_back();
@@ -124,7 +135,7 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
     for (std::size_t k = 0; k < in_zone.size(); ++k) {
         if (!in_zone[k]) continue;
         const int ring = int(k) / sectors, sector = int(k) % sectors;
-        z.depth[std::size_t(sector)] = std::max(z.depth[std::size_t(sector)], (ring + 1) * cell);
+        z.depth[std::size_t(sector)] = std::max(z.depth[std::size_t(sector)], (ring + 1 - wall[std::size_t(sector)]) * cell);
         const double r0 = z.radius + ring * cell, r1 = r0 + cell;
         z.area += pi * (r1 * r1 - r0 * r0) / sectors;
     }
@@ -139,6 +150,9 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
             if (off <= 45.0 + 1e-9 && z.depth[std::size_t(k)] > 0) extent += 360.0 / sectors;
         }
     };
+    z.wall_offset.assign(std::size_t(sectors), 0.0);
+    for (int sector = 0; sector < sectors; ++sector)
+        if (wall[std::size_t(sector)] < rings) z.wall_offset[std::size_t(sector)] = wall[std::size_t(sector)] * cell;
     about(springline, z.depth_springline, z.extent_springline_deg);
     about(crown, z.depth_crown, z.extent_crown_deg);
     return z;
@@ -157,7 +171,8 @@ std::vector<Vec2> FailedZone::outline() const {
     const int sectors = int(depth.size());
     for (int k = 0; k < sectors; ++k) {
         const double mid = (k + 0.5) * 2 * 3.141592653589793 / sectors;
-        points.push_back(center + (radius + depth[std::size_t(k)]) * Vec2{std::cos(mid), std::sin(mid)});
+        points.push_back(center + (radius + wall_offset[std::size_t(k)] + depth[std::size_t(k)]) *
+                                      Vec2{std::cos(mid), std::sin(mid)});
     }
     return points;
 }

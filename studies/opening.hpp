@@ -34,14 +34,18 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
 /// `threshold` of its joint length is broken (the broken-contact density per unit
 /// area over that of the intact pattern: independent of the block size); the zone
 /// is the damaged cells connected through damaged neighbours (across rings and
-/// sectors) to a damaged cell of the first ring. Its depth in a sector is the outer
-/// edge of its deepest cell less the radius — a resolution of one cell. A scattered
+/// sectors) to a damaged cell at the wall (a sector's innermost ring with rock).
+/// Its depth in a sector is the outer edge of its deepest cell less the wall's
+/// inner edge — a resolution of one cell. A scattered
 /// crack deep in the rock, not connected to the wall, is not in it (the deepest
 /// single crack is OpeningMeasures' failed depth).
 struct FailedZone {
     double cell = 0, threshold = 0, radius = 0;
     Vec2 center{};
-    std::vector<double> depth; ///< per sector, counter-clockwise from +x, m (0: none)
+    std::vector<double> depth; ///< per sector, counter-clockwise from +x, from the wall, m (0: none)
+    /// Per sector, the wall's distance beyond `radius` (whole cells: non-zero where
+    /// the opening is wider than its smaller radius).
+    std::vector<double> wall_offset;
     double depth_springline = 0, depth_crown = 0; ///< deepest within +/-15 deg of each direction
     /// Angular width of the zone (sectors with a depth) within +/-45 deg of each direction.
     double extent_springline_deg = 0, extent_crown_deg = 0;
