@@ -384,13 +384,13 @@ CheckpointInterval parse_checkpoint_interval(const std::string& text) {
 int run_model(const RunOptions& opt) {
     // From the start: a scheduler's signal during meshing or the elastic solve
     // must not kill the run either (it stops after the first step).
+    // The handlers stay installed after the run: a scheduler's signal that comes
+    // once the run has written its results (a job's time limit while the process
+    // exits) must not turn a finished run into one killed by a signal (status
+    // 138 for SIGUSR1: the requeued job would then fail). `bbm compare` reads the
+    // flag between models.
     interrupted = 0;
     for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, [](int signal) { interrupted = signal; });
-    struct DefaultSignals {
-        ~DefaultSignals() {
-            for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, SIG_DFL);
-        }
-    } restore_signals;
     std::string model_path = opt.model;
     std::ifstream checkpoint;
     CheckpointHeader header;
@@ -553,7 +553,8 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         o.quiet = quiet || parallel;
         if (!o.quiet) std::fprintf(stderr, "== %s\n", name.c_str());
         const int rc = run_model(o);
-        stopped = stopped || rc == 130;
+        // Stopped in this model, or by a signal that came after it had finished.
+        stopped = stopped || rc == 130 || interrupted.load() != 0;
         return std::to_string(rc);
     });
     if (!Ranks::root()) return 0;
@@ -562,7 +563,10 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         const std::string name = fs::path(model).stem().string();
         RunOptions o;
         o.out = out / name;
-        if (codes[m] == "not started") continue; // the comparison was interrupted before it
+        if (codes[m] == "not started") { // the comparison was interrupted before it
+            if (status == 0) status = 130;
+            continue;
+        }
         const int rc = std::stoi(codes[m]);
         if (rc != 0 && status == 0) status = rc;
         std::ifstream f(o.out / "summary.json");
