@@ -531,7 +531,7 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
            "cracks_springline_sector,cracks_crown_sector,failed_zone_depth_springline_m,failed_zone_depth_crown_m,"
            "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
-          "crack depth (90%%) springline m | crack depth (90%%) crown m | sector cracks springline / crown | "
+          "crack depth (90%) springline m | crack depth (90%) crown m | sector cracks springline / crown | "
           "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio |\n"
        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::vector<Series> curves;
