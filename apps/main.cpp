@@ -247,9 +247,13 @@ int run_cli(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
+    // First thing: a scheduler's SIGUSR1 or SIGTERM while bbm starts must ask for
+    // a checkpoint, not kill it (again after MPI, which may install its own).
+    studies::catch_stop_signals();
     // Under mpirun (or srun) the independent runs of a study are spread over the
     // ranks (studies/ranks.hpp); otherwise nothing changes.
     studies::Ranks::start(&argc, &argv);
+    studies::catch_stop_signals();
     const int status = run_cli(argc, argv);
     studies::Ranks::stop();
     return status;

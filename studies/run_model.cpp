@@ -381,6 +381,12 @@ CheckpointInterval parse_checkpoint_interval(const std::string& text) {
     return every;
 }
 
+void catch_stop_signals() {
+    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, [](int signal) { interrupted = signal; });
+}
+
+bool stop_signal_received() { return interrupted.load() > 0; }
+
 int run_model(const RunOptions& opt) {
     // From the start: a scheduler's signal during meshing or the elastic solve
     // must not kill the run either (it stops after the first step).
@@ -389,8 +395,10 @@ int run_model(const RunOptions& opt) {
     // exits) must not turn a finished run into one killed by a signal (status
     // 138 for SIGUSR1: the requeued job would then fail). `bbm compare` reads the
     // flag between models.
-    interrupted = 0;
-    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, [](int signal) { interrupted = signal; });
+    // A signal that came before (during start-up) is kept: the run stops after
+    // its first step. Only an earlier run's --stop-at-step is forgotten.
+    if (interrupted.load() < 0) interrupted = 0;
+    catch_stop_signals();
     std::string model_path = opt.model;
     std::ifstream checkpoint;
     CheckpointHeader header;

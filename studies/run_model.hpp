@@ -50,6 +50,15 @@ struct RunOptions {
 /// Throws InputError for bad input, std::runtime_error for other failures.
 int run_model(const RunOptions& options);
 
+/// Installs the handlers of SIGINT, SIGTERM and SIGUSR1 that ask a run to stop
+/// after its current step (with a checkpoint). `bbm` installs them first thing, so
+/// that a scheduler's signal during start-up (loading, meshing) is not fatal.
+void catch_stop_signals();
+
+/// Whether SIGINT, SIGTERM or SIGUSR1 has come: `bbm compare` and `bbm sweep` then
+/// start no further run.
+bool stop_signal_received();
+
 /// `bbm compare A.toml B.toml ... --out DIR`: runs each model into DIR/<name>/ and
 /// writes DIR/comparison.csv and comparison.md (opening displacements, cracks by
 /// mode, failed-zone depths, counts and run time per model) and comparison.png

@@ -15,6 +15,7 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 namespace bbm::studies {
 
@@ -127,6 +128,10 @@ int run_sweep(const SweepOptions& o) {
                      Ranks::size() > 1 ? "s" : "", o.jobs);
     std::vector<std::string> errors;
     const auto summaries = run_spread(int(runs), o.jobs, [&](int k) -> std::string {
+        // Interrupted (Ctrl-C, a scheduler's signal): the runs under way stop with a
+        // checkpoint, no further run starts; `bbm sweep --resume` runs the rest.
+        if (stop_signal_received())
+            throw std::runtime_error("not started: the sweep was interrupted (bbm sweep --resume runs it)");
         const auto& r = plan[std::size_t(k)];
         const fs::path dir = o.out / r.dir;
         if (o.resume && fs::exists(dir / "summary.json") && read_text(dir / "model.toml") == r.text) {
@@ -236,7 +241,7 @@ int run_sweep(const SweepOptions& o) {
     if (!o.quiet)
         std::fprintf(stderr, "%zu runs, %d failed or incomplete; wrote %s/{sweep.csv, sweep.json%s}\n", runs, failed,
                      o.out.string().c_str(), mean.empty() ? "" : ", sweep.png");
-    return failed ? 1 : 0;
+    return stop_signal_received() ? 130 : failed ? 1 : 0;
 }
 
 } // namespace bbm::studies
