@@ -76,15 +76,22 @@ JointPropertySpec calibration_start(const CalibrationTargets& t, const Calibrati
     return j;
 }
 
+std::vector<std::pair<double, double>> hoek_brown_targets(double sigma_ci, double mi, const std::vector<double>& sigma3) {
+    std::vector<std::pair<double, double>> points;
+    for (double s3 : sigma3) points.push_back({s3, s3 + sigma_ci * std::sqrt(mi * s3 / sigma_ci + 1.0)});
+    return points;
+}
+
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed, double confinement) {
+                                              std::uint64_t first_seed, const std::vector<double>& confinements) {
     const auto t0 = std::chrono::steady_clock::now();
     const int n = o.realizations;
-    // UCS, direct tension (and biaxial) runs for each seed, shared among the threads.
-    const int kinds = confinement > 0.0 ? 3 : 2;
-    // Each run travels (between ranks under mpirun) as the three numbers used here.
+    // Runs k: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests at
+    // each confinement; shared among the threads and ranks.
+    const int runs = (2 + int(confinements.size())) * n;
+    // Each run travels (between ranks under mpirun) as the four numbers used here.
     struct Measured {
-        double E = 0, nu = 0, peak_stress = 0;
+        double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0;
     };
     auto run = [&](int k) -> std::string {
         LabTestOptions lo = o.base;
@@ -99,33 +106,37 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
             lo.platen_friction = -1.0;                           // tension needs platens that hold
         } else {
             lo.kind = LabTestOptions::Kind::biaxial;
-            lo.confinement = confinement;
+            lo.confinement = confinements[std::size_t(k / n - 2)];
+            lo.post_peak_strain = 1e-3; // as bbm envelope: a confined peak is final once the specimen has failed
         }
         const LabTestResult r = run_labtest(lo);
-        char text[96];
-        std::snprintf(text, sizeof text, "%.17g %.17g %.17g", r.E, r.nu, r.peak_stress);
+        char text[128];
+        std::snprintf(text, sizeof text, "%.17g %.17g %.17g %.17g", r.E, r.nu, r.peak_stress,
+                      r.crack_initiation_stress);
         return text;
     };
     // Runs over ranks and threads; every rank gets every result.
-    std::vector<Measured> ucs(n), tension(n), biaxial(n);
-    const auto texts = studies::run_spread(kinds * n, o.threads, run);
-    for (int k = 0; k < kinds * n; ++k) {
-        Measured m;
-        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf", &m.E, &m.nu, &m.peak_stress) != 3)
+    std::vector<Measured> measured(static_cast<std::size_t>(runs));
+    const auto texts = studies::run_spread(runs, o.threads, run);
+    for (int k = 0; k < runs; ++k) {
+        Measured& m = measured[std::size_t(k)];
+        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation) != 4)
             throw std::runtime_error("calibration: a run's result did not arrive");
-        (k < n ? ucs[k] : k < 2 * n ? tension[k - n] : biaxial[k - 2 * n]) = m;
     }
     CalibrationIteration it;
     it.joint = joint;
-    std::vector<double> E, nu, peak, ten;
+    std::vector<double> E, peak, ten, ci;
     for (int k = 0; k < n; ++k) {
-        E.push_back(ucs[k].E), nu.push_back(ucs[k].nu), peak.push_back(ucs[k].peak_stress);
-        ten.push_back(tension[k].peak_stress);
+        E.push_back(measured[k].E), peak.push_back(measured[k].peak_stress);
+        ci.push_back(measured[k].crack_initiation / measured[k].peak_stress);
+        ten.push_back(measured[n + k].peak_stress);
     }
     mean_std(E, it.E_test, it.E_test_std);
+    mean_std(ci, it.ci_ratio, it.ci_ratio_std);
     // E and ν from the elastic solve of each realization: the initial slope and
     // the lateral strain of a cracking specimen are too noisy to steer by.
-    nu.clear(), E.clear();
+    std::vector<double> nu;
+    E.clear();
     for (int k = 0; k < n; ++k) {
         LabTestOptions lo = o.base;
         lo.seed = first_seed + std::uint64_t(k);
@@ -136,29 +147,62 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     mean_std(nu, it.nu, it.nu_std);
     mean_std(peak, it.ucs, it.ucs_std);
     mean_std(ten, it.tensile, it.tensile_std);
-    if (confinement > 0.0) {
+    for (std::size_t c = 0; c < confinements.size(); ++c) {
         std::vector<double> s1;
-        for (const auto& r : biaxial) s1.push_back(r.peak_stress);
-        mean_std(s1, it.biaxial, it.biaxial_std);
+        for (int k = 0; k < n; ++k) s1.push_back(measured[(2 + c) * std::size_t(n) + std::size_t(k)].peak_stress);
+        double mean = 0, sd = 0;
+        mean_std(s1, mean, sd);
+        it.confined.push_back(mean), it.confined_std.push_back(sd);
     }
     it.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return it;
 }
 
+double calibration_misfit(const CalibrationIteration& it, const CalibrationTargets& t) {
+    double misfit = std::max({std::abs(it.E / t.E - 1), std::abs(it.nu / t.nu - 1), std::abs(it.ucs / t.ucs - 1),
+                              std::abs(it.tensile / t.tensile - 1)});
+    for (std::size_t c = 0; c < t.envelope.size() && c < it.confined.size(); ++c)
+        misfit = std::max(misfit, std::abs(it.confined[c] / t.envelope[c].second - 1));
+    return misfit;
+}
+
+const CalibrationIteration& best_iteration(const std::vector<CalibrationIteration>& iterations) {
+    if (iterations.empty()) throw std::logic_error("best_iteration: no iterations");
+    const CalibrationIteration* best = &iterations.front();
+    for (const auto& it : iterations) {
+        if (it.converged) return it;
+        if (it.misfit < best->misfit) best = &it;
+    }
+    return *best;
+}
+
+namespace {
+/// The envelope's mean slope through the UCS: least squares of σ1 − UCS = k σ3.
+double envelope_slope(const std::vector<double>& sigma3, const std::vector<double>& sigma1, double ucs) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t c = 0; c < sigma3.size(); ++c) num += sigma3[c] * (sigma1[c] - ucs), den += sigma3[c] * sigma3[c];
+    return num / den;
+}
+} // namespace
+
 std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
                                             const std::function<void(const CalibrationIteration&)>& report) {
     std::vector<CalibrationIteration> out;
     JointPropertySpec j = calibration_start(t, o);
-    const bool with_phi = t.biaxial > 0.0 && t.confinement > 0.0;
+    const bool with_phi = !t.envelope.empty();
+    std::vector<double> sigma3, sigma1_target;
+    for (const auto& [s3, s1] : t.envelope) sigma3.push_back(s3), sigma1_target.push_back(s1);
     // Slope of the strength envelope, σ1 = UCS + k σ3 (k = tan²(45° + φ/2) for Coulomb).
-    const double k_target = with_phi ? (t.biaxial - t.ucs) / t.confinement : 0.0;
+    const double k_target = with_phi ? envelope_slope(sigma3, sigma1_target, t.ucs) : 0.0;
     double prev_tan = 0.0, prev_k = 0.0;
     for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
-        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, with_phi ? t.confinement : 0.0);
+        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, sigma3);
+        it.misfit = calibration_misfit(it, t);
         it.converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
                        std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&
-                       std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile &&
-                       (!with_phi || std::abs(it.biaxial / t.biaxial - 1) <= o.tolerance_biaxial);
+                       std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile;
+        for (std::size_t c = 0; c < sigma3.size(); ++c)
+            it.converged = it.converged && std::abs(it.confined[c] / sigma1_target[c] - 1) <= o.tolerance_envelope;
         out.push_back(it);
         if (report) report(it);
         if (it.converged) break;
@@ -173,7 +217,7 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         j.cohesion *= t.ucs / it.ucs;
         if (with_phi) {
             constexpr double deg = std::numbers::pi / 180.0;
-            const double k = (it.biaxial - it.ucs) / t.confinement, tan_phi = std::tan(j.friction * deg);
+            const double k = envelope_slope(sigma3, it.confined, it.ucs), tan_phi = std::tan(j.friction * deg);
             double tan_new = tan_phi * std::max(0.05, k_target - 1.0) / std::max(0.05, k - 1.0);
             if (iteration > 0 && std::abs(k - prev_k) > 1e-6 * std::abs(k) && std::abs(tan_phi - prev_tan) > 1e-9)
                 tan_new = tan_phi + (k_target - k) * (tan_phi - prev_tan) / (k - prev_k); // secant

@@ -18,30 +18,44 @@
 // unknown by the quantity it mainly controls:
 //   kn ← kn × E*/E,   r: shifted by the lattice value of r at ν* minus that at ν,
 //   σt ← σt × T*/T,   c ← c × UCS*/UCS,
-// and, with a biaxial target σ1* at confinement σ3, φ by the slope of the
-// strength envelope k = (σ1 − UCS)/σ3 (k* from the targets): tan φ scaled by
-// (k* − 1)/(k − 1) at first, then by the secant through the last two iterations,
-// steps within ±10°, φ within 5–60°;
-// stopping when all the means are within tolerance or after max_iterations.
+// and, with confined targets (the record's triaxial or biaxial strengths, or
+// points of its Hoek–Brown curve), φ by the envelope's mean slope k: the least-
+// squares slope through the UCS, k = Σ σ3 (σ1 − UCS) / Σ σ3², measured and
+// target (k = tan²(45° + φ/2) for Coulomb): tan φ scaled by (k* − 1)/(k − 1) at
+// first, then by the secant through the last two iterations, steps within ±10°,
+// φ within 5–60°. One friction angle sets one slope: the curvature of a record's
+// envelope is not fitted, and the misfit at each σ3 is reported.
+// Converged when every mean is within its tolerance; otherwise, after
+// max_iterations, the best set (the smallest largest misfit) is the result.
 // The means are over realizations, so the result carries their scatter: a new
 // set of seeds reproduces the targets only to within the realization scatter
-// (reported as the standard deviation).
+// (reported as the standard deviation). The record's σci/UCS, when given, is
+// reported beside the model's and not calibrated (it needs heterogeneity the
+// joints do not have: docs/calibration.md).
 #pragma once
 
 #include "studies/labtest.hpp"
 
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace bbm {
 
 struct CalibrationTargets {
     double E = 20e9, nu = 0.2, ucs = 20e6, tensile = 2.5e6;
-    /// Optional: the strength σ1 of a biaxial test at lateral stress `confinement`
-    /// (both Pa, compression positive); with it the friction angle φ is calibrated
-    /// too. 0 = φ stays as given.
-    double biaxial = 0.0, confinement = 0.0;
+    /// Optional: the record's confined strengths, (σ3, σ1) pairs in Pa,
+    /// compression positive (triaxial or biaxial tests, or points of its
+    /// Hoek–Brown curve: hoek_brown_targets). With them the friction angle φ is
+    /// calibrated too; empty = φ stays as given.
+    std::vector<std::pair<double, double>> envelope;
+    /// Optional: the record's crack-initiation stress over its UCS; reported beside
+    /// the model's, not calibrated. 0 = none.
+    double ci_ratio = 0.0;
 };
+
+/// Points (σ3, σ1) of the Hoek–Brown intact-rock criterion σ1 = σ3 + σci √(mi σ3/σci + 1).
+std::vector<std::pair<double, double>> hoek_brown_targets(double sigma_ci, double mi, const std::vector<double>& sigma3);
 
 struct CalibrationOptions {
     LabTestOptions base = LabTestOptions::paper_ucs(); ///< pattern, size, specimen, friction, softening
@@ -49,7 +63,7 @@ struct CalibrationOptions {
     int threads = 2;          ///< realizations run in parallel on these
     int max_iterations = 6;
     double tolerance_E = 0.02, tolerance_nu = 0.05, tolerance_ucs = 0.03, tolerance_tensile = 0.05;
-    double tolerance_biaxial = 0.03;
+    double tolerance_envelope = 0.05; ///< on σ1 at every confined target
     /// Starting values the user gave (kn, ks, tensile, cohesion of base.joint);
     /// the others start from the lattice inversion.
     bool start_kn = false, start_ks = false, start_tensile = false, start_cohesion = false;
@@ -59,11 +73,19 @@ struct CalibrationIteration {
     JointPropertySpec joint;
     double E = 0, nu = 0, ucs = 0, tensile = 0;             ///< means over realizations
     double E_std = 0, nu_std = 0, ucs_std = 0, tensile_std = 0;
-    double biaxial = 0, biaxial_std = 0; ///< σ1 of the biaxial tests (with a biaxial target)
+    /// σ1 at the σ3 of each confined target (means over realizations, std).
+    std::vector<double> confined, confined_std;
     double E_test = 0, E_test_std = 0; ///< E of the UCS curves (initial slope), for comparison
+    double ci_ratio = 0, ci_ratio_std = 0; ///< σci/UCS of the UCS runs
+    /// The largest |measure / target − 1| over E, ν, UCS, tension and the confined targets.
+    double misfit = 0;
     double seconds = 0;
     bool converged = false;
 };
+
+/// The calibrated set of an iteration table: the converged iteration, or else the
+/// one with the smallest misfit.
+const CalibrationIteration& best_iteration(const std::vector<CalibrationIteration>& iterations);
 
 /// The starting joint properties from the lattice inversion (see above).
 JointPropertySpec calibration_start(const CalibrationTargets& t, const CalibrationOptions& o);
@@ -81,9 +103,13 @@ struct ElasticMeasure {
 ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOptions& base);
 
 /// Mean and sample standard deviation of the measures for a joint set (E and ν
-/// from elastic_measure, the strengths from the UCS and tension tests, and from
-/// biaxial tests at `confinement` if it is > 0).
+/// from elastic_measure, the strengths and σci/UCS from the UCS and tension
+/// tests, and σ1 from biaxial tests at each of `confinements`), without misfit.
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed, double confinement = 0.0);
+                                              std::uint64_t first_seed,
+                                              const std::vector<double>& confinements = {});
+
+/// The misfit of measured properties against the targets (CalibrationIteration::misfit).
+double calibration_misfit(const CalibrationIteration& it, const CalibrationTargets& t);
 
 } // namespace bbm

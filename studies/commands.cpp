@@ -7,6 +7,7 @@
 #include "core/solver.hpp"
 #include "meshing/blocks.hpp"
 #include "studies/calibrate.hpp"
+#include "studies/envelope.hpp"
 #include "studies/cli_checks.hpp"
 #include "studies/labtest.hpp"
 #include "studies/ranks.hpp"
@@ -561,22 +562,51 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
     return 0;
 }
 
+namespace {
+
+/// The confined targets of `bbm calibrate` (one biaxial test, a CSV record or a
+/// Hoek–Brown mi: one of them) as targets.envelope, checked.
+void confined_targets(CalibrateCli& v) {
+    auto& t = v.targets;
+    if ((v.biaxial > 0.0) != (v.confinement > 0.0))
+        throw InputError(v.biaxial > 0.0 ? "--target-biaxial" : "--target-confinement", 0, "",
+                         "--target-biaxial and --target-confinement go together (the strength and the lateral stress "
+                         "of one biaxial test)");
+    const int given = int(v.biaxial > 0.0) + int(!v.record.empty()) + int(v.mi > 0.0);
+    if (given > 1)
+        throw InputError("--target-record", 0, "",
+                         "give one confined target: --target-biaxial, --target-record or --target-mi");
+    if (!v.mi_confinements.empty() && !(v.mi > 0.0))
+        throw InputError("--target-mi-confinements", 0, "", "goes with --target-mi");
+    t.envelope.clear();
+    if (v.biaxial > 0.0) t.envelope.push_back({v.confinement, v.biaxial});
+    if (!v.record.empty()) {
+        for (const auto& p : read_strength_record(v.record))
+            if (p.first > 0.0) t.envelope.push_back(p); // σ3 = 0 is the UCS target's
+        if (t.envelope.empty()) throw InputError(v.record, 0, "", "no confined test (sigma3 > 0) in the record");
+    }
+    if (v.mi > 0.0) {
+        const auto s3 = v.mi_confinements.empty() ? std::vector<double>{t.ucs / 6.0, t.ucs / 3.0} : v.mi_confinements;
+        t.envelope = hoek_brown_targets(t.ucs, v.mi, s3);
+    }
+    for (const auto& [s3, s1] : t.envelope)
+        if (s1 <= t.ucs)
+            throw InputError(!v.record.empty() ? v.record : "--target-biaxial", 0, "",
+                             "a confined strength must exceed the UCS target (" + fmt_number(t.ucs) + " Pa); got " +
+                                 fmt_number(s1) + " Pa at sigma3 " + fmt_number(s3) + " Pa");
+}
+
+} // namespace
+
 /// `bbm calibrate`: iterates the micro-properties and writes the joint property
 /// set as a TOML fragment, with the iteration table as JSON.
 int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string* calibration_json) {
     quiet = quiet || !Ranks::root(); // under mpirun, rank 0 reports and writes
     LabTestCli& c = values.lab;
-    const CalibrationTargets& targets = values.targets;
+    CalibrationTargets& targets = values.targets;
     const int iterations = values.iterations;
     const fs::path out = c.out;
-    if ((targets.biaxial > 0.0) != (targets.confinement > 0.0))
-        throw InputError(targets.biaxial > 0.0 ? "--target-biaxial" : "--target-confinement", 0, "",
-                         "--target-biaxial and --target-confinement go together (the strength and the lateral stress "
-                         "of one biaxial test)");
-    if (targets.biaxial > 0.0 && targets.biaxial <= targets.ucs)
-        throw InputError("--target-biaxial", 0, "",
-                         "a confined strength must exceed the UCS target (" + fmt_number(targets.ucs) + " Pa); got " +
-                             fmt_number(targets.biaxial) + " Pa");
+    confined_targets(values);
     CalibrationOptions o;
     o.base = c.o;
     // Joint values given on the command line (or in --config) are the starting point.
@@ -598,17 +628,24 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     const double first_kn = targets.E / o.base.size, first_ks = targets.E / (2.0 * (1.0 + targets.nu)) / o.base.size;
     const JointPropertySpec start = calibration_start(targets, o);
     if (c.write_files) io::make_output_directory(out);
-    const bool with_phi = targets.biaxial > 0.0;
+    const bool with_phi = !targets.envelope.empty();
+    auto confined_json = [](const std::vector<double>& v) { return nlohmann::json(v); };
+    std::vector<double> sigma3;
+    for (const auto& p : targets.envelope) sigma3.push_back(p.first);
     if (!quiet) {
         std::fprintf(stderr,
                      "bbm calibrate: %s blocks of %.3g m, %g m x %g m, %d realizations of UCS and direct tension per "
                      "iteration\ntargets: E %.4g GPa, nu %.3g, UCS %.4g MPa, tensile %.4g MPa\n",
                      c.pattern.c_str(), o.base.size, o.base.width, o.base.height, o.realizations, targets.E / 1e9,
                      targets.nu, targets.ucs / 1e6, targets.tensile / 1e6);
-        if (with_phi)
-            std::fprintf(stderr, "and biaxial strength %.4g MPa at %.4g MPa confinement: friction angle calibrated too "
-                                 "(phi and sigma1 at the end of each row)\n",
-                         targets.biaxial / 1e6, targets.confinement / 1e6);
+        if (with_phi) {
+            std::fprintf(stderr, "and the confined strengths sigma1 at sigma3 (MPa):");
+            for (const auto& [s3, s1] : targets.envelope) std::fprintf(stderr, " %.4g at %.4g,", s1 / 1e6, s3 / 1e6);
+            std::fprintf(stderr, " the friction angle calibrated too (phi and the sigma1 at the end of each row)\n");
+        }
+        if (targets.ci_ratio > 0)
+            std::fprintf(stderr, "the record's sigma_ci/UCS %.3g is reported beside the model's, not calibrated\n",
+                         targets.ci_ratio);
         std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start kn %.2f, ks %.2f GPa/m (%s)\n",
                      first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9,
                      o.start_kn || o.start_ks ? "as given" : "lattice inversion on the generated blocks");
@@ -623,27 +660,41 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
             std::fprintf(stderr, "%4d %10.2f %10.2f %9.3f %9.3f | %9.2f %9.2f %7.3f %10.2f %10.3f %8.0f", k,
                          it.joint.kn / 1e9, it.joint.ks / 1e9, it.joint.tensile / 1e6, it.joint.cohesion / 1e6,
                          it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds);
-            if (with_phi) std::fprintf(stderr, "   phi %5.2f  sigma1 %7.2f MPa", it.joint.friction, it.biaxial / 1e6);
-            std::fprintf(stderr, "%s\n", it.converged ? "  converged" : "");
+            std::fprintf(stderr, " ci/UCS %.2f", it.ci_ratio);
+            if (with_phi) {
+                std::fprintf(stderr, "   phi %5.2f  sigma1", it.joint.friction);
+                for (double s1 : it.confined) std::fprintf(stderr, " %7.2f", s1 / 1e6);
+            }
+            std::fprintf(stderr, "  misfit %.3f%s\n", it.misfit, it.converged ? "  converged" : "");
         }
         table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
                          {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
                          {"nu_std", it.nu_std}, {"ucs", it.ucs}, {"ucs_std", it.ucs_std}, {"tensile_strength", it.tensile},
                          {"tensile_strength_std", it.tensile_std}, {"friction", it.joint.friction},
-                         {"biaxial_strength", it.biaxial}, {"biaxial_strength_std", it.biaxial_std},
-                         {"seconds", it.seconds}, {"converged", it.converged}});
+                         {"confined_strength", confined_json(it.confined)},
+                         {"confined_strength_std", confined_json(it.confined_std)}, {"ci_ratio", it.ci_ratio},
+                         {"ci_ratio_std", it.ci_ratio_std}, {"misfit", it.misfit}, {"seconds", it.seconds},
+                         {"converged", it.converged}});
     });
-    const auto& last = iterations_done.back();
+    // The converged set, or else the best one (the smallest misfit).
+    const auto& last = best_iteration(iterations_done);
     const auto& j = last.joint;
     // The calibrated set on seeds it has not seen: what a new model will get.
-    const auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, with_phi ? targets.confinement : 0.0);
+    auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, sigma3);
+    fresh.misfit = calibration_misfit(fresh, targets);
     if (!quiet) {
         std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "
                              "(std %.3f)",
                      static_cast<unsigned long long>(o.base.seed + 1000), fresh.E / 1e9, fresh.E_test / 1e9, fresh.nu,
                      fresh.ucs / 1e6, fresh.ucs_std / 1e6, fresh.tensile / 1e6, fresh.tensile_std / 1e6);
-        if (with_phi) std::fprintf(stderr, ", sigma1 %.2f MPa (std %.2f)", fresh.biaxial / 1e6, fresh.biaxial_std / 1e6);
-        std::fprintf(stderr, "\n");
+        for (std::size_t i = 0; i < sigma3.size(); ++i)
+            std::fprintf(stderr, ", sigma1 %.2f MPa (std %.2f; target %.2f) at %.3g", fresh.confined[i] / 1e6,
+                         fresh.confined_std[i] / 1e6, targets.envelope[i].second / 1e6, sigma3[i] / 1e6);
+        std::fprintf(stderr, ", ci/UCS %.2f (std %.2f%s), misfit %.3f\n", fresh.ci_ratio, fresh.ci_ratio_std,
+                     targets.ci_ratio > 0 ? ("; record " + fmt_number(targets.ci_ratio)).c_str() : "", fresh.misfit);
+        if (!last.converged)
+            std::fprintf(stderr, "not converged: the best set is iteration %d (misfit %.3f)\n",
+                         int(&last - iterations_done.data()) + 1, last.misfit);
     }
     // The set holds for this pattern only: say which, as a model file writes it.
     const std::string pattern_line = "pattern = { type = \"" + c.pattern + "\", size = " + fmt_number(o.base.size) +
@@ -656,14 +707,12 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                        "\n# Targets E " +
                        fmt_number(targets.E) + " Pa, nu " + fmt_number(targets.nu) + ", UCS " + fmt_number(targets.ucs) +
                        " Pa, tensile " + fmt_number(targets.tensile) + " Pa" +
-                       (with_phi ? ", biaxial " + fmt_number(targets.biaxial) + " Pa at " + fmt_number(targets.confinement) +
-                                       " Pa"
-                                 : std::string()) +
-                       ".\n# Last iteration (mean of " +
+                       (with_phi ? ", " + std::to_string(targets.envelope.size()) + " confined strengths" : std::string()) +
+                       ".\n# Calibrated set, iteration " + std::to_string(int(&last - iterations_done.data()) + 1) + " (mean of " +
                        std::to_string(o.realizations) + "): E " + fmt_number(last.E) + " Pa, nu " + fmt_number(last.nu) +
                        ", UCS " + fmt_number(last.ucs) + " Pa, tensile " + fmt_number(last.tensile) + " Pa" +
-                       (with_phi ? ", biaxial " + fmt_number(last.biaxial) + " Pa" : std::string()) +
-                       (last.converged ? "" : " (NOT converged: see calibration.json)") + ".\n";
+                       ", largest misfit " + fmt_number(last.misfit) +
+                       (last.converged ? "" : " (NOT converged: the best set; see calibration.json)") + ".\n";
     auto pts = [](const std::vector<std::pair<double, double>>& v) {
         std::string s = "[";
         for (std::size_t i = 0; i < v.size(); ++i)
@@ -675,14 +724,15 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
             fmt_number(j.cohesion) + "\nfriction = " + fmt_number(j.friction) +
             "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
     const nlohmann::json calibration{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
-                                                          {"tensile", targets.tensile}, {"biaxial", targets.biaxial},
-                                                          {"confinement", targets.confinement}}},
+                                                          {"tensile", targets.tensile}, {"envelope", targets.envelope},
+                                                          {"ci_ratio", targets.ci_ratio}}},
                                              {"pattern", c.pattern},
                                              {"size", o.base.size},
                                              {"size_measure", c.size_measure},
                                              {"lloyd", o.base.lloyd},
                                              {"realizations", o.realizations},
                                              {"converged", last.converged},
+                                             {"calibrated_iteration", int(&last - iterations_done.data()) + 1},
                                              {"first_estimate", {{"kn", first_kn}, {"ks", first_ks}}},
                                              {"start", {{"kn", start.kn}, {"ks", start.ks}, {"tensile", start.tensile},
                                                         {"cohesion", start.cohesion}}},
@@ -691,8 +741,11 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                                                               {"ucs", fresh.ucs}, {"ucs_std", fresh.ucs_std},
                                                               {"tensile_strength", fresh.tensile},
                                                               {"tensile_strength_std", fresh.tensile_std},
-                                                              {"biaxial_strength", fresh.biaxial},
-                                                              {"biaxial_strength_std", fresh.biaxial_std}}},
+                                                              {"confined_strength", confined_json(fresh.confined)},
+                                                              {"confined_strength_std", confined_json(fresh.confined_std)},
+                                                              {"ci_ratio", fresh.ci_ratio},
+                                                              {"ci_ratio_std", fresh.ci_ratio_std},
+                                                              {"misfit", fresh.misfit}}},
                                              {"iterations", table},
                                              {"joint_property_toml", toml}};
     if (calibration_json) *calibration_json = calibration.dump();
@@ -713,13 +766,29 @@ void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
     cmd->add_option("--target-nu", t.nu, "Target Poisson's ratio")->check(cli::in_range(0.01, 0.33))->capture_default_str();
     cmd->add_option("--target-ucs", t.ucs, "Target uniaxial compressive strength (Pa)")->check(cli::positive())->capture_default_str();
     cmd->add_option("--target-tensile", t.tensile, "Target direct tensile strength (Pa)")->check(cli::positive())->capture_default_str();
-    cmd->add_option("--target-biaxial", t.biaxial,
+    cmd->add_option("--target-biaxial", v.biaxial,
                     "Optional: target strength sigma1 of a biaxial test at --target-confinement (Pa); calibrates the "
                     "friction angle too")
         ->check(cli::positive());
-    cmd->add_option("--target-confinement", t.confinement,
+    cmd->add_option("--target-confinement", v.confinement,
                     "Lateral stress of the --target-biaxial test (Pa, compression positive)")
         ->check(cli::positive());
+    cmd->add_option("--target-record", v.record,
+                    "Optional: the record's triaxial strengths, a CSV of sigma3, sigma1 in MPa (a header line "
+                    "allowed); calibrates the friction angle to their mean slope")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--target-mi", v.mi,
+                    "Optional: the record's Hoek-Brown mi (sigma_ci = --target-ucs); its curve at "
+                    "--target-mi-confinements is the confined target")
+        ->check(cli::positive());
+    cmd->add_option("--target-mi-confinements", v.mi_confinements,
+                    "sigma3 of the Hoek-Brown targets (Pa, comma-separated; default UCS/6 and UCS/3)")
+        ->delimiter(',')
+        ->check(cli::positive());
+    cmd->add_option("--target-ci-ratio", t.ci_ratio,
+                    "Optional: the record's crack-initiation stress over its UCS (reported beside the model's, not "
+                    "calibrated)")
+        ->check(cli::in_range(0.01, 1.0));
     cmd->add_option("--iterations", v.iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
 }
 

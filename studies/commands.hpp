@@ -84,6 +84,11 @@ LabTestResult labtest_from_record_text(const std::string& text);
 struct CalibrateCli {
     LabTestCli lab;
     CalibrationTargets targets;
+    /// The confined targets as given; run_calibrate turns them into targets.envelope.
+    double biaxial = 0.0, confinement = 0.0; ///< one biaxial test: σ1 at σ3 (Pa)
+    std::string record;                      ///< CSV of σ3, σ1 pairs in MPa (the lab's triaxial tests)
+    double mi = 0.0;                         ///< Hoek–Brown mi of the record (σci = the UCS target)
+    std::vector<double> mi_confinements;     ///< σ3 of the Hoek–Brown points, Pa (default UCS/6, UCS/3)
     int iterations = 6;
     /// Joint values given (they are the starting point rather than estimates).
     bool given_kn = false, given_ks = false, given_tensile = false, given_cohesion = false;

@@ -90,7 +90,7 @@ struct LabTestOptions {
     /// contacts of this friction angle (degrees; kn, ks of the bond). Compression
     /// and biaxial tests only. < 0: the face blocks are the platens (rough_platens).
     double platen_friction = -1.0;
-    double stop_fraction = 0.5;         ///< stop after the peak below this fraction of it
+    double stop_fraction = 0.8;         ///< stop after the peak below this fraction of it
     /// A drop by this fraction from the peak marks failure: the peak is then the
     /// strength, and the run stops if the stress climbs back above it.
     double failure_drop = 0.1;
