@@ -223,7 +223,17 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
                 tan_new = tan_phi + (k_target - k) * (tan_phi - prev_tan) / (k - prev_k); // secant
             prev_tan = tan_phi, prev_k = k;
             const double phi = std::clamp(std::atan(std::max(tan_new, 0.0)) / deg, j.friction - 10.0, j.friction + 10.0);
-            j.friction = std::clamp(phi, 5.0, 60.0);
+            // The UCS rises with φ as well as with c: for Coulomb, UCS = 2 c √Nφ with
+            // Nφ = (1 + sin φ)/(1 − sin φ). Without this the cohesion, corrected for
+            // the old φ, overshoots the UCS whenever φ moves (Lac du Bonnet: φ 25° →
+            // 35° took the UCS from 191 to 276 MPa against 213).
+            auto n_phi = [](double degrees) {
+                const double s = std::sin(degrees * deg);
+                return (1.0 + s) / (1.0 - s);
+            };
+            const double phi_new = std::clamp(phi, 5.0, 60.0);
+            j.cohesion *= std::sqrt(n_phi(j.friction) / n_phi(phi_new));
+            j.friction = phi_new;
         }
     }
     return out;

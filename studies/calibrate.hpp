@@ -23,7 +23,8 @@
 // squares slope through the UCS, k = Σ σ3 (σ1 − UCS) / Σ σ3², measured and
 // target (k = tan²(45° + φ/2) for Coulomb): tan φ scaled by (k* − 1)/(k − 1) at
 // first, then by the secant through the last two iterations, steps within ±10°,
-// φ within 5–60°. One friction angle sets one slope: the curvature of a record's
+// φ within 5–60°, and c scaled by √(Nφ_old/Nφ_new), Nφ = (1 + sin φ)/(1 − sin φ),
+// as the Coulomb UCS 2c√Nφ would need to stay put. One friction angle sets one slope: the curvature of a record's
 // envelope is not fitted, and the misfit at each σ3 is reported.
 // Converged when every mean is within its tolerance; otherwise, after
 // max_iterations, the best set (the smallest largest misfit) is the result.

@@ -194,8 +194,11 @@ def envelope(quiet=True, **options):
 
 
 def calibrate(quiet=True, **options):
-    """Calibrates kn, ks, tensile strength and cohesion (and friction with
-    ``target_biaxial``) to targets; options as ``bbm calibrate`` (``target_E=20e9,
-    target_ucs=20.7e6``...). Returns the dict of calibration.json, with the joint
-    property set's model-file text in ``joint_property_toml``."""
+    """Calibrates kn, ks, tensile strength and cohesion (and friction with a
+    confined target: ``target_biaxial`` and ``target_confinement``,
+    ``target_record`` (a CSV of sigma3, sigma1 in MPa) or ``target_mi``) to a
+    laboratory record; options as ``bbm calibrate`` (``target_E=20e9,
+    target_ucs=20.7e6, target_mi=12``...). Returns the dict of calibration.json
+    (per iteration the confined strengths, sigma_ci/UCS and the misfit), with the
+    calibrated joint property set's model-file text in ``joint_property_toml``."""
     return _calibrate(_option_args(options), quiet)
