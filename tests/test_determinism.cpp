@@ -58,10 +58,12 @@ Outcome run_model(const io::ModelFile& model, const meshing::BlockAssembly& bloc
 }
 
 /// The example model files with stages (a model without is a mesh only).
+/// examples/lab/ holds the lab-test commands' option files (`bbm --config FILE
+/// calibrate`), not model files.
 std::vector<fs::path> examples() {
     std::vector<fs::path> out;
     for (const auto& e : fs::recursive_directory_iterator(fs::path(BBM_SOURCE_DIR) / "examples"))
-        if (e.path().extension() == ".toml") out.push_back(e.path());
+        if (e.path().extension() == ".toml" && e.path().parent_path().filename() != "lab") out.push_back(e.path());
     std::sort(out.begin(), out.end());
     return out;
 }
