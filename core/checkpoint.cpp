@@ -28,9 +28,9 @@ namespace bbm {
 namespace {
 // "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
 // count (a resumed run renumbered its contacts at another step: issue 27); 3 the
-// stage monitor's samples (a resumed run's verdict).
+// stage monitor's samples (a resumed run's verdict); 4 the installed bolts.
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '4';
+constexpr std::uint64_t format = '5';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -73,6 +73,11 @@ std::uint64_t Solver::compute_model_fingerprint() const {
     auto vec = [&](const auto& v) { mix(v.data(), v.size() * sizeof(v[0])); };
     vec(b_.local), vec(b_.centroid0), vec(b_.real_mass), vec(b_.fixed), vec(b_.fixed_velocity), vec(b_.applied);
     vec(n_.position0), vec(n_.real_mass), vec(n_.fixed), vec(n_.applied), vec(z_.elasticity);
+    for (const auto& set : bolts_.sets) {
+        const double p[9] = {set.ea, set.yield_force, set.rupture_strain, set.bond_stiffness, set.bond_strength,
+                             set.normal_stiffness, set.line_mass, set.spacing, double(set.cable)};
+        mix(p, sizeof p);
+    }
     for (const auto& law : laws_) {
         const double k[2] = {contact::normal_stiffness(law), contact::shear_stiffness(law)};
         mix(k, sizeof k);
@@ -99,6 +104,11 @@ void Solver::visit_state(Self& s, Visit&& v) {
     // lab tests (the servo's platen speed, the confinement ramp).
     v(s.b_.fixed_velocity), v(s.b_.fixed_omega), v(s.b_.applied), v(s.b_.applied_moment);
     v(s.n_.fixed_velocity), v(s.n_.applied);
+    // Installed bolts (core/bolts.hpp): nodes, their ties to the rock, segments.
+    auto& B = s.bolts_;
+    v(B.installed), v(B.position), v(B.velocity), v(B.applied), v(B.mass), v(B.length), v(B.slip), v(B.bond), v(B.host);
+    v(B.tied), v(B.node_set), v(B.segment_node), v(B.rest), v(B.plastic), v(B.axial), v(B.state);
+    v(B.first), v(B.bolt_set);
     // What the stage did so far, for its verdict (not physics: not in the state hash).
     v(s.monitor_.samples_);
 }
@@ -136,6 +146,7 @@ void Solver::load_state(std::istream& i) {
     std::uint64_t hash = 0;
     get(i, hash);
     c_.normal.resize(c_.size());
+    bolts_.force.assign(bolts_.position.size(), {});
     normals_stale_ = true;
     rebuild_contact_index();
     detector_.invalidate();

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "base/vec2.hpp"
+#include "core/bolts.hpp"
 #include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
 
@@ -107,7 +108,9 @@ struct HistorySpec {
 
 struct StageSpec {
     /// elastic: elastic equilibrium in one implicit sparse solve (SPEC §5), no keys.
-    enum class Kind { initialize, solve, excavate, cycle, elastic };
+    /// install: puts the named support sets ([[bolt]]) in place, tied to the rock
+    /// as it is at that moment (after a partial relaxation: convergence–confinement).
+    enum class Kind { initialize, solve, excavate, cycle, elastic, install };
     std::string name;
     Kind kind = Kind::solve;
     StressFieldSpec stress;            ///< initialize
@@ -118,9 +121,10 @@ struct StageSpec {
     /// at `ratio` (until = "rest"; "ratio", the default, waits for the model's ratio).
     bool until_rest = false;
     long quiet_steps = 2000;
-    long steps = 0;                    ///< cycle
+    long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps)
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
+    std::vector<std::string> supports; ///< install: names of [[bolt]] sets
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;
@@ -141,6 +145,7 @@ struct AnalysisSpec {
     SolverSpec solver;
     std::vector<HistorySpec> histories;
     std::vector<StageSpec> stages;
+    std::vector<BoltSetSpec> bolts; ///< support sets, installed by install stages
     ReportSpec report;
 };
 

@@ -262,6 +262,17 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     rebuild_contact_index();
 
     apply_boundaries(an, a);
+    // Support sets (core/bolts.hpp): properties per metre of model; installed by stages.
+    for (const auto& spec : an.bolts) {
+        const double S = spec.spacing;
+        bolt_specs_.push_back(spec);
+        bolt_names_.push_back(spec.name);
+        bolts_.sets.push_back({spec.young * spec.area / S, spec.yield_force / S, spec.rupture_strain,
+                               spec.bond_stiffness / S, spec.bond_strength / S,
+                               (spec.normal_stiffness > 0.0 ? spec.normal_stiffness : spec.bond_stiffness) / S,
+                               spec.density * spec.area / S, S, std::uint8_t(spec.cable)});
+    }
+    bolts_.installed.assign(bolts_.sets.size(), 0);
     update_vertices();
     update_timestep();
     fingerprint_ = compute_model_fingerprint();
@@ -445,7 +456,12 @@ void Solver::update_timestep() {
         }
     }
     const double s = settings_.safety;
-    if (settings_.mode == SolverSpec::Mode::quasi_static) {
+    const bool scaled = settings_.mode == SolverSpec::Mode::quasi_static;
+    if (bolts_.node_count() > 0) {
+        const double step = scaled ? (settings_.timestep > 0 ? settings_.timestep : 1.0) : 0.0;
+        add_bolt_stiffness(k, kr, kn, scaled ? (step / (2.0 * s)) * (step / (2.0 * s)) : 0.0);
+    }
+    if (scaled) {
         dt_ = settings_.timestep > 0 ? settings_.timestep : 1.0;
         const double f = (dt_ / (2.0 * s)) * (dt_ / (2.0 * s));
         // A block that has lost all its contacts keeps its scaled mass: with the
@@ -464,6 +480,7 @@ void Solver::update_timestep() {
         }
         for (int i = 0; i < nn; ++i)
             if (!b_.removed[n_.block[i]] && kn[i] > 0) limit = std::min(limit, 2.0 * std::sqrt(n_.real_mass[i] / kn[i]));
+        if (bolts_.node_count() > 0) limit = std::min(limit, bolt_time_limit());
         dt_ = settings_.timestep > 0 ? settings_.timestep : (std::isfinite(limit) ? s * limit : 1e-3);
         b_.mass = b_.real_mass;
         b_.inertia = b_.real_inertia;
@@ -576,6 +593,11 @@ void Solver::compute_forces() {
         if (relax > 0.0) f += relax * relax_node_force_[k];
         n_.force[k] = f;
     }
+    // Bolts add to the gathered forces of their rock: serially, in a fixed order.
+    if (bolts_.node_count() > 0) {
+#pragma omp single
+        bolt_pass();
+    }
 }
 
 void Solver::release_relaxation() {
@@ -649,6 +671,7 @@ void Solver::integrate() {
             work_ += chunk_sums_[chunk].work;
             max_unbalanced = std::max(max_unbalanced, chunk_sums_[chunk].unbalanced);
         }
+        if (bolts_.node_count() > 0) max_unbalanced = std::max(max_unbalanced, integrate_bolts(work_));
         const double scale = force_scale();
         ratio_ = scale > 0.0 ? max_unbalanced / scale : 0.0;
     }
@@ -667,12 +690,15 @@ void Solver::sum_boundary_forces() {
 double Solver::force_scale() const {
     // The root-mean-square contact (and zone nodal) force. SPEC §5 says "mean
     // contact force magnitude"; RMS >= mean, and it needs no square root per contact.
-    const double terms = double(c_.size()) + 3.0 * double(z_.size());
-    const double squares = contact::contact_force_squares(c_) + (z_.size() > 0 ? fem::zone_force_squares(z_) : 0.0);
+    // Bolts count with their segments' axial forces (a bolt may be all that holds a block).
+    const double terms = double(c_.size()) + 3.0 * double(z_.size()) + double(bolts_.segment_count());
+    double squares = contact::contact_force_squares(c_) + (z_.size() > 0 ? fem::zone_force_squares(z_) : 0.0);
+    for (double n : bolts_.axial) squares += n * n;
     double mean_force = terms > 0 ? std::sqrt(squares / terms) : 0.0;
     if (mean_force <= 0.0) {
         for (int i = 0; i < b_.count(); ++i) mean_force += norm(b_.applied[i] + b_.real_mass[i] * settings_.gravity);
         for (int i = 0; i < n_.count(); ++i) mean_force += norm(n_.applied[i] + n_.real_mass[i] * settings_.gravity);
+        for (Vec2 f : bolts_.applied) mean_force += norm(f);
         mean_force /= std::max(1, b_.count() + n_.count());
     }
     return mean_force;
@@ -878,7 +904,10 @@ Solver::Memory Solver::memory() const {
     m.contacts = bytes(c_.vertex_block, c_.vertex_id, c_.edge_block, c_.edge_id, c_.edge_end, c_.length, c_.property,
                        c_.history, c_.normal, c_.force, c_.block_entry, c_.node_entry, c_.fill_);
     for (const auto& batch : c_.batches) m.contacts += bytes(batch);
-    m.other = bytes(junctions_, chunk_sums_);
+    const auto& B = bolts_;
+    m.other = bytes(junctions_, chunk_sums_, B.position, B.velocity, B.force, B.mass, B.length, B.slip, B.bond, B.host,
+                    B.tied, B.node_set, B.segment_node, B.rest, B.plastic, B.axial, B.state, B.first, B.bolt_set,
+                    bolt_stiffness_);
     return m;
 }
 
@@ -897,6 +926,9 @@ std::uint64_t Solver::state_hash() const {
     for (int i = 0; i < n_.count(); ++i)
         mix(n_.position[i].x), mix(n_.position[i].y), mix(n_.velocity[i].x), mix(n_.velocity[i].y);
     for (const auto& s : z_.stress) mix(s[0]), mix(s[1]), mix(s[2]);
+    for (int i = 0; i < bolts_.node_count(); ++i)
+        mix(bolts_.position[i].x), mix(bolts_.position[i].y), mix(bolts_.velocity[i].x), mix(bolts_.velocity[i].y);
+    for (double n : bolts_.axial) mix(n);
     return h;
 }
 

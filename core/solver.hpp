@@ -69,6 +69,15 @@ public:
     /// relaxed linearly to zero over relax_steps steps.
     void excavate(const std::vector<std::string>& regions, long relax_steps);
     void step();
+    /// Installs the named [[bolt]] sets (core/bolts.hpp): nodes along each bolt,
+    /// each tied to the rock it lies in now, unstressed. Throws InputError (key
+    /// "stage.supports") for an unknown or already installed set.
+    void install_bolts(const std::vector<std::string>& sets);
+    const BoltState& bolts() const { return bolts_; }
+    BoltState& bolts() { return bolts_; } ///< a study may load a node (BoltState::applied)
+    const std::vector<std::string>& bolt_set_names() const { return bolt_names_; }
+    /// Per installed set: loads per bolt and how many yielded or broke.
+    std::vector<BoltSetSummary> bolt_summary() const;
     /// Recomputes time step and (quasi-static) masses from the current contacts.
     void update_timestep();
     /// Implicit elastic stage (SPEC §5): assembles the linear stiffness of blocks
@@ -212,6 +221,14 @@ private:
     static void visit_state(Self& self, Visit&& visit); ///< core/checkpoint.cpp
     std::uint64_t compute_model_fingerprint() const;    ///< core/checkpoint.cpp
     void integrate();
+    // Bolts (core/bolts.cpp).
+    void bolt_pass();                       ///< segment and grout forces, reactions on the rock
+    double integrate_bolts(double& work);   ///< returns the largest free force component
+    void add_bolt_stiffness(std::vector<double>& block, std::vector<double>& rotation,
+                            std::vector<double>& node, double mass_factor);
+    double bolt_time_limit() const;         ///< dynamic: the bolts' critical time step
+    BoltHost find_host(Vec2 p, double reach) const;
+    Vec2 host_position(const BoltHost& h) const;
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
 
@@ -221,6 +238,10 @@ private:
     mutable contact::Contacts c_; ///< mutable: its normals are a cache (refresh_normals)
     mutable bool normals_stale_ = true;
     StageMonitor monitor_;
+    BoltState bolts_;
+    std::vector<std::string> bolt_names_;
+    std::vector<BoltSetSpec> bolt_specs_;
+    std::vector<double> bolt_stiffness_; ///< per bolt node, scratch of update_timestep()
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
     std::vector<std::string> region_names_;

@@ -13,6 +13,7 @@ const char* to_string(StageSpec::Kind k) {
     case StageSpec::Kind::excavate: return "excavate";
     case StageSpec::Kind::cycle: return "cycle";
     case StageSpec::Kind::elastic: return "elastic";
+    case StageSpec::Kind::install: return "install";
     }
     return "?";
 }
@@ -61,6 +62,7 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
             case StageSpec::Kind::excavate: s.excavate(st.regions, st.relax_steps); break;
             case StageSpec::Kind::elastic: r.method = s.solve_elastic().method; break;
+            case StageSpec::Kind::install: s.install_bolts(st.supports); break;
             case StageSpec::Kind::solve:
             case StageSpec::Kind::cycle: break;
             }
@@ -71,9 +73,10 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             if (!(resumed && solved(cursor.step))) run(st.max_steps, true);
             r.converged = s.unbalanced_ratio() <= st.ratio;
             break;
-        case StageSpec::Kind::excavate: run(st.relax_steps, false); break;
+        case StageSpec::Kind::excavate: run(st.steps, false); break;
         case StageSpec::Kind::cycle: run(st.steps, false); break;
         case StageSpec::Kind::initialize:
+        case StageSpec::Kind::install:
         case StageSpec::Kind::elastic: break;
         }
         r.ratio = s.unbalanced_ratio();

@@ -5,11 +5,11 @@
 // ("pattern.size") under which its line is kept in ModelSource. Every table is
 // checked for unknown keys before its values are read, so a misspelt key is
 // reported as such (with a suggestion), not as the required key it failed to be.
-#include "io/model_input.hpp"
+// toml++ is compiled once, here (TOML_HEADER_ONLY=0 for the io target).
+#define TOML_IMPLEMENTATION
+#include "io/reader.hpp"
 
 #include "core/verdict.hpp"
-
-#include <toml++/toml.h>
 
 #include <algorithm>
 #include <array>
@@ -35,349 +35,7 @@ using meshing::SegmentSpec;
 
 namespace {
 
-using Keys = std::span<const std::string_view>;
-
-// --- text helpers ----------------------------------------------------------------
-
-/// Shortest text that reads back as the same double, so "-0.3" stays "-0.3".
-std::string fmt(double v) {
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);
-    return {buf, r.ptr};
-}
-
-/// A computed value, to 6 significant digits: 2.1 - 0.6 shows as 1.5.
-std::string fmt6(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-}
-
-std::string fmt(Vec2 p) {
-    return "[" + fmt(p.x) + ", " + fmt(p.y) + "]";
-}
-
-std::string quoted(std::string_view s) {
-    return "'" + std::string(s) + "'";
-}
-
-std::string join(Keys words) {
-    std::string s;
-    for (std::string_view w : words)
-        s += (s.empty() ? "" : ", ") + std::string(w);
-    return s;
-}
-
-/// Optimal string alignment distance: Levenshtein plus adjacent transpositions,
-/// so that "szie" is one edit from "size".
-int edit_distance(std::string_view a, std::string_view b) {
-    std::vector<std::vector<int>> d(a.size() + 1, std::vector<int>(b.size() + 1));
-    for (std::size_t i = 0; i <= a.size(); ++i)
-        d[i][0] = static_cast<int>(i);
-    for (std::size_t j = 0; j <= b.size(); ++j)
-        d[0][j] = static_cast<int>(j);
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const int cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
-            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
-                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-        }
-    }
-    return d[a.size()][b.size()];
-}
-
-/// " (did you mean 'size'?)" for the closest option within two edits, else "".
-/// A word must be longer than the distance, or any short word would match.
-std::string did_you_mean(std::string_view word, Keys options) {
-    int best = 3;
-    std::string_view match;
-    for (std::string_view o : options) {
-        const int d = edit_distance(word, o);
-        if (d < best && d < static_cast<int>(word.size())) best = d, match = o;
-    }
-    return match.empty() ? "" : " (did you mean " + quoted(match) + "?)";
-}
-
-std::string describe(const toml::node& n) {
-    switch (n.type()) {
-    case toml::node_type::string:
-        return "string \"" + n.as_string()->get() + "\"";
-    case toml::node_type::integer:
-        return "integer " + std::to_string(n.as_integer()->get());
-    case toml::node_type::floating_point:
-        return "float " + fmt(n.as_floating_point()->get());
-    case toml::node_type::boolean:
-        return n.as_boolean()->get() ? "boolean true" : "boolean false";
-    case toml::node_type::array:
-        return "an array";
-    case toml::node_type::table:
-        return "a table";
-    default:
-        return "a date or time";
-    }
-}
-
-int line(const toml::node& n) {
-    return static_cast<int>(n.source().begin.line);
-}
-
-// --- where we are ----------------------------------------------------------------
-
-struct Path {
-    std::string full; ///< for messages: "region[1].pattern.size"
-    std::string rel;  ///< inside the region, for ModelSource: "pattern.size"
-
-    Path key(std::string_view k) const {
-        const std::string s(k);
-        return {full.empty() ? s : full + "." + s, rel.empty() ? s : rel + "." + s};
-    }
-    Path at(std::size_t i) const {
-        const std::string s = "[" + std::to_string(i) + "]";
-        return {full + s, rel + s};
-    }
-};
-
-struct Ctx {
-    std::string file;
-    ModelSource* source = nullptr;
-    int region = -1; ///< region being read, -1 outside regions
-    /// The named table being read, for messages: "region 'bonded'", "boundary 'top'".
-    std::string owner;
-
-    [[noreturn]] void fail(int at_line, const Path& p, const std::string& message) const {
-        throw InputError(file, at_line, p.full, message);
-    }
-    [[noreturn]] void fail(const toml::node& n, const Path& p, const std::string& message) const {
-        fail(line(n), p, message);
-    }
-    void note(const Path& p, const toml::node& n) const {
-        if (region >= 0) {
-            if (!p.rel.empty()) source->key_line[region][p.rel] = line(n);
-        } else if (!p.full.empty()) {
-            source->analysis_line[p.full] = line(n);
-        }
-    }
-    /// "region 'bonded': " inside a named table, for messages where the index alone
-    /// would make the user count tables.
-    std::string in_owner() const { return owner.empty() ? "" : owner + ": "; }
-};
-
-// --- value conversions: a node at path p to a C++ value, or an error at its line ----
-
-double to_number(const Ctx& c, const toml::node& n, const Path& p) {
-    double v;
-    if (const auto* i = n.as_integer())
-        v = static_cast<double>(i->get());
-    else if (const auto* f = n.as_floating_point())
-        v = f->get();
-    else
-        c.fail(n, p, "expected a number, got " + describe(n));
-    if (!std::isfinite(v)) c.fail(n, p, "expected a finite number, got " + fmt(v));
-    return v;
-}
-
-Vec2 to_vec2(const Ctx& c, const toml::node& n, const Path& p) {
-    const auto* a = n.as_array();
-    if (!a) c.fail(n, p, "expected a point [x, y], got " + describe(n));
-    if (a->size() != 2)
-        c.fail(n, p,
-               "expected a point [x, y] of 2 numbers, got an array of " +
-                   std::to_string(a->size()));
-    return {to_number(c, (*a)[0], p.at(0)), to_number(c, (*a)[1], p.at(1))};
-}
-
-const toml::table& to_table(const Ctx& c, const toml::node& n, const Path& p,
-                            std::string_view expected) {
-    const auto* t = n.as_table();
-    if (!t) c.fail(n, p, "expected " + std::string(expected) + ", got " + describe(n));
-    return *t;
-}
-
-const toml::array& to_array(const Ctx& c, const toml::node& n, const Path& p,
-                            std::string_view expected) {
-    const auto* a = n.as_array();
-    if (!a) c.fail(n, p, "expected " + std::string(expected) + ", got " + describe(n));
-    return *a;
-}
-
-std::string to_str(const Ctx& c, const toml::node& n, const Path& p) {
-    const auto* s = n.as_string();
-    if (!s) c.fail(n, p, "expected a string, got " + describe(n));
-    return s->get();
-}
-
-// --- keys of a table ---------------------------------------------------------------
-
-/// Rejects keys outside `allowed`. A key in `elsewhere` (valid for another kind of
-/// the same table) is reported as not applying to `kind`. The key reported is the
-/// first in the file, as toml++ iterates a table in key order.
-void check_keys(const Ctx& c, const toml::table& t, const Path& p, Keys allowed,
-                Keys elsewhere = {}, std::string_view kind = {}) {
-    const toml::key* bad = nullptr;
-    for (auto&& [k, v] : t) {
-        if (std::ranges::find(allowed, k.str()) != allowed.end()) continue;
-        if (!bad || k.source().begin.line < bad->source().begin.line) bad = &k;
-    }
-    if (!bad) return;
-    const std::string_view k = bad->str();
-    const int at = static_cast<int>(bad->source().begin.line);
-    if (std::ranges::find(elsewhere, k) != elsewhere.end())
-        c.fail(at, p.key(k),
-               "key " + quoted(k) + " does not apply to " + std::string(kind) +
-                   "; its keys are: " + join(allowed));
-    const std::string where = p.full.empty() ? "at top level" : "in " + p.full;
-    c.fail(at, p.key(k),
-           "unknown key " + quoted(k) + " " + where + did_you_mean(k, allowed) +
-               "; allowed keys: " + join(allowed));
-}
-
-/// The child `key` of t, its line noted; nullptr when absent.
-const toml::node* find(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
-    const toml::node* n = t.get(key);
-    if (n) c.note(p.key(key), *n);
-    return n;
-}
-
-const toml::node& need(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
-                       std::string_view expected) {
-    const toml::node* n = find(c, t, p, key);
-    if (!n)
-        c.fail(t, p.key(key),
-               c.in_owner() + "missing required key " + quoted(key) + ": expected " +
-                   std::string(expected));
-    return *n;
-}
-
-/// Allowed values of a number, and its unit (with a leading space) for messages.
-struct Range {
-    double lo = -std::numeric_limits<double>::infinity();
-    double hi = std::numeric_limits<double>::infinity();
-    bool lo_open = false, hi_open = false;
-    std::string_view unit;
-
-    bool contains(double v) const {
-        return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
-    }
-    std::string text() const {
-        if (std::isinf(hi))
-            return std::isinf(lo) ? "" : (lo_open ? "> " : ">= ") + fmt(lo) + std::string(unit);
-        return "in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) +
-               (hi_open ? ")" : "]") + std::string(unit);
-    }
-};
-Range unbounded(std::string_view unit) {
-    return {.unit = unit};
-}
-Range above(double lo, std::string_view unit) {
-    return {.lo = lo, .lo_open = true, .unit = unit};
-}
-Range at_least(double lo, std::string_view unit) {
-    return {.lo = lo, .unit = unit};
-}
-Range below(double lo, double hi, std::string_view unit) {
-    return {.lo = lo, .hi = hi, .hi_open = true, .unit = unit};
-}
-
-constexpr std::string_view metres = " m";
-constexpr std::string_view degrees = " degrees";
-
-double checked_number(const Ctx& c, const toml::node& n, const Path& p, const Range& r) {
-    const double v = to_number(c, n, p);
-    if (!r.contains(v)) c.fail(n, p, "must be " + r.text() + ", got " + fmt(v));
-    return v;
-}
-
-std::optional<double> number(const Ctx& c, const toml::table& t, const Path& p,
-                             std::string_view key, const Range& r) {
-    const toml::node* n = find(c, t, p, key);
-    if (!n) return std::nullopt;
-    return checked_number(c, *n, p.key(key), r);
-}
-
-double required_number(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
-                       const Range& r) {
-    const std::string expected = "a number" + (r.text().empty() ? "" : " " + r.text());
-    return checked_number(c, need(c, t, p, key, expected), p.key(key), r);
-}
-
-/// An integer >= lo; `hi` only guards the C++ type it is stored in.
-std::int64_t to_integer(const Ctx& c, const toml::node& n, const Path& p, std::int64_t lo,
-                        std::int64_t hi) {
-    const auto* i = n.as_integer();
-    if (!i) c.fail(n, p, "expected an integer >= " + std::to_string(lo) + ", got " + describe(n));
-    if (i->get() < lo)
-        c.fail(n, p,
-               "must be an integer >= " + std::to_string(lo) + ", got " + std::to_string(i->get()));
-    if (i->get() > hi)
-        c.fail(n, p,
-               "must be an integer <= " + std::to_string(hi) + ", got " + std::to_string(i->get()));
-    return i->get();
-}
-
-std::optional<std::int64_t> integer(const Ctx& c, const toml::table& t, const Path& p,
-                                    std::string_view key, std::int64_t lo, std::int64_t hi) {
-    const toml::node* n = find(c, t, p, key);
-    if (!n) return std::nullopt;
-    return to_integer(c, *n, p.key(key), lo, hi);
-}
-
-std::int64_t required_integer(const Ctx& c, const toml::table& t, const Path& p,
-                              std::string_view key, std::int64_t lo, std::int64_t hi) {
-    const toml::node& n = need(c, t, p, key, "an integer >= " + std::to_string(lo));
-    return to_integer(c, n, p.key(key), lo, hi);
-}
-
-std::optional<std::uint64_t> seed(const Ctx& c, const toml::table& t, const Path& p) {
-    const auto s = integer(c, t, p, "seed", 0, std::numeric_limits<std::int64_t>::max());
-    if (!s) return std::nullopt;
-    return static_cast<std::uint64_t>(*s);
-}
-
-std::optional<bool> boolean(const Ctx& c, const toml::table& t, const Path& p,
-                            std::string_view key) {
-    const toml::node* n = find(c, t, p, key);
-    if (!n) return std::nullopt;
-    const auto* b = n->as_boolean();
-    if (!b) c.fail(*n, p.key(key), "expected true or false, got " + describe(*n));
-    return b->get();
-}
-
-std::optional<Vec2> point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
-    const toml::node* n = find(c, t, p, key);
-    if (!n) return std::nullopt;
-    return to_vec2(c, *n, p.key(key));
-}
-
-Vec2 required_point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
-    return to_vec2(c, need(c, t, p, key, "a point [x, y]"), p.key(key));
-}
-
-/// Index of the string at node n in `options`; `what` names the choice.
-std::size_t to_choice(const Ctx& c, const toml::node& n, const Path& p, Keys options,
-                      std::string_view what) {
-    const std::string s = to_str(c, n, p);
-    const auto it = std::ranges::find(options, s);
-    if (it == options.end())
-        c.fail(n, p,
-               "unknown " + std::string(what) + " " + quoted(s) + did_you_mean(s, options) +
-                   "; expected one of: " + join(options));
-    return static_cast<std::size_t>(it - options.begin());
-}
-
-/// Index of the string value of the required `key` in `options`.
-std::size_t choice(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
-                   Keys options, std::string_view what) {
-    return to_choice(c, need(c, t, p, key, "one of " + join(options)), p.key(key), options, what);
-}
-
-/// Each element of an array-valued key, with its path and its line noted.
-template <class F> void for_each_element(const Ctx& c, const toml::array& a, const Path& p, F&& f) {
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        c.note(p.at(i), a[i]);
-        f(a[i], p.at(i));
-    }
-}
+using namespace reader;
 
 // --- the model's tables ------------------------------------------------------------
 
@@ -714,101 +372,6 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 
 // --- the analysis tables -----------------------------------------------------------
 
-std::string article(std::string_view word) {
-    return std::string(std::string_view("aeiou").find(word.front()) == std::string_view::npos
-                           ? "a "
-                           : "an ") +
-           std::string(word);
-}
-
-/// The names of one kind of table, for uniqueness and for references to them.
-struct Names {
-    std::string_view what;   ///< "joint property"
-    std::string_view plural; ///< "joint properties"
-    std::string_view table;  ///< "joint_property": the key of its tables
-    std::vector<std::string> names;
-    std::vector<int> lines; ///< line of each table
-
-    std::vector<std::string_view> views() const { return {names.begin(), names.end()}; }
-    bool has(std::string_view s) const { return std::ranges::find(names, s) != names.end(); }
-};
-
-/// A new name for `names`: not used before. `at` is the line of its key.
-void add_name(const Ctx& c, Names& names, const std::string& name, int at, const Path& np,
-              int table_line) {
-    for (std::size_t j = 0; j < names.names.size(); ++j)
-        if (names.names[j] == name)
-            c.fail(at, np,
-                   std::string(names.what) + " name " + quoted(name) + " is already used by " +
-                       std::string(names.table) + "[" + std::to_string(j) + "] (line " +
-                       std::to_string(names.lines[j]) + ")");
-    names.names.push_back(name);
-    names.lines.push_back(table_line);
-}
-
-/// The required, non-empty, unique `name` of a table; it becomes the owner in messages.
-std::string read_name(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    const Path np = p.key("name");
-    const toml::node& n = need(c, t, p, "name", "a non-empty string");
-    std::string s = to_str(c, n, np);
-    if (s.empty()) c.fail(n, np, "must be a non-empty string, got \"\"");
-    add_name(c, names, s, line(n), np, line(t));
-    c.owner = std::string(names.what) + " " + quoted(s);
-    return s;
-}
-
-/// `name` must be one of `known`.
-void check_ref(const Ctx& c, int at, const Path& p, std::string_view name, const Names& known) {
-    if (known.has(name)) return;
-    const std::string head = "unknown " + std::string(known.what) + " " + quoted(name);
-    const auto v = known.views();
-    if (v.empty())
-        c.fail(at, p, head + ": the file has no [[" + std::string(known.table) + "]] tables");
-    c.fail(at, p,
-           head + did_you_mean(name, v) + "; " + std::string(known.plural) + " are: " + join(v));
-}
-
-/// The array of strings `key` (required or not): not empty, no repeats, each
-/// checked by f(string, node, path). `if_absent` says what leaving it out means.
-template <class F>
-std::vector<std::string> string_list(const Ctx& c, const toml::table& t, const Path& p,
-                                     std::string_view key, std::string_view what,
-                                     std::string_view if_absent, F&& f) {
-    std::vector<std::string> list;
-    const std::string expected = "an array of " + std::string(what) + " names";
-    const toml::node* n = if_absent.empty()
-                              ? &need(c, t, p, key, "a non-empty " + expected.substr(3))
-                              : find(c, t, p, key);
-    if (!n) return list;
-    const Path kp = p.key(key);
-    const toml::array& a = to_array(c, *n, kp, expected);
-    if (a.empty())
-        c.fail(*n, kp,
-               "must list at least one " + std::string(what) + ", got an empty array" +
-                   (if_absent.empty()
-                        ? ""
-                        : "; leave " + quoted(key) + " out " + std::string(if_absent)));
-    for_each_element(c, a, kp, [&](const toml::node& e, const Path& ep) {
-        std::string s = to_str(c, e, ep);
-        f(s, e, ep);
-        if (const auto it = std::ranges::find(list, s); it != list.end())
-            c.fail(e, ep,
-                   quoted(s) + " is already listed as " + std::string(key) + "[" +
-                       std::to_string(it - list.begin()) + "]");
-        list.push_back(std::move(s));
-    });
-    return list;
-}
-
-std::vector<std::string> name_list(const Ctx& c, const toml::table& t, const Path& p,
-                                   std::string_view key, const Names& known,
-                                   std::string_view if_absent) {
-    return string_list(c, t, p, key, known.what, if_absent,
-                       [&](const std::string& s, const toml::node& e, const Path& ep) {
-                           check_ref(c, line(e), ep, s, known);
-                       });
-}
-
 constexpr std::string_view pascals = " Pa";
 constexpr std::string_view pascals_per_metre = " Pa/m";
 
@@ -826,8 +389,8 @@ constexpr std::array<std::string_view, 14> quantities{"unbalanced_ratio",  "disp
                                                       "cracks_tensile",    "cracks_shear",
                                                       "kinetic_energy",    "strain_energy",
                                                       "dissipated_energy", "work"};
-constexpr std::array<std::string_view, 5> stage_types{"initialize", "solve", "excavate", "cycle",
-                                                      "elastic"};
+constexpr std::array<std::string_view, 6> stage_types{"initialize", "solve", "excavate", "cycle",
+                                                      "elastic",    "install"};
 
 SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
                        const Names& properties) {
@@ -1113,17 +676,18 @@ HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& nam
 }
 
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
-                     const Names& regions) {
-    static constexpr std::array<std::string_view, 16> all_keys{
+                     const Names& regions, const Names& supports) {
+    static constexpr std::array<std::string_view, 17> all_keys{
         "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy", "dsyy_dy",
-        "dsxy_dy", "ratio", "max_steps", "until", "quiet_steps", "regions", "relax_steps", "steps"};
+        "dsxy_dy", "ratio", "max_steps", "until", "quiet_steps", "regions", "relax_steps", "steps", "supports"};
+    static constexpr std::array<std::string_view, 3> install_keys{"name", "type", "supports"};
     static constexpr std::array<std::string_view, 9> initialize_keys{
         "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
     static constexpr std::array<std::string_view, 6> solve_keys{"name",  "type",       "ratio",
                                                                 "max_steps", "until", "quiet_steps"};
     static constexpr std::array<std::string_view, 2> until_options{"ratio", "rest"};
-    static constexpr std::array<std::string_view, 4> excavate_keys{"name", "type", "regions",
-                                                                   "relax_steps"};
+    static constexpr std::array<std::string_view, 5> excavate_keys{"name", "type", "regions",
+                                                                   "relax_steps", "steps"};
     static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
     static constexpr std::array<std::string_view, 2> elastic_keys{"name", "type"};
     check_keys(c, t, p, all_keys);
@@ -1145,6 +709,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
                       : s.kind == Kind::solve    ? Keys(solve_keys)
                       : s.kind == Kind::excavate ? Keys(excavate_keys)
                       : s.kind == Kind::cycle    ? Keys(cycle_keys)
+                      : s.kind == Kind::install  ? Keys(install_keys)
                                                  : Keys(elastic_keys);
     check_keys(c, t, p, keys, all_keys,
                article(stage_types[static_cast<std::size_t>(s.kind)]) + " stage");
@@ -1165,11 +730,20 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     case Kind::excavate:
         s.regions = name_list(c, t, p, "regions", regions, "");
         s.relax_steps = integer(c, t, p, "relax_steps", 0, long_max).value_or(0);
+        // Steps run in this stage: fewer than relax_steps stops part-way through the
+        // relaxation (which goes on in the next stages), e.g. to install support.
+        s.steps = integer(c, t, p, "steps", 0, long_max).value_or(s.relax_steps);
+        if (s.steps > s.relax_steps)
+            c.fail(*find(c, t, p, "steps"), p.key("steps"),
+                   "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));
         break;
     case Kind::cycle:
         s.steps = required_integer(c, t, p, "steps", 1, long_max);
         break;
     case Kind::elastic:
+        break;
+    case Kind::install:
+        s.supports = name_list(c, t, p, "supports", supports, "");
         break;
     }
     return s;
@@ -1199,21 +773,6 @@ void check_deformable_materials(const Ctx& c, const ModelFile& mf) {
         if (m->young == 0)
             c.fail(at, p, head + "its material " + quoted(m->name) + " has no young modulus");
     }
-}
-
-/// Each table of the top-level array `key` ([[key]] sections), read by f(table, path).
-template <class F> void read_tables(Ctx& c, const toml::table& doc, std::string_view key, F&& f) {
-    const Path kp = Path{}.key(key);
-    const toml::node* n = find(c, doc, Path{}, key);
-    if (!n) return;
-    const std::string what = "[[" + std::string(key) + "]]";
-    const toml::array& a = to_array(c, *n, kp, "an array of " + what + " tables (double brackets)");
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        c.note(kp.at(i), a[i]);
-        c.owner.clear();
-        f(to_table(c, a[i], kp.at(i), "a " + what + " table"), kp.at(i), i);
-    }
-    c.owner.clear();
 }
 
 /// The analysis tables, after the regions (whose names they refer to) are read.
@@ -1254,9 +813,11 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     read_tables(c, doc, "history", [&](const toml::table& t, const Path& p, std::size_t) {
         an.histories.push_back(read_history(c, t, p, histories, boundaries));
     });
+    Names supports{"bolt set", "bolt sets", "bolt", {}, {}};
+    read_bolt_sets(c, doc, an.bolts, supports);
     Names stages{"stage", "stages", "stage", {}, {}};
     read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
-        an.stages.push_back(read_stage(c, t, p, i, stages, regions));
+        an.stages.push_back(read_stage(c, t, p, i, stages, regions, supports));
     });
     if (const toml::node* n = find(c, doc, Path{}, "report")) {
         const Path p = Path{}.key("report");
@@ -1315,9 +876,9 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     c.file = name;
     c.source = &mf.source;
     const Path root{};
-    static constexpr std::array<std::string_view, 10> top_keys{
+    static constexpr std::array<std::string_view, 11> top_keys{
         "model",    "region", "material", "joint_property", "joint_assignment",
-        "boundary", "solver", "history",  "stage",          "report"};
+        "boundary", "solver", "history",  "stage",          "report", "bolt"};
     check_keys(c, doc, root, top_keys);
 
     if (const toml::node* n = find(c, doc, root, "model")) {

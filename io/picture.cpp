@@ -231,6 +231,29 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
         cairo_line_to(cr, y.x, y.y);
         cairo_stroke(cr);
     }
+    // Bolts: each segment coloured by its axial force, green (none) to purple (the
+    // largest of the run); yielded segments drawn thicker, broken ones dashed black.
+    const auto& bolts = s.bolts();
+    double bolt_max = 0.0;
+    for (int seg = 0; seg < bolts.segment_count(); ++seg)
+        bolt_max = std::max(bolt_max, std::abs(bolts.axial[seg]) * bolts.sets[bolts.node_set[bolts.segment_node[seg]]].spacing);
+    for (int seg = 0; seg < bolts.segment_count(); ++seg) {
+        const int a = bolts.segment_node[seg];
+        const double f = bolt_max > 0 ? std::abs(bolts.axial[seg]) * bolts.sets[bolts.node_set[a]].spacing / bolt_max : 0.0;
+        const bool broken = bolts.state[seg] == BoltState::broken, yielded = bolts.state[seg] == BoltState::yielded;
+        if (broken) {
+            cairo_set_source_rgb(cr, 0, 0, 0);
+            const double dash[2] = {3.0 * px, 3.0 * px};
+            cairo_set_dash(cr, dash, 2, 0.0);
+        } else {
+            cairo_set_source_rgb(cr, 0.1 + 0.5 * f, 0.6 - 0.5 * f, 0.2 + 0.5 * f);
+        }
+        cairo_set_line_width(cr, (yielded ? 4.0 : 2.5) * px);
+        cairo_move_to(cr, bolts.position[a].x, bolts.position[a].y);
+        cairo_line_to(cr, bolts.position[a + 1].x, bolts.position[a + 1].y);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, nullptr, 0, 0.0);
+    }
     if (!o.outline.empty()) {
         cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
         cairo_set_line_width(cr, 2.0 * px);
@@ -255,9 +278,13 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s",
+    char bolt_text[120] = "";
+    if (bolts.segment_count() > 0)
+        std::snprintf(bolt_text, sizeof bolt_text, "   bolts: green 0 to purple %.0f kN", bolt_max / 1e3);
+    std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s%s",
                   s.cracks(contact::JointState::broken_shear), 1e3 * umax, 1e3 * umax_all,
-                  o.outline.empty() ? "" : "   dashed: failed zone", o.title.empty() ? "" : "   ", o.title.c_str());
+                  o.outline.empty() ? "" : "   dashed: failed zone", bolt_text, o.title.empty() ? "" : "   ",
+                  o.title.c_str());
     text(cr, 292, y0, buf);
     canvas.finish();
 }

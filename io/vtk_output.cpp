@@ -498,4 +498,48 @@ void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
     write_grid(grid, file);
 }
 
+void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
+    const auto& B = s.bolts();
+    const auto nodes = static_cast<vtkIdType>(B.node_count()), n = static_cast<vtkIdType>(B.segment_count());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(nodes);
+    auto bond = double_array("bond_kN_per_m", nodes), slip = double_array("slip", nodes);
+    for (vtkIdType k = 0; k < nodes; ++k) {
+        points->SetPoint(k, B.position[k].x, B.position[k].y, 0.0);
+        bond->SetValue(k, B.bond[k] * B.sets[B.node_set[k]].spacing / 1e3);
+        slip->SetValue(k, B.slip[k]);
+    }
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->SetNumberOfValues(n + 1);
+    connectivity->SetNumberOfValues(2 * n);
+    auto axial = double_array("axial_force_kN", n);
+    auto state = int_array("state", n), set = int_array("set", n), bolt = int_array("bolt", n);
+    int b = 0;
+    for (vtkIdType i = 0; i < n; ++i) {
+        const int a = B.segment_node[i];
+        while (a >= B.first[b + 1]) ++b;
+        offsets->SetValue(i, 2 * i);
+        connectivity->SetValue(2 * i, a);
+        connectivity->SetValue(2 * i + 1, a + 1);
+        axial->SetValue(i, B.axial[i] * B.sets[B.node_set[a]].spacing / 1e3);
+        state->SetValue(i, B.state[i]);
+        set->SetValue(i, B.node_set[a]);
+        bolt->SetValue(i, b);
+    }
+    offsets->SetValue(n, 2 * n);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+    vtkNew<vtkUnstructuredGrid> grid;
+    grid->SetPoints(points);
+    grid->SetCells(VTK_LINE, cells);
+    add_cell_arrays(grid, axial, state, set, bolt);
+    grid->GetPointData()->AddArray(bond);
+    grid->GetPointData()->AddArray(slip);
+    const std::vector<std::string> states{"elastic", "yielded", "broken"};
+    grid->GetFieldData()->AddArray(string_array("state_names", states, [](const std::string& x) { return x; }));
+    grid->GetFieldData()->AddArray(string_array("set_names", s.bolt_set_names(), [](const std::string& x) { return x; }));
+    write_grid(grid, file);
+}
+
 } // namespace bbm::io

@@ -65,5 +65,10 @@ void write_state_blocks_vtu(const Solver& s, const std::filesystem::path& file);
 /// us, damage, state (0 intact, 1 softening, 2 broken-tension, 3 broken-shear,
 /// 4 sliding), property, length).
 void write_state_contacts_vtu(const Solver& s, const std::filesystem::path& file);
+/// Installed bolts (core/bolts.hpp): one line cell per segment, cell data
+/// axial_force_kN (per bolt, tension positive), state (0 elastic, 1 yielded,
+/// 2 broken), set, bolt; point data bond_kN_per_m (grout force along the bolt,
+/// per bolt) and slip (plastic grout slip, m). Field data set_names, state_names.
+void write_state_bolts_vtu(const Solver& s, const std::filesystem::path& file);
 
 } // namespace bbm::io

@@ -93,6 +93,7 @@ struct BlockArrays : StateArrays {};
 struct ContactArrays : StateArrays {};
 struct ZoneArrays : StateArrays {};
 struct NodeArrays : StateArrays {};
+struct BoltArrays : StateArrays {};
 
 const Solver& solver_of(const StateArrays& a) { return *a.solver; }
 
@@ -338,6 +339,48 @@ PYBIND11_MODULE(_bbm, mod) {
             return out;
         }, "n×2 displacements since the start, m (computed)");
 
+    py::class_<BoltArrays>(mod, "BoltArrays",
+                           "Installed bolts (core/bolts.hpp): n nodes, s segments (segment i joins nodes "
+                           "segment_node[i] and segment_node[i] + 1). Forces per bolt (times the out-of-plane spacing).")
+        .def_property_readonly("node_count", [](const BoltArrays& a) { return solver_of(a).bolts().node_count(); })
+        .def_property_readonly("segment_count", [](const BoltArrays& a) { return solver_of(a).bolts().segment_count(); })
+        .def_property_readonly("position", [](const BoltArrays& a) {
+            const auto& b = solver_of(a).bolts();
+            return view<double>(b.position.data(), b.node_count(), 2, sizeof(Vec2), a.model);
+        }, "n×2 node positions, m (view)")
+        .def_property_readonly("segment_node", [](const BoltArrays& a) {
+            const auto& b = solver_of(a).bolts();
+            auto out = fresh<int>(b.segment_count());
+            std::copy(b.segment_node.begin(), b.segment_node.end(), out.mutable_data());
+            return out;
+        }, "s first nodes of the segments")
+        .def_property_readonly("axial_force", [](const BoltArrays& a) {
+            const auto& b = solver_of(a).bolts();
+            auto out = fresh<double>(b.segment_count());
+            for (int i = 0; i < b.segment_count(); ++i)
+                out.mutable_data()[i] = b.axial[i] * b.sets[b.node_set[b.segment_node[i]]].spacing;
+            return out;
+        }, "s axial forces, N per bolt, tension positive")
+        .def_property_readonly("state", [](const BoltArrays& a) {
+            const auto& b = solver_of(a).bolts();
+            auto out = fresh<int>(b.segment_count());
+            std::copy(b.state.begin(), b.state.end(), out.mutable_data());
+            return out;
+        }, "s segment states: 0 elastic, 1 yielded, 2 broken")
+        .def_property_readonly("bond", [](const BoltArrays& a) {
+            const auto& b = solver_of(a).bolts();
+            auto out = fresh<double>(b.node_count());
+            for (int i = 0; i < b.node_count(); ++i) out.mutable_data()[i] = b.bond[i] * b.sets[b.node_set[i]].spacing;
+            return out;
+        }, "n grout forces along the bolt, N per m of bolt, per bolt")
+        .def_property_readonly("set", [](const BoltArrays& a) {
+            const auto& b = solver_of(a).bolts();
+            auto out = fresh<int>(b.node_count());
+            std::copy(b.node_set.begin(), b.node_set.end(), out.mutable_data());
+            return out;
+        }, "n set index of each node (set_names)")
+        .def_property_readonly("set_names", [](const BoltArrays& a) { return solver_of(a).bolt_set_names(); });
+
     py::class_<Model>(mod, "Model")
         .def(py::init([](const std::string& path, int threads, double max_elements) {
                  py::gil_scoped_release release;
@@ -377,6 +420,8 @@ PYBIND11_MODULE(_bbm, mod) {
         .def_property_readonly("contacts", [](py::object self) { return arrays_of<ContactArrays>(self); })
         .def_property_readonly("zones", [](py::object self) { return arrays_of<ZoneArrays>(self); })
         .def_property_readonly("nodes", [](py::object self) { return arrays_of<NodeArrays>(self); })
+        .def_property_readonly("bolts", [](py::object self) { return arrays_of<BoltArrays>(self); },
+                               "Installed bolts: positions, axial forces, grout forces, states")
         .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
         .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
         .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })

@@ -141,6 +141,19 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             summary["verdict"]["stage"] = r->name;
             break;
         }
+    // Support: per installed bolt set, the loads an engineer reads (per bolt).
+    if (const auto sets = solver.bolt_summary(); !sets.empty()) {
+        nlohmann::json bolts = nlohmann::json::array();
+        for (const auto& b : sets)
+            bolts.push_back({{"name", b.name},
+                             {"bolts", b.bolts},
+                             {"max_axial_kN", b.max_axial / 1e3},
+                             {"max_compression_kN", -b.min_axial / 1e3},
+                             {"max_bond_kN_per_m", b.max_bond / 1e3},
+                             {"yielded", b.yielded},
+                             {"broken", b.broken}});
+        summary["bolts"] = bolts;
+    }
     const auto& rep = file.analysis.report;
     if (rep.opening) {
         const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);

@@ -134,7 +134,7 @@ public:
         const double el = std::chrono::duration<double>(now - stage_t0_).count();
         const double rate = el > 0 ? (k - stage_k0_) / el : 0.0;
         const long total = st.kind == StageSpec::Kind::cycle ? st.steps
-                         : st.kind == StageSpec::Kind::excavate ? st.relax_steps : st.max_steps;
+                         : st.kind == StageSpec::Kind::excavate ? st.steps : st.max_steps;
         std::fprintf(stderr, "\r  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s  ",
                      st.name.c_str(), k, total, s.unbalanced_ratio(), s.cracks(contact::JointState::broken_tension),
                      s.cracks(contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
@@ -252,13 +252,23 @@ public:
         std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
         write_state_contacts_vtu(s, out_ / name);
         series_.push_back({s.time(), name});
-        // result.pvd holds both parts; blocks.pvd and contacts.pvd one each (for
-        // scripts that style them apart, examples/paraview_view.py).
+        if (s.bolts().node_count() > 0) {
+            std::snprintf(name, sizeof name, "vtk/bolts_%08ld.vtu", s.steps());
+            write_state_bolts_vtu(s, out_ / name);
+            series_.push_back({s.time(), name});
+        }
+        // result.pvd holds every part; blocks.pvd, contacts.pvd (and bolts.pvd) one
+        // each (for scripts that style them apart, examples/paraview_view.py).
         write_pvd(out_ / "result.pvd", series_);
-        std::vector<std::pair<double, std::string>> blocks, contacts;
-        for (std::size_t k = 0; k < series_.size(); ++k) (k % 2 ? contacts : blocks).push_back(series_[k]);
+        std::vector<std::pair<double, std::string>> blocks, contacts, bolts;
+        for (const auto& entry : series_)
+            (entry.second.starts_with("vtk/blocks_") ? blocks
+             : entry.second.starts_with("vtk/bolts_") ? bolts
+                                                      : contacts)
+                .push_back(entry);
         write_pvd(out_ / "blocks.pvd", blocks);
         write_pvd(out_ / "contacts.pvd", contacts);
+        if (!bolts.empty()) write_pvd(out_ / "bolts.pvd", bolts);
     }
     void flush_history() {
         std::ostringstream csv;
@@ -470,6 +480,10 @@ int run_model(const RunOptions& opt) {
         this_part = run_stages(*solver, model.analysis.stages, output, start);
     } catch (const NumericalError& e) {
         health = e.what();
+    } catch (const InputError& e) {
+        // Found by a stage (a bolt installed where there is no rock): the model's line.
+        if (!e.file().empty()) throw;
+        throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
     }
     const int stop_signal = interrupted.load();
     if (stop_signal != 0) {
@@ -525,6 +539,12 @@ int run_model(const RunOptions& opt) {
                          1e3 * summary["opening"]["crown_convergence"].get<double>(),
                          summary["opening"]["cracks_springline_sector"].get<int>(),
                          summary["opening"]["cracks_crown_sector"].get<int>());
+        if (summary.contains("bolts"))
+            for (const auto& b : summary["bolts"])
+                std::fprintf(stderr, "bolts '%s': %d, largest load %.1f kN (bond %.1f kN/m), %d yielded, %d broken\n",
+                             b["name"].get<std::string>().c_str(), b["bolts"].get<int>(),
+                             b["max_axial_kN"].get<double>(), b["max_bond_kN_per_m"].get<double>(),
+                             b["yielded"].get<int>(), b["broken"].get<int>());
         std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
                      opt.out.string().c_str());
     }
@@ -537,11 +557,13 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
            "cracks_springline_sector,cracks_crown_sector,failed_zone_depth_springline_m,failed_zone_depth_crown_m,"
-           "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio\n";
+           "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio,bolts,bolt_max_axial_kN,bolts_yielded,"
+           "bolts_broken\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
           "crack depth (90%) springline m | crack depth (90%) crown m | sector cracks springline / crown | "
-          "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio | "
+          "bolts: largest load kN (yielded / broken) |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::vector<Series> curves;
     int status = 0;
     // The models over ranks under mpirun (one after another within a rank, each on
@@ -587,8 +609,19 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         const int fragments = verdict.value("fragments", 0);
         const auto zone = op.contains("failed_zone") ? op["failed_zone"] : nlohmann::json::object();
         const double zone_springline = zone.value("depth_springline", 0.0), zone_crown = zone.value("depth_crown", 0.0);
+        // Support, over its sets: how many bolts, the largest load, how many yielded or broke.
+        int bolts = 0, yielded = 0, broken = 0;
+        double bolt_load = 0.0;
+        if (j.contains("bolts"))
+            for (const auto& b : j["bolts"]) {
+                bolts += b["bolts"].get<int>(), yielded += b["yielded"].get<int>(), broken += b["broken"].get<int>();
+                bolt_load = std::max(bolt_load, b["max_axial_kN"].get<double>());
+            }
+        char bolt_cell[96] = "-";
+        if (bolts > 0) std::snprintf(bolt_cell, sizeof bolt_cell, "%d: %.0f (%d / %d)", bolts, bolt_load, yielded, broken);
         char row[1024];
-        std::snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e\n",
+        std::snprintf(row, sizeof row,
+                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d\n",
                       name.c_str(),
                       j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
                       j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
@@ -596,18 +629,18 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
                       1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
                       get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
                       int(get("cracks_crown_sector")), zone_springline, zone_crown, kind.c_str(), crack_rate, fragments,
-                      rock_ratio);
+                      rock_ratio, bolts, bolt_load, yielded, broken);
         csv << row;
         const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
         std::snprintf(row, sizeof row,
                       "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f | %s | %.2f | %d | "
-                      "%.2e |\n",
+                      "%.2e | %s |\n",
                       shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
                       1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
                       int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), zone_springline, zone_crown,
-                      kind.c_str(), crack_rate, fragments, rock_ratio);
+                      kind.c_str(), crack_rate, fragments, rock_ratio, bolt_cell);
         md << row;
         // Cracks against step from the run's history (columns whose quantity is a crack count).
         Series ser{name, {}, {}};

@@ -1009,13 +1009,49 @@ TEST_CASE("history and stage mistakes") {
                 "does not apply to an initialize stage");
     check_error(with("[[stage]]\ntype = \"run\"\n"), "run", "stage[0].type",
                 "unknown stage type 'run'; expected one of: initialize, solve, excavate, cycle, "
-                "elastic");
+                "elastic, install");
     check_error(with("[[stage]]\ntype = \"elastic\"\nsteps = 10\n"), "steps", "stage[0].steps",
                 "key 'steps' does not apply to an elastic stage; its keys are: name, type");
     check_error(with("[[stage]]\ntype = \"solve\"\n\n[[stage]]\nname = \"stage 1\"\n"
                      "type = \"solve\"\n"),
                 "name = \"stage 1\"", "stage[1].name",
                 "stage name 'stage 1' is already used by stage[0] (line 5)");
+}
+
+TEST_CASE("bolts: a set, its installation, and its mistakes") {
+    const std::string set = "[[bolt]]\nname = \"rebar\"\nbolts = [[[0.0, 0.0], [2.0, 0.0]]]\n"
+                            "diameter = 0.025\nyield_force = 200e3\nbond_stiffness = 1e9\nspacing = 1.5\n";
+    const auto mf = parse_model(with(set + "\n[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\n"
+                                           "relax_steps = 100\nsteps = 40\n\n[[stage]]\ntype = \"install\"\n"
+                                           "supports = [\"rebar\"]\n"),
+                                "t.toml");
+    REQUIRE(mf.analysis.bolts.size() == 1);
+    const auto& b = mf.analysis.bolts[0];
+    CHECK(b.name == "rebar");
+    CHECK(b.bolts.size() == 1);
+    CHECK(b.area == doctest::Approx(4.9087e-4).epsilon(1e-4));
+    CHECK(b.spacing == 1.5);
+    CHECK(b.bond_strength == 0.0);
+    CHECK(mf.analysis.stages[0].steps == 40);
+    CHECK(mf.analysis.stages[1].kind == bbm::StageSpec::Kind::install);
+    CHECK(mf.analysis.stages[1].supports == std::vector<std::string>{"rebar"});
+
+    check_error(with("[[bolt]]\nname = \"b\"\nbond_stiffness = 1e9\n"), "[[bolt]]", "bolt[0]",
+                "bolt set 'b': no bolts: give 'bolts'");
+    check_error(with("[[bolt]]\nname = \"b\"\nbolts = [[[1.0, 1.0], [1.0, 1.0]]]\nbond_stiffness = 1e9\n"),
+                "bolts =", "bolt[0].bolts[0]", "head and toe are the same point");
+    check_error(with("[[bolt]]\nname = \"b\"\nring = { center = [0, 0], radius = 2.0, length = 3.0, count = 4, "
+                     "spacing = 1.0 }\nbond_stiffness = 1e9\n"),
+                "ring =", "bolt[0].ring", "give the bolts' 'count' or their 'spacing'");
+    check_error(with("[[bolt]]\nname = \"b\"\nbolts = [[[0.0, 0.0], [1.0, 0.0]]]\n"),
+                "[[bolt]]", "bolt[0].bond_stiffness", "missing required key 'bond_stiffness'");
+    check_error(with("[[bolt]]\nname = \"b\"\nbolts = [[[0.0, 0.0], [1.0, 0.0]]]\nbond_stiffness = 1e9\n"
+                     "area = 5e-4\ndiameter = 0.025\n"),
+                "[[bolt]]", "bolt[0].diameter", "give the steel's 'area' or its 'diameter', not both");
+    check_error(with(set + "[[stage]]\ntype = \"install\"\nsupports = [\"rebars\"]\n"), "supports",
+                "stage[0].supports[0]", "unknown bolt set 'rebars' (did you mean 'rebar'?)");
+    check_error(with("[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\nrelax_steps = 100\nsteps = 200\n"),
+                "steps = 200", "stage[0].steps", "must be at most relax_steps (100), got 200");
 }
 
 TEST_CASE("analysis tables may come before the tables they name") {

@@ -187,6 +187,19 @@ def test_checkpoint_of_an_older_format_is_refused(tmp_path):
         bbm.Model.resume(str(old))
 
 
+def test_bolt_arrays_of_the_bolted_tunnel():
+    m = bbm.Model(str(SOURCE / "examples/support/tunnel_voronoi_bolted.toml"), threads=2)
+    assert m.bolts.node_count == 0  # installed by a stage
+    m.run()
+    b = m.bolts
+    assert b.set_names == ["rebar"]
+    assert b.position.shape == (b.node_count, 2)
+    assert b.axial_force.shape == (b.segment_count,) and b.state.shape == (b.segment_count,)
+    # Loaded in tension by the converging wall, within the steel's yield (200 kN).
+    assert 10e3 < b.axial_force.max() <= 200e3 * (1 + 1e-9)
+    assert np.abs(b.bond).max() > 0
+
+
 def test_envelope_small_specimen():
     """bbm.envelope() returns envelope.json as a dict: the fits and every run."""
     e = bbm.envelope(width=2.0, height=4.0, confinements=[2e6, 5e6], realizations=1, threads=1)

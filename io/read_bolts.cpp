@@ -1,0 +1,86 @@
+// bbm io: the [[bolt]] tables of a model file — rock bolts and cables (core/bolts.hpp,
+// docs/input.md "Rock bolts and cables").
+#include "io/reader.hpp"
+
+namespace bbm::io::reader {
+
+namespace {
+
+constexpr std::string_view newtons = " N";
+constexpr std::string_view stiffness_per_length = " N/m per m";
+constexpr std::string_view force_per_length = " N/m";
+
+BoltSetSpec::Ring read_ring(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a table {center, radius, length, count or spacing, from, to}");
+    static constexpr std::array<std::string_view, 7> keys{"center", "radius", "length", "count",
+                                                          "spacing", "from",  "to"};
+    check_keys(c, t, p, keys);
+    BoltSetSpec::Ring r;
+    r.center = required_point(c, t, p, "center");
+    r.radius = required_number(c, t, p, "radius", above(0, metres));
+    r.length = required_number(c, t, p, "length", above(0, metres));
+    const auto count = integer(c, t, p, "count", 1, 100000);
+    const auto spacing = number(c, t, p, "spacing", above(0, metres));
+    if (count.has_value() == spacing.has_value())
+        c.fail(t, p, "give the bolts' 'count' or their 'spacing' along the wall (one of them)");
+    r.count = int(count.value_or(0));
+    r.spacing = spacing.value_or(0.0);
+    r.from = number(c, t, p, "from", unbounded(degrees)).value_or(0.0);
+    r.to = number(c, t, p, "to", unbounded(degrees)).value_or(r.from + 360.0);
+    if (!(r.to > r.from) || r.to - r.from > 360.0 + 1e-9)
+        c.fail(t, p, "'to' must be above 'from' by at most 360 degrees, got from " + fmt(r.from) + " to " + fmt(r.to));
+    return r;
+}
+
+BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& names) {
+    static constexpr std::array<std::string_view, 17> keys{
+        "name",          "bolts",          "ring",             "segment_length", "young",
+        "area",          "diameter",       "density",          "yield_force",    "rupture_strain",
+        "cable",         "bond_stiffness", "bond_strength",    "normal_stiffness", "spacing",
+        "face_plate",    "end_anchor"};
+    check_keys(c, t, p, keys);
+    BoltSetSpec b;
+    b.name = read_name(c, t, p, names);
+    if (const toml::node* n = find(c, t, p, "bolts")) {
+        const Path bp = p.key("bolts");
+        const toml::array& a = to_array(c, *n, bp, "an array of bolts [[x1, y1], [x2, y2]] (head, toe)");
+        for_each_element(c, a, bp, [&](const toml::node& e, const Path& ep) {
+            const toml::array& pair = to_array(c, e, ep, "a bolt [[x1, y1], [x2, y2]] (head, toe)");
+            if (pair.size() != 2) c.fail(e, ep, "a bolt is 2 points [head, toe], got " + std::to_string(pair.size()));
+            const Vec2 head = to_vec2(c, pair[0], ep.at(0)), toe = to_vec2(c, pair[1], ep.at(1));
+            if (!(norm(toe - head) > 0)) c.fail(e, ep, "head and toe are the same point " + fmt(head));
+            b.bolts.push_back({head, toe});
+        });
+    }
+    if (const toml::node* n = find(c, t, p, "ring")) b.ring = read_ring(c, *n, p.key("ring"));
+    if (b.bolts.empty() && !b.ring)
+        c.fail(t, p, c.in_owner() + "no bolts: give 'bolts' (head and toe of each) or a 'ring' around an opening");
+    b.segment_length = number(c, t, p, "segment_length", above(0, metres)).value_or(b.segment_length);
+    b.young = number(c, t, p, "young", above(0, " Pa")).value_or(b.young);
+    const auto area = number(c, t, p, "area", above(0, " m²"));
+    const auto diameter = number(c, t, p, "diameter", above(0, metres));
+    if (area && diameter) c.fail(t, p.key("diameter"), "give the steel's 'area' or its 'diameter', not both");
+    if (area) b.area = *area;
+    if (diameter) b.area = 0.25 * 3.141592653589793 * *diameter * *diameter;
+    b.density = number(c, t, p, "density", above(0, " kg/m³")).value_or(b.density);
+    b.yield_force = number(c, t, p, "yield_force", above(0, newtons)).value_or(0.0);
+    b.rupture_strain = number(c, t, p, "rupture_strain", above(0, "")).value_or(0.0);
+    b.cable = boolean(c, t, p, "cable").value_or(false);
+    b.bond_stiffness = required_number(c, t, p, "bond_stiffness", above(0, stiffness_per_length));
+    b.bond_strength = number(c, t, p, "bond_strength", above(0, force_per_length)).value_or(0.0);
+    b.normal_stiffness = number(c, t, p, "normal_stiffness", above(0, stiffness_per_length)).value_or(0.0);
+    b.spacing = number(c, t, p, "spacing", above(0, metres)).value_or(1.0);
+    b.face_plate = boolean(c, t, p, "face_plate").value_or(false);
+    b.end_anchor = boolean(c, t, p, "end_anchor").value_or(false);
+    return b;
+}
+
+} // namespace
+
+void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names) {
+    read_tables(c, doc, "bolt", [&](const toml::table& t, const Path& p, std::size_t) {
+        bolts.push_back(read_bolt_set(c, t, p, names));
+    });
+}
+
+} // namespace bbm::io::reader
