@@ -126,7 +126,39 @@ void Solver::install_bolts(const std::vector<std::string>& names) {
             B.bolt_set.push_back(set);
         }
     }
+    index_bolt_hosts();
     update_timestep();
+}
+
+void Solver::index_bolt_hosts() {
+    auto& B = bolts_;
+    B.reaction.assign(B.node_count(), {});
+    B.reaction_moment.assign(B.node_count(), 0.0);
+    const int nb = b_.count(), nn = n_.count();
+    bolt_block_first_.assign(nb + 1, 0);
+    bolt_node_first_.assign(nn + 1, 0);
+    for (const BoltHost& h : B.host) {
+        if (h.block < 0) continue;
+        if (h.zone < 0) ++bolt_block_first_[h.block + 1];
+        else
+            for (int j = 0; j < 3; ++j) ++bolt_node_first_[z_.node[h.zone][j] + 1];
+    }
+    for (int i = 0; i < nb; ++i) bolt_block_first_[i + 1] += bolt_block_first_[i];
+    for (int i = 0; i < nn; ++i) bolt_node_first_[i + 1] += bolt_node_first_[i];
+    bolt_block_tie_.assign(bolt_block_first_[nb], 0);
+    bolt_node_tie_.assign(bolt_node_first_[nn], {});
+    std::vector<int> fill_block(bolt_block_first_.begin(), bolt_block_first_.end() - 1),
+        fill_node(bolt_node_first_.begin(), bolt_node_first_.end() - 1);
+    for (int k = 0; k < B.node_count(); ++k) { // in bolt-node order: the gather's order
+        const BoltHost& h = B.host[k];
+        if (h.block < 0) continue;
+        if (h.zone < 0) bolt_block_tie_[fill_block[h.block]++] = k;
+        else
+            for (int j = 0; j < 3; ++j) {
+                const int node = z_.node[h.zone][j];
+                bolt_node_tie_[fill_node[node]++] = {k, h.weight[j]};
+            }
+    }
 }
 
 void Solver::bolt_pass() {
@@ -163,6 +195,8 @@ void Solver::bolt_pass() {
             const BoltHost& h = B.host[k];
             if (h.block < 0 || b_.removed[h.block]) {
                 B.bond[k] = 0.0;
+                B.reaction[k] = {};
+                B.reaction_moment[k] = 0.0;
                 continue;
             }
             const auto& set = B.sets[B.node_set[k]];
@@ -179,12 +213,8 @@ void Solver::bolt_pass() {
             B.bond[k] = q;
             const Vec2 f = B.length[k] * (q * t + set.normal_stiffness * (d - s * t));
             B.force[k] += f;
-            if (h.zone < 0) {
-                b_.force[h.block] -= f;
-                b_.moment[h.block] -= cross(x - b_.centroid[h.block], f);
-            } else {
-                for (int j = 0; j < 3; ++j) n_.force[z_.node[h.zone][j]] -= h.weight[j] * f;
-            }
+            B.reaction[k] = -f;
+            B.reaction_moment[k] = h.zone < 0 ? -cross(x - b_.centroid[h.block], f) : 0.0;
         }
     }
 }

@@ -20,9 +20,10 @@
 // F_y, k_bond, q_max, k_normal and the steel's mass divided by S (per metre of
 // model); its figures are reported per bolt (times S).
 //
-// The bolt pass runs once per step after the gather of block and node forces,
-// serially and in the bolts' order (a few hundred nodes: cheaper than a barrier
-// per thread, and the same bits on any thread count); the nodes are integrated
+// The bolt pass runs once per step, by one thread while the others start on the
+// contacts (a few hundred nodes: no barrier of its own); it writes each node's
+// reaction on its rock, which the gather of block and node forces adds in a
+// fixed order (the same bits on any thread count). The nodes are integrated
 // with the blocks' damping and, quasi-static, their masses scaled to their
 // stiffness. Nothing is allocated per step.
 #pragma once
@@ -92,6 +93,10 @@ struct BoltState {
     std::vector<Vec2> applied; ///< a load on a node, N/m (a pull-out test's jack)
     std::vector<double> mass, length, slip, bond; ///< bond: last grout force per metre along the bolt
     std::vector<BoltHost> host;
+    /// What each node's grout puts on its rock this step (the force on the rock,
+    /// and its moment about a rigid host's centroid): scratch, gathered by the rock.
+    std::vector<Vec2> reaction;
+    std::vector<double> reaction_moment;
     std::vector<std::uint8_t> tied;
     std::vector<int> node_set;
     // segments: between nodes segment_node[s] and segment_node[s] + 1

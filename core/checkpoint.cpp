@@ -147,6 +147,7 @@ void Solver::load_state(std::istream& i) {
     get(i, hash);
     c_.normal.resize(c_.size());
     bolts_.force.assign(bolts_.position.size(), {});
+    index_bolt_hosts();
     normals_stale_ = true;
     rebuild_contact_index();
     detector_.invalidate();

@@ -569,6 +569,12 @@ void Solver::compute_forces() {
     // First passes (contacts, then zones: independent of each other, no barrier
     // between them), then one gather per block and node: its contacts' and zones'
     // forces in a fixed order, plus gravity, boundary loads and relaxing supports.
+    // Bolts: one thread, while the others start on the contacts (dynamic batches).
+    const bool bolts = bolts_.node_count() > 0;
+    if (bolts) {
+#pragma omp single nowait
+        bolt_pass();
+    }
     contact::contact_pass(c_, laws_, view(), dt_, corner_radius_);
     normals_stale_ = true;
     if (z_.size() > 0) fem::zone_pass(z_, n_.position.data(), n_.velocity.data(), dt_, b_.removed.data());
@@ -584,6 +590,9 @@ void Solver::compute_forces() {
         f += b_.applied[i] + b_.real_mass[i] * g;
         m += b_.applied_moment[i];
         if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
+        if (bolts)
+            for (int t = bolt_block_first_[i]; t < bolt_block_first_[i + 1]; ++t)
+                f += bolts_.reaction[bolt_block_tie_[t]], m += bolts_.reaction_moment[bolt_block_tie_[t]];
         b_.force[i] = f;
         b_.moment[i] = m;
     }
@@ -591,12 +600,10 @@ void Solver::compute_forces() {
     for (int k = 0; k < nn; ++k) {
         Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
         if (relax > 0.0) f += relax * relax_node_force_[k];
+        if (bolts)
+            for (int t = bolt_node_first_[k]; t < bolt_node_first_[k + 1]; ++t)
+                f += bolt_node_tie_[t].second * bolts_.reaction[bolt_node_tie_[t].first];
         n_.force[k] = f;
-    }
-    // Bolts add to the gathered forces of their rock: serially, in a fixed order.
-    if (bolts_.node_count() > 0) {
-#pragma omp single
-        bolt_pass();
     }
 }
 
@@ -907,7 +914,8 @@ Solver::Memory Solver::memory() const {
     const auto& B = bolts_;
     m.other = bytes(junctions_, chunk_sums_, B.position, B.velocity, B.force, B.mass, B.length, B.slip, B.bond, B.host,
                     B.tied, B.node_set, B.segment_node, B.rest, B.plastic, B.axial, B.state, B.first, B.bolt_set,
-                    bolt_stiffness_);
+                    B.reaction, B.reaction_moment, bolt_stiffness_, bolt_block_first_, bolt_block_tie_,
+                    bolt_node_first_, bolt_node_tie_);
     return m;
 }
 

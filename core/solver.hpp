@@ -228,6 +228,7 @@ private:
                             std::vector<double>& node, double mass_factor);
     double bolt_time_limit() const;         ///< dynamic: the bolts' critical time step
     BoltHost find_host(Vec2 p, double reach) const;
+    void index_bolt_hosts(); ///< the per-block and per-node lists of bolt ties (after install, load)
     Vec2 host_position(const BoltHost& h) const;
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
@@ -242,6 +243,9 @@ private:
     std::vector<std::string> bolt_names_;
     std::vector<BoltSetSpec> bolt_specs_;
     std::vector<double> bolt_stiffness_; ///< per bolt node, scratch of update_timestep()
+    /// Bolt nodes tied to each rigid block (CSR), and (bolt node, weight) to each FE node.
+    std::vector<int> bolt_block_first_, bolt_block_tie_, bolt_node_first_;
+    std::vector<std::pair<int, double>> bolt_node_tie_;
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
     std::vector<std::string> region_names_;
