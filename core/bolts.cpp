@@ -130,6 +130,21 @@ void Solver::install_bolts(const std::vector<std::string>& names) {
     update_timestep();
 }
 
+void Solver::install_supports(const std::vector<std::string>& names) {
+    std::vector<std::string> bolts;
+    for (const auto& name : names) {
+        const auto it = std::find(liner_names_.begin(), liner_names_.end(), name);
+        if (it == liner_names_.end()) {
+            bolts.push_back(name);
+            continue;
+        }
+        const int set = int(it - liner_names_.begin());
+        if (liners_.installed[set]) throw InputError("", 0, "stage.supports", "liner '" + name + "' is already installed");
+        install_liner(set);
+    }
+    install_bolts(bolts); // indexes the ties of both and updates the time step
+}
+
 void Solver::index_bolt_hosts() {
     auto& B = bolts_;
     B.reaction.assign(B.node_count(), {});
@@ -137,7 +152,13 @@ void Solver::index_bolt_hosts() {
     const int nb = b_.count(), nn = n_.count();
     bolt_block_first_.assign(nb + 1, 0);
     bolt_node_first_.assign(nn + 1, 0);
-    for (const BoltHost& h : B.host) {
+    // Ties: bolt nodes 0 … B.node_count() − 1, then liner nodes.
+    auto host_of = [&](int tie) -> const BoltHost& {
+        return tie < B.node_count() ? B.host[tie] : liners_.host[tie - B.node_count()];
+    };
+    const int ties = B.node_count() + liners_.node_count();
+    for (int tie = 0; tie < ties; ++tie) {
+        const BoltHost& h = host_of(tie);
         if (h.block < 0) continue;
         if (h.zone < 0) ++bolt_block_first_[h.block + 1];
         else
@@ -149,8 +170,8 @@ void Solver::index_bolt_hosts() {
     bolt_node_tie_.assign(bolt_node_first_[nn], {});
     std::vector<int> fill_block(bolt_block_first_.begin(), bolt_block_first_.end() - 1),
         fill_node(bolt_node_first_.begin(), bolt_node_first_.end() - 1);
-    for (int k = 0; k < B.node_count(); ++k) { // in bolt-node order: the gather's order
-        const BoltHost& h = B.host[k];
+    for (int k = 0; k < ties; ++k) { // in tie order: the gather's order
+        const BoltHost& h = host_of(k);
         if (h.block < 0) continue;
         if (h.zone < 0) bolt_block_tie_[fill_block[h.block]++] = k;
         else

@@ -28,7 +28,7 @@ namespace bbm {
 namespace {
 // "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
 // count (a resumed run renumbered its contacts at another step: issue 27); 3 the
-// stage monitor's samples (a resumed run's verdict); 4 the installed bolts.
+// stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners.
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
 constexpr std::uint64_t format = '5';
 constexpr std::uint64_t magic = magic_base | format;
@@ -78,6 +78,12 @@ std::uint64_t Solver::compute_model_fingerprint() const {
                              set.normal_stiffness, set.line_mass, set.spacing, double(set.cable)};
         mix(p, sizeof p);
     }
+    for (const auto& set : liners_.sets) {
+        const double p[13] = {set.ea, set.ei, set.line_mass, set.line_inertia, set.kn, set.ks, set.tensile,
+                              set.cohesion, set.tan_friction, set.thrust_capacity, set.tension_capacity,
+                              set.moment_capacity, double(set.symmetric_ends)};
+        mix(p, sizeof p);
+    }
     for (const auto& law : laws_) {
         const double k[2] = {contact::normal_stiffness(law), contact::shear_stiffness(law)};
         mix(k, sizeof k);
@@ -109,6 +115,12 @@ void Solver::visit_state(Self& s, Visit&& v) {
     v(B.installed), v(B.position), v(B.velocity), v(B.applied), v(B.mass), v(B.length), v(B.slip), v(B.bond), v(B.host);
     v(B.tied), v(B.node_set), v(B.segment_node), v(B.rest), v(B.plastic), v(B.axial), v(B.state);
     v(B.first), v(B.bolt_set);
+    auto& L = s.liners_;
+    v(L.installed), v(L.position), v(L.velocity), v(L.theta), v(L.omega), v(L.mass), v(L.inertia), v(L.length);
+    v(L.shear_slip), v(L.host), v(L.separated), v(L.normal_stress), v(L.node_set), v(L.held);
+    v(L.element_node), v(L.rest), v(L.chord0), v(L.thrust), v(L.moment_a), v(L.moment_b);
+    v(L.plastic_strain), v(L.plastic_rotation_a), v(L.plastic_rotation_b), v(L.yielded);
+    v(L.first), v(L.liner_set), v(L.closed);
     // What the stage did so far, for its verdict (not physics: not in the state hash).
     v(s.monitor_.samples_);
 }
@@ -147,6 +159,10 @@ void Solver::load_state(std::istream& i) {
     get(i, hash);
     c_.normal.resize(c_.size());
     bolts_.force.assign(bolts_.position.size(), {});
+    liners_.force.assign(liners_.position.size(), {});
+    liners_.moment.assign(liners_.position.size(), 0.0);
+    liners_.reaction.assign(liners_.position.size(), {});
+    liners_.reaction_moment.assign(liners_.position.size(), 0.0);
     index_bolt_hosts();
     normals_stale_ = true;
     rebuild_contact_index();

@@ -10,6 +10,7 @@
 
 #include "base/vec2.hpp"
 #include "core/bolts.hpp"
+#include "core/liners.hpp"
 #include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
 
@@ -124,7 +125,7 @@ struct StageSpec {
     long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps)
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
-    std::vector<std::string> supports; ///< install: names of [[bolt]] sets
+    std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;
@@ -146,6 +147,7 @@ struct AnalysisSpec {
     std::vector<HistorySpec> histories;
     std::vector<StageSpec> stages;
     std::vector<BoltSetSpec> bolts; ///< support sets, installed by install stages
+    std::vector<LinerSpec> liners;
     ReportSpec report;
 };
 

@@ -273,6 +273,19 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
                                spec.density * spec.area / S, S, std::uint8_t(spec.cable)});
     }
     bolts_.installed.assign(bolts_.sets.size(), 0);
+    for (const auto& spec : an.liners) {
+        const double e = spec.young / (1.0 - spec.poisson * spec.poisson), t = spec.thickness;
+        const double ring = e * t / (spec.radius * spec.radius);
+        const double kn = spec.normal_stiffness > 0.0 ? spec.normal_stiffness : 10.0 * ring;
+        liner_specs_.push_back(spec);
+        liner_names_.push_back(spec.name);
+        liners_.sets.push_back({e * t, e * t * t * t / 12.0, spec.density * t, spec.density * t * t * t / 12.0, kn,
+                                spec.shear_stiffness > 0.0 ? spec.shear_stiffness : kn, spec.tensile_strength,
+                                spec.cohesion, std::tan(spec.friction * 3.141592653589793 / 180.0),
+                                spec.thrust_capacity, spec.tension_capacity, spec.moment_capacity,
+                                std::uint8_t(spec.symmetric_ends)});
+    }
+    liners_.installed.assign(liners_.sets.size(), 0);
     update_vertices();
     update_timestep();
     fingerprint_ = compute_model_fingerprint();
@@ -457,9 +470,11 @@ void Solver::update_timestep() {
     }
     const double s = settings_.safety;
     const bool scaled = settings_.mode == SolverSpec::Mode::quasi_static;
-    if (bolts_.node_count() > 0) {
+    if (bolts_.node_count() + liners_.node_count() > 0) {
         const double step = scaled ? (settings_.timestep > 0 ? settings_.timestep : 1.0) : 0.0;
-        add_bolt_stiffness(k, kr, kn, scaled ? (step / (2.0 * s)) * (step / (2.0 * s)) : 0.0);
+        const double factor = scaled ? (step / (2.0 * s)) * (step / (2.0 * s)) : 0.0;
+        if (bolts_.node_count() > 0) add_bolt_stiffness(k, kr, kn, factor);
+        if (liners_.node_count() > 0) add_liner_stiffness(k, kr, kn, factor);
     }
     if (scaled) {
         dt_ = settings_.timestep > 0 ? settings_.timestep : 1.0;
@@ -481,6 +496,7 @@ void Solver::update_timestep() {
         for (int i = 0; i < nn; ++i)
             if (!b_.removed[n_.block[i]] && kn[i] > 0) limit = std::min(limit, 2.0 * std::sqrt(n_.real_mass[i] / kn[i]));
         if (bolts_.node_count() > 0) limit = std::min(limit, bolt_time_limit());
+        if (liners_.node_count() > 0) limit = std::min(limit, liner_time_limit());
         dt_ = settings_.timestep > 0 ? settings_.timestep : (std::isfinite(limit) ? s * limit : 1e-3);
         b_.mass = b_.real_mass;
         b_.inertia = b_.real_inertia;
@@ -569,11 +585,16 @@ void Solver::compute_forces() {
     // First passes (contacts, then zones: independent of each other, no barrier
     // between them), then one gather per block and node: its contacts' and zones'
     // forces in a fixed order, plus gravity, boundary loads and relaxing supports.
-    // Bolts: one thread, while the others start on the contacts (dynamic batches).
-    const bool bolts = bolts_.node_count() > 0;
+    // Support (bolts, liners): one thread, while the others start on the contacts
+    // (dynamic batches).
+    const int bolt_ties = bolts_.node_count();
+    const bool bolts = bolt_ties + liners_.node_count() > 0;
     if (bolts) {
 #pragma omp single nowait
-        bolt_pass();
+        {
+            if (bolt_ties > 0) bolt_pass();
+            if (liners_.node_count() > 0) liner_pass();
+        }
     }
     contact::contact_pass(c_, laws_, view(), dt_, corner_radius_);
     normals_stale_ = true;
@@ -591,8 +612,11 @@ void Solver::compute_forces() {
         m += b_.applied_moment[i];
         if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
         if (bolts)
-            for (int t = bolt_block_first_[i]; t < bolt_block_first_[i + 1]; ++t)
-                f += bolts_.reaction[bolt_block_tie_[t]], m += bolts_.reaction_moment[bolt_block_tie_[t]];
+            for (int t = bolt_block_first_[i]; t < bolt_block_first_[i + 1]; ++t) {
+                const int tie = bolt_block_tie_[t];
+                if (tie < bolt_ties) f += bolts_.reaction[tie], m += bolts_.reaction_moment[tie];
+                else f += liners_.reaction[tie - bolt_ties], m += liners_.reaction_moment[tie - bolt_ties];
+            }
         b_.force[i] = f;
         b_.moment[i] = m;
     }
@@ -601,8 +625,10 @@ void Solver::compute_forces() {
         Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
         if (relax > 0.0) f += relax * relax_node_force_[k];
         if (bolts)
-            for (int t = bolt_node_first_[k]; t < bolt_node_first_[k + 1]; ++t)
-                f += bolt_node_tie_[t].second * bolts_.reaction[bolt_node_tie_[t].first];
+            for (int t = bolt_node_first_[k]; t < bolt_node_first_[k + 1]; ++t) {
+                const auto [tie, weight] = bolt_node_tie_[t];
+                f += weight * (tie < bolt_ties ? bolts_.reaction[tie] : liners_.reaction[tie - bolt_ties]);
+            }
         n_.force[k] = f;
     }
 }
@@ -679,6 +705,7 @@ void Solver::integrate() {
             max_unbalanced = std::max(max_unbalanced, chunk_sums_[chunk].unbalanced);
         }
         if (bolts_.node_count() > 0) max_unbalanced = std::max(max_unbalanced, integrate_bolts(work_));
+        if (liners_.node_count() > 0) max_unbalanced = std::max(max_unbalanced, integrate_liners(work_));
         const double scale = force_scale();
         ratio_ = scale > 0.0 ? max_unbalanced / scale : 0.0;
     }
@@ -916,6 +943,12 @@ Solver::Memory Solver::memory() const {
                     B.tied, B.node_set, B.segment_node, B.rest, B.plastic, B.axial, B.state, B.first, B.bolt_set,
                     B.reaction, B.reaction_moment, bolt_stiffness_, bolt_block_first_, bolt_block_tie_,
                     bolt_node_first_, bolt_node_tie_);
+    const auto& L = liners_;
+    m.other += bytes(L.position, L.velocity, L.force, L.theta, L.omega, L.moment, L.mass, L.inertia, L.length,
+                     L.shear_slip, L.host, L.separated, L.normal_stress, L.node_set, L.reaction, L.reaction_moment,
+                     L.held, L.element_node, L.rest, L.chord0, L.thrust, L.moment_a, L.moment_b, L.plastic_strain,
+                     L.plastic_rotation_a, L.plastic_rotation_b, L.yielded, L.first,
+                     L.liner_set, L.closed, liner_stiffness_, liner_rotation_stiffness_);
     return m;
 }
 
@@ -937,6 +970,9 @@ std::uint64_t Solver::state_hash() const {
     for (int i = 0; i < bolts_.node_count(); ++i)
         mix(bolts_.position[i].x), mix(bolts_.position[i].y), mix(bolts_.velocity[i].x), mix(bolts_.velocity[i].y);
     for (double n : bolts_.axial) mix(n);
+    for (int i = 0; i < liners_.node_count(); ++i)
+        mix(liners_.position[i].x), mix(liners_.position[i].y), mix(liners_.theta[i]), mix(liners_.velocity[i].x),
+            mix(liners_.velocity[i].y), mix(liners_.omega[i]);
     return h;
 }
 

@@ -73,6 +73,13 @@ public:
     /// each tied to the rock it lies in now, unstressed. Throws InputError (key
     /// "stage.supports") for an unknown or already installed set.
     void install_bolts(const std::vector<std::string>& sets);
+    /// Installs the named supports, [[bolt]] sets or [[liner]]s (core/liners.hpp):
+    /// what an `install` stage does.
+    void install_supports(const std::vector<std::string>& names);
+    const LinerState& liners() const { return liners_; }
+    const std::vector<std::string>& liner_names() const { return liner_names_; }
+    /// Per installed liner: thrust and moment extremes, separated interface nodes.
+    std::vector<LinerSetSummary> liner_summary() const;
     const BoltState& bolts() const { return bolts_; }
     BoltState& bolts() { return bolts_; } ///< a study may load a node (BoltState::applied)
     const std::vector<std::string>& bolt_set_names() const { return bolt_names_; }
@@ -228,7 +235,16 @@ private:
                             std::vector<double>& node, double mass_factor);
     double bolt_time_limit() const;         ///< dynamic: the bolts' critical time step
     BoltHost find_host(Vec2 p, double reach) const;
-    void index_bolt_hosts(); ///< the per-block and per-node lists of bolt ties (after install, load)
+    /// The per-block and per-node lists of support ties — bolt nodes, then liner
+    /// nodes numbered after them (after an install, a load).
+    void index_bolt_hosts();
+    // Liners (core/liners.cpp).
+    void install_liner(int set);
+    void liner_pass();
+    double integrate_liners(double& work);
+    void add_liner_stiffness(std::vector<double>& block, std::vector<double>& rotation, std::vector<double>& node,
+                             double mass_factor);
+    double liner_time_limit() const;
     Vec2 host_position(const BoltHost& h) const;
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
@@ -243,6 +259,10 @@ private:
     std::vector<std::string> bolt_names_;
     std::vector<BoltSetSpec> bolt_specs_;
     std::vector<double> bolt_stiffness_; ///< per bolt node, scratch of update_timestep()
+    LinerState liners_;
+    std::vector<std::string> liner_names_;
+    std::vector<LinerSpec> liner_specs_;
+    std::vector<double> liner_stiffness_, liner_rotation_stiffness_; ///< per liner node, scratch
     /// Bolt nodes tied to each rigid block (CSR), and (bolt node, weight) to each FE node.
     std::vector<int> bolt_block_first_, bolt_block_tie_, bolt_node_first_;
     std::vector<std::pair<int, double>> bolt_node_tie_;

@@ -6,6 +6,7 @@
 #include <cairo.h>
 
 #include <algorithm>
+#include <cstring>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -254,6 +255,24 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
         cairo_stroke(cr);
         cairo_set_dash(cr, nullptr, 0, 0.0);
     }
+    // Liners: a thick line along the wall, darker blue the higher its thrust.
+    const auto& liners = s.liners();
+    double thrust_max = 0.0;
+    for (double t : liners.thrust) thrust_max = std::max(thrust_max, std::abs(t));
+    {
+        int l = 0;
+        for (int e = 0; e < liners.element_count(); ++e) {
+            const int a = liners.element_node[e];
+            while (a >= liners.first[l + 1]) ++l;
+            const int b = a + 1 < liners.first[l + 1] ? a + 1 : liners.first[l];
+            const double f = thrust_max > 0 ? std::abs(liners.thrust[e]) / thrust_max : 0.0;
+            cairo_set_source_rgb(cr, 0.55 - 0.45 * f, 0.75 - 0.55 * f, 0.95 - 0.35 * f);
+            cairo_set_line_width(cr, 5.0 * px);
+            cairo_move_to(cr, liners.position[a].x, liners.position[a].y);
+            cairo_line_to(cr, liners.position[b].x, liners.position[b].y);
+            cairo_stroke(cr);
+        }
+    }
     if (!o.outline.empty()) {
         cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
         cairo_set_line_width(cr, 2.0 * px);
@@ -278,9 +297,12 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    char bolt_text[120] = "";
+    char bolt_text[200] = "";
     if (bolts.segment_count() > 0)
         std::snprintf(bolt_text, sizeof bolt_text, "   bolts: green 0 to purple %.0f kN", bolt_max / 1e3);
+    if (liners.element_count() > 0)
+        std::snprintf(bolt_text + std::strlen(bolt_text), sizeof bolt_text - std::strlen(bolt_text),
+                      "   liner: light to dark blue %.0f kN/m thrust", thrust_max / 1e3);
     std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s%s",
                   s.cracks(contact::JointState::broken_shear), 1e3 * umax, 1e3 * umax_all,
                   o.outline.empty() ? "" : "   dashed: failed zone", bolt_text, o.title.empty() ? "" : "   ",

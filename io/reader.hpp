@@ -487,5 +487,7 @@ template <class F> void read_tables(Ctx& c, const toml::table& doc, std::string_
 
 /// [[bolt]] tables (io/read_bolts.cpp): appended to `bolts`; their names to `names`.
 void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names);
+/// [[liner]] tables (io/read_liners.cpp).
+void read_liners(Ctx& c, const toml::table& doc, std::vector<LinerSpec>& liners, Names& names);
 
 } // namespace bbm::io::reader

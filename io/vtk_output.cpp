@@ -542,4 +542,48 @@ void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
     write_grid(grid, file);
 }
 
+void write_state_liners_vtu(const Solver& s, const fs::path& file) {
+    const auto& L = s.liners();
+    const auto nodes = static_cast<vtkIdType>(L.node_count()), n = static_cast<vtkIdType>(L.element_count());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(nodes);
+    auto normal = double_array("interface_normal_MPa", nodes);
+    auto open = int_array("interface_open", nodes);
+    for (vtkIdType k = 0; k < nodes; ++k) {
+        points->SetPoint(k, L.position[k].x, L.position[k].y, 0.0);
+        normal->SetValue(k, L.normal_stress[k] / 1e6);
+        open->SetValue(k, L.separated[k] && L.normal_stress[k] == 0.0);
+    }
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->SetNumberOfValues(n + 1);
+    connectivity->SetNumberOfValues(2 * n);
+    auto thrust = double_array("thrust_kN_per_m", n), moment = double_array("moment_kNm_per_m", n);
+    auto liner = int_array("liner", n), yielded = int_array("yielded", n);
+    int l = 0;
+    for (vtkIdType e = 0; e < n; ++e) {
+        const int a = L.element_node[e];
+        while (a >= L.first[l + 1]) ++l;
+        const int b = a + 1 < L.first[l + 1] ? a + 1 : L.first[l];
+        offsets->SetValue(e, 2 * e);
+        connectivity->SetValue(2 * e, a);
+        connectivity->SetValue(2 * e + 1, b);
+        thrust->SetValue(e, L.thrust[e] / 1e3);
+        moment->SetValue(e, (std::abs(L.moment_a[e]) >= std::abs(L.moment_b[e]) ? L.moment_a[e] : -L.moment_b[e]) / 1e3);
+        liner->SetValue(e, l);
+        yielded->SetValue(e, L.yielded[e]);
+    }
+    offsets->SetValue(n, 2 * n);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+    vtkNew<vtkUnstructuredGrid> grid;
+    grid->SetPoints(points);
+    grid->SetCells(VTK_LINE, cells);
+    add_cell_arrays(grid, thrust, moment, liner, yielded);
+    grid->GetPointData()->AddArray(normal);
+    grid->GetPointData()->AddArray(open);
+    grid->GetFieldData()->AddArray(string_array("liner_names", s.liner_names(), [](const std::string& x) { return x; }));
+    write_grid(grid, file);
+}
+
 } // namespace bbm::io

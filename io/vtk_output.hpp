@@ -70,5 +70,11 @@ void write_state_contacts_vtu(const Solver& s, const std::filesystem::path& file
 /// 2 broken), set, bolt; point data bond_kN_per_m (grout force along the bolt,
 /// per bolt) and slip (plastic grout slip, m). Field data set_names, state_names.
 void write_state_bolts_vtu(const Solver& s, const std::filesystem::path& file);
+/// Installed liners (core/liners.hpp): one line cell per beam element, cell data
+/// thrust_kN_per_m (compression positive), moment_kNm_per_m (the larger end
+/// moment by magnitude, with its sign), liner, yielded (bit 0 thrust, bit 1
+/// bending); point data
+/// interface_normal_MPa (tension positive), interface_open.
+void write_state_liners_vtu(const Solver& s, const std::filesystem::path& file);
 
 } // namespace bbm::io

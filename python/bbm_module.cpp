@@ -94,6 +94,7 @@ struct ContactArrays : StateArrays {};
 struct ZoneArrays : StateArrays {};
 struct NodeArrays : StateArrays {};
 struct BoltArrays : StateArrays {};
+struct LinerArrays : StateArrays {};
 
 const Solver& solver_of(const StateArrays& a) { return *a.solver; }
 
@@ -381,6 +382,42 @@ PYBIND11_MODULE(_bbm, mod) {
         }, "n set index of each node (set_names)")
         .def_property_readonly("set_names", [](const BoltArrays& a) { return solver_of(a).bolt_set_names(); });
 
+    py::class_<LinerArrays>(mod, "LinerArrays",
+                            "Installed liners (core/liners.hpp): n nodes, e beam elements (element i joins nodes "
+                            "element_node[i] and the next node of its liner). Per metre of tunnel.")
+        .def_property_readonly("node_count", [](const LinerArrays& a) { return solver_of(a).liners().node_count(); })
+        .def_property_readonly("element_count", [](const LinerArrays& a) { return solver_of(a).liners().element_count(); })
+        .def_property_readonly("position", [](const LinerArrays& a) {
+            const auto& l = solver_of(a).liners();
+            return view<double>(l.position.data(), l.node_count(), 2, sizeof(Vec2), a.model);
+        }, "n×2 node positions, m (view)")
+        .def_property_readonly("element_node", [](const LinerArrays& a) {
+            const auto& l = solver_of(a).liners();
+            auto out = fresh<int>(l.element_count());
+            std::copy(l.element_node.begin(), l.element_node.end(), out.mutable_data());
+            return out;
+        }, "e first nodes of the elements")
+        .def_property_readonly("thrust", [](const LinerArrays& a) {
+            const auto& l = solver_of(a).liners();
+            auto out = fresh<double>(l.element_count());
+            std::copy(l.thrust.begin(), l.thrust.end(), out.mutable_data());
+            return out;
+        }, "e thrusts, N/m, compression positive")
+        .def_property_readonly("moment", [](const LinerArrays& a) {
+            const auto& l = solver_of(a).liners();
+            auto out = fresh<double>(l.element_count(), 2);
+            for (int e = 0; e < l.element_count(); ++e)
+                out.mutable_data()[2 * e] = l.moment_a[e], out.mutable_data()[2 * e + 1] = l.moment_b[e];
+            return out;
+        }, "e×2 end moments, N·m/m")
+        .def_property_readonly("interface_normal_stress", [](const LinerArrays& a) {
+            const auto& l = solver_of(a).liners();
+            auto out = fresh<double>(l.node_count());
+            std::copy(l.normal_stress.begin(), l.normal_stress.end(), out.mutable_data());
+            return out;
+        }, "n normal stresses on the wall, Pa, tension positive")
+        .def_property_readonly("names", [](const LinerArrays& a) { return solver_of(a).liner_names(); });
+
     py::class_<Model>(mod, "Model")
         .def(py::init([](const std::string& path, int threads, double max_elements) {
                  py::gil_scoped_release release;
@@ -422,6 +459,8 @@ PYBIND11_MODULE(_bbm, mod) {
         .def_property_readonly("nodes", [](py::object self) { return arrays_of<NodeArrays>(self); })
         .def_property_readonly("bolts", [](py::object self) { return arrays_of<BoltArrays>(self); },
                                "Installed bolts: positions, axial forces, grout forces, states")
+        .def_property_readonly("liners", [](py::object self) { return arrays_of<LinerArrays>(self); },
+                               "Installed liners: positions, thrusts, moments, interface stresses")
         .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
         .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
         .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })

@@ -154,6 +154,19 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
                              {"broken", b.broken}});
         summary["bolts"] = bolts;
     }
+    if (const auto liners = solver.liner_summary(); !liners.empty()) {
+        nlohmann::json out = nlohmann::json::array();
+        for (const auto& l : liners)
+            out.push_back({{"name", l.name},
+                           {"nodes", l.nodes},
+                           {"max_thrust_kN_per_m", l.max_thrust / 1e3},
+                           {"min_thrust_kN_per_m", l.min_thrust / 1e3},
+                           {"max_moment_kNm_per_m", l.max_moment / 1e3},
+                           {"open_interface_nodes", l.open},
+                           {"elements", l.elements},
+                           {"yielded_elements", l.yielded}});
+        summary["liners"] = out;
+    }
     const auto& rep = file.analysis.report;
     if (rep.opening) {
         const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);

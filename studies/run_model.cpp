@@ -257,18 +257,25 @@ public:
             write_state_bolts_vtu(s, out_ / name);
             series_.push_back({s.time(), name});
         }
+        if (s.liners().node_count() > 0) {
+            std::snprintf(name, sizeof name, "vtk/liners_%08ld.vtu", s.steps());
+            write_state_liners_vtu(s, out_ / name);
+            series_.push_back({s.time(), name});
+        }
         // result.pvd holds every part; blocks.pvd, contacts.pvd (and bolts.pvd) one
         // each (for scripts that style them apart, examples/paraview_view.py).
         write_pvd(out_ / "result.pvd", series_);
-        std::vector<std::pair<double, std::string>> blocks, contacts, bolts;
+        std::vector<std::pair<double, std::string>> blocks, contacts, bolts, liners;
         for (const auto& entry : series_)
-            (entry.second.starts_with("vtk/blocks_") ? blocks
-             : entry.second.starts_with("vtk/bolts_") ? bolts
-                                                      : contacts)
+            (entry.second.starts_with("vtk/blocks_")  ? blocks
+             : entry.second.starts_with("vtk/bolts_")  ? bolts
+             : entry.second.starts_with("vtk/liners_") ? liners
+                                                       : contacts)
                 .push_back(entry);
         write_pvd(out_ / "blocks.pvd", blocks);
         write_pvd(out_ / "contacts.pvd", contacts);
         if (!bolts.empty()) write_pvd(out_ / "bolts.pvd", bolts);
+        if (!liners.empty()) write_pvd(out_ / "liners.pvd", liners);
     }
     void flush_history() {
         std::ostringstream csv;
@@ -545,6 +552,14 @@ int run_model(const RunOptions& opt) {
                              b["name"].get<std::string>().c_str(), b["bolts"].get<int>(),
                              b["max_axial_kN"].get<double>(), b["max_bond_kN_per_m"].get<double>(),
                              b["yielded"].get<int>(), b["broken"].get<int>());
+        if (summary.contains("liners"))
+            for (const auto& l : summary["liners"])
+                std::fprintf(stderr, "liner '%s': thrust %.0f to %.0f kN/m, largest moment %.1f kNm/m, %d of %d "
+                                     "elements yielded, %d of %d interface nodes open\n",
+                             l["name"].get<std::string>().c_str(), l["min_thrust_kN_per_m"].get<double>(),
+                             l["max_thrust_kN_per_m"].get<double>(), l["max_moment_kNm_per_m"].get<double>(),
+                             l["yielded_elements"].get<int>(), l["elements"].get<int>(),
+                             l["open_interface_nodes"].get<int>(), l["nodes"].get<int>());
         std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
                      opt.out.string().c_str());
     }
@@ -558,12 +573,12 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
            "cracks_springline_sector,cracks_crown_sector,failed_zone_depth_springline_m,failed_zone_depth_crown_m,"
            "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio,bolts,bolt_max_axial_kN,bolts_yielded,"
-           "bolts_broken\n";
+           "bolts_broken,liner_max_thrust_kN_per_m,liner_max_moment_kNm_per_m\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
           "crack depth (90%) springline m | crack depth (90%) crown m | sector cracks springline / crown | "
           "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio | "
-          "bolts: largest load kN (yielded / broken) |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "bolts: largest load kN (yielded / broken) | liner: thrust kN/m, moment kNm/m |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     std::vector<Series> curves;
     int status = 0;
     // The models over ranks under mpirun (one after another within a rank, each on
@@ -617,11 +632,21 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
                 bolts += b["bolts"].get<int>(), yielded += b["yielded"].get<int>(), broken += b["broken"].get<int>();
                 bolt_load = std::max(bolt_load, b["max_axial_kN"].get<double>());
             }
+        double liner_thrust = 0.0, liner_moment = 0.0;
+        const bool lined = j.contains("liners");
+        if (lined)
+            for (const auto& l : j["liners"]) {
+                liner_thrust = std::max(liner_thrust, l["max_thrust_kN_per_m"].get<double>());
+                liner_moment = std::max(liner_moment, l["max_moment_kNm_per_m"].get<double>());
+            }
+        char liner_cell[96] = "-";
+        if (lined) std::snprintf(liner_cell, sizeof liner_cell, "%.0f, %.1f", liner_thrust, liner_moment);
         char bolt_cell[96] = "-";
         if (bolts > 0) std::snprintf(bolt_cell, sizeof bolt_cell, "%d: %.0f (%d / %d)", bolts, bolt_load, yielded, broken);
         char row[1024];
         std::snprintf(row, sizeof row,
-                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d\n",
+                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d,%.1f,"
+                      "%.2f\n",
                       name.c_str(),
                       j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
                       j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
@@ -629,18 +654,18 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
                       1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
                       get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
                       int(get("cracks_crown_sector")), zone_springline, zone_crown, kind.c_str(), crack_rate, fragments,
-                      rock_ratio, bolts, bolt_load, yielded, broken);
+                      rock_ratio, bolts, bolt_load, yielded, broken, liner_thrust, liner_moment);
         csv << row;
         const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
         std::snprintf(row, sizeof row,
                       "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f | %s | %.2f | %d | "
-                      "%.2e | %s |\n",
+                      "%.2e | %s | %s |\n",
                       shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
                       1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
                       int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), zone_springline, zone_crown,
-                      kind.c_str(), crack_rate, fragments, rock_ratio, bolt_cell);
+                      kind.c_str(), crack_rate, fragments, rock_ratio, bolt_cell, liner_cell);
         md << row;
         // Cracks against step from the run's history (columns whose quantity is a crack count).
         Series ser{name, {}, {}};

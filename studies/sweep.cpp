@@ -51,13 +51,28 @@ namespace {
 
 /// A summary value by dotted path ("opening.failed_depth_springline"); NaN if absent.
 double summary_value(const nlohmann::json& s, const std::string& path) {
+    // "opening.failed_zone.depth_springline"; an array element by index,
+    // "bolts[0].max_axial_kN" or "bolts.0.max_axial_kN".
+    std::string p = path;
+    for (std::size_t at; (at = p.find('[')) != std::string::npos;) {
+        const auto close = p.find(']', at);
+        if (close == std::string::npos) return NAN;
+        p = p.substr(0, at) + "." + p.substr(at + 1, close - at - 1) + p.substr(close + 1);
+    }
     const nlohmann::json* j = &s;
     std::size_t at = 0;
-    while (at <= path.size()) {
-        const auto end = path.find('.', at);
-        const std::string part = path.substr(at, end == std::string::npos ? std::string::npos : end - at);
-        if (!j->is_object() || !j->contains(part)) return NAN;
-        j = &(*j)[part];
+    while (at <= p.size()) {
+        const auto end = p.find('.', at);
+        const std::string part = p.substr(at, end == std::string::npos ? std::string::npos : end - at);
+        if (j->is_array()) {
+            if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos) return NAN;
+            const std::size_t index = std::stoul(part);
+            if (index >= j->size()) return NAN;
+            j = &(*j)[index];
+        } else {
+            if (!j->is_object() || !j->contains(part)) return NAN;
+            j = &(*j)[part];
+        }
         if (end == std::string::npos) break;
         at = end + 1;
     }
@@ -165,8 +180,11 @@ int run_sweep(const SweepOptions& o) {
         << ",folder\n";
     nlohmann::json table = nlohmann::json::array();
     int failed = 0;
-    std::map<long, io::Series> by_seed;
-    std::map<double, std::pair<double, int>> mean; // x -> (sum, count)
+    // Series of the plot: one per seed offset and per value of the other swept keys
+    // (a sweep over bolt length and bolt count draws one line per count); the mean
+    // over seeds per value of the other keys.
+    std::map<std::pair<std::string, long>, io::Series> by_seed;
+    std::map<std::string, std::map<double, std::pair<double, int>>> mean; // others -> x -> (sum, count)
     for (std::size_t k = 0; k < runs; ++k) {
         const auto& r = plan[k];
         nlohmann::json row{{"run", k + 1}, {"folder", r.dir}, {"seed_offset", r.seed_offset}};
@@ -207,10 +225,14 @@ int run_sweep(const SweepOptions& o) {
             char* end = nullptr;
             const double x = std::strtod(r.set.front().second.c_str(), &end);
             if (end && *end == '\0') {
-                auto& ser = by_seed[r.seed_offset];
-                ser.label = "seed offset " + std::to_string(r.seed_offset);
+                std::string others;
+                for (std::size_t q = 1; q < r.set.size(); ++q)
+                    others += (others.empty() ? "" : ", ") + r.set[q].first + " = " + r.set[q].second;
+                auto& ser = by_seed[{others, r.seed_offset}];
+                ser.label = others.empty() ? "seed offset " + std::to_string(r.seed_offset)
+                                           : others + (o.seeds > 1 ? ", seed offset " + std::to_string(r.seed_offset) : "");
                 ser.x.push_back(x), ser.y.push_back(y);
-                auto& m = mean[x];
+                auto& m = mean[others][x];
                 m.first += y, ++m.second;
             }
         }
@@ -230,11 +252,12 @@ int run_sweep(const SweepOptions& o) {
                                       .dump(2) + "\n");
     if (!mean.empty()) {
         std::vector<io::Series> series;
-        if (o.seeds > 1) {
-            io::Series m{"mean", {}, {}};
-            for (const auto& [x, sum] : mean) m.x.push_back(x), m.y.push_back(sum.first / sum.second);
-            series.push_back(std::move(m));
-        }
+        if (o.seeds > 1)
+            for (const auto& [others, points] : mean) {
+                io::Series m{others.empty() ? "mean" : "mean, " + others, {}, {}};
+                for (const auto& [x, sum] : points) m.x.push_back(x), m.y.push_back(sum.first / sum.second);
+                series.push_back(std::move(m));
+            }
         for (auto& [seed, ser] : by_seed) series.push_back(std::move(ser));
         io::draw_curves(series, o.set.front().first, o.plot, o.out / "sweep.png", "bbm sweep: " + o.model);
     }

@@ -1049,9 +1049,30 @@ TEST_CASE("bolts: a set, its installation, and its mistakes") {
                      "area = 5e-4\ndiameter = 0.025\n"),
                 "[[bolt]]", "bolt[0].diameter", "give the steel's 'area' or its 'diameter', not both");
     check_error(with(set + "[[stage]]\ntype = \"install\"\nsupports = [\"rebars\"]\n"), "supports",
-                "stage[0].supports[0]", "unknown bolt set 'rebars' (did you mean 'rebar'?)");
+                "stage[0].supports[0]", "unknown support 'rebars' (did you mean 'rebar'?)");
     check_error(with("[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\nrelax_steps = 100\nsteps = 200\n"),
                 "steps = 200", "stage[0].steps", "must be at most relax_steps (100), got 200");
+}
+
+TEST_CASE("liners: a ring along an opening, and its mistakes") {
+    const std::string liner = "[[liner]]\nname = \"shotcrete\"\ncenter = [0.0, 0.0]\nradius = 4.0\nfrom = -90.0\n"
+                              "to = 90.0\nthickness = 0.1\nsymmetric_ends = true\n";
+    const auto mf = parse_model(with(liner + "\n[[stage]]\ntype = \"install\"\nsupports = [\"shotcrete\"]\n"), "t.toml");
+    REQUIRE(mf.analysis.liners.size() == 1);
+    CHECK(mf.analysis.liners[0].radius == 4.0);
+    CHECK(mf.analysis.liners[0].symmetric_ends);
+    CHECK(mf.analysis.liners[0].young == 30e9);
+    check_error(with("[[liner]]\nname = \"l\"\ncenter = [0, 0]\nradius = 1.0\n"), "[[liner]]", "liner[0].thickness",
+                "missing required key 'thickness'");
+    check_error(with("[[liner]]\nname = \"l\"\ncenter = [0, 0]\nradius = 1.0\nthickness = 0.1\nsymmetric_ends = true\n"),
+                "symmetric_ends", "liner[0].symmetric_ends", "a closed ring (from 0 to 360 degrees) has no ends");
+    check_error(with("[[liner]]\nname = \"l\"\ncenter = [0, 0]\nradius = 1.0\nthickness = 0.1\nfrom = 90\nto = 0\n"),
+                "[[liner]]", "liner[0]", "'to' must be above 'from'");
+    check_error(with("[[liner]]\nname = \"l\"\ncenter = [0, 0]\nradius = 1.0\nthickness = 0.1\n"
+                     "tension_capacity = 1e5\n"),
+                "tension_capacity", "liner[0].tension_capacity", "needs a thrust capacity");
+    check_error(with(liner + "[[bolt]]\nname = \"shotcrete\"\nbolts = [[[0.0, 0.0], [1.0, 0.0]]]\nbond_stiffness = 1e9\n"),
+                "name = \"shotcrete\"\ncenter", "liner[0].name", "name 'shotcrete' is already used by bolt[0]");
 }
 
 TEST_CASE("analysis tables may come before the tables they name") {

@@ -218,3 +218,221 @@ supports = ["bolt"]
     while (again.steps() < s.steps()) again.step();
     CHECK(again.state_hash() == s.state_hash());
 }
+
+namespace {
+
+// A circular opening of radius a = 1 m in elastic ground (E 5 GPa, ν 0.25) under an
+// isotropic 10 MPa, a quarter model (symmetry on x = 0 and y = 0, rollers at 10 m);
+// the opening is a block excavated with its support relaxed over 2,000 steps.
+std::string lined_opening(bool lined, double thrust_capacity = 0.0) {
+    std::string text = R"(
+[solver]
+mode = "quasi_static"
+
+[[material]]
+name = "rock"
+young = 5.0e9
+poisson = 0.25
+
+[[region]]
+name = "ground"
+outline = { type = "path", start = [1.0, 0.0], steps = [
+  { to = [10.0, 0.0] }, { to = [10.0, 10.0] }, { to = [0.0, 10.0] }, { to = [0.0, 1.0] },
+  { to = [1.0, 0.0], center = [0.0, 0.0], clockwise = true } ] }
+minus = ["opening"]
+pattern = { type = "single" }
+mesh = { size = 0.08, size_far = 1.5, grading = 0.3, toward = ["opening"] }
+
+[[region]]
+name = "opening"
+outline = { type = "path", start = [0.0, 0.0], steps = [
+  { to = [1.0, 0.0] }, { to = [0.0, 1.0], center = [0.0, 0.0] }, { to = [0.0, 0.0] } ] }
+pattern = { type = "single" }
+
+[[joint_property]]
+name = "glue"
+law = "elastic"
+kn = 1e12
+ks = 1e12
+
+[[joint_assignment]]
+property = "glue"
+
+[[boundary]]
+name = "x0"
+type = "velocity"
+box = { min = [-0.01, -0.01], max = [0.01, 10.01] }
+touching = true
+vx = 0.0
+omega = 0.0
+
+[[boundary]]
+name = "y0"
+type = "velocity"
+box = { min = [-0.01, -0.01], max = [10.01, 0.01] }
+touching = true
+vy = 0.0
+omega = 0.0
+
+[[boundary]]
+name = "right"
+type = "velocity"
+box = { min = [9.99, -0.01], max = [10.01, 10.01] }
+vx = 0.0
+
+[[boundary]]
+name = "top"
+type = "velocity"
+box = { min = [-0.01, 9.99], max = [10.01, 10.01] }
+vy = 0.0
+
+[[liner]]
+name = "shotcrete"
+center = [0.0, 0.0]
+radius = 1.0
+from = 0.0
+to = 90.0
+segment_length = 0.05
+young = 30e9
+poisson = 0.2
+thickness = 0.2
+normal_stiffness = 1e12
+symmetric_ends = true
+
+[[stage]]
+type = "initialize"
+sxx = -10e6
+syy = -10e6
+
+[[stage]]
+type = "excavate"
+regions = ["opening"]
+relax_steps = 2000
+steps = 0
+)";
+    if (thrust_capacity > 0.0) {
+        const auto at = text.find("symmetric_ends = true");
+        text.insert(at, "thrust_capacity = " + std::to_string(thrust_capacity) + "\n");
+        const auto relax = text.find("relax_steps = 2000");
+        text.replace(relax, 18, "relax_steps = 20000");
+    }
+    if (lined) text += "\n[[stage]]\ntype = \"install\"\nsupports = [\"shotcrete\"]\n";
+    text += "\n[[stage]]\ntype = \"cycle\"\nsteps = " + std::string(thrust_capacity > 0.0 ? "20000" : "2000") +
+            "\n\n[[stage]]\ntype = \"solve\"\nratio = 1e-7\nmax_steps = 100000\n";
+    return text;
+}
+
+struct Quiet : StageObserver {};
+
+/// Mean inward displacement of the ground's nodes on the wall (r = 1).
+double wall_convergence(const Solver& s) {
+    const auto& n = s.nodes();
+    double sum = 0.0;
+    int count = 0;
+    for (int i = 0; i < n.count(); ++i)
+        if (std::abs(norm(n.position0[i]) - 1.0) < 1e-6) {
+            sum -= dot(n.position[i] - n.position0[i], n.position0[i]);
+            ++count;
+        }
+    REQUIRE(count > 10);
+    return sum / count;
+}
+
+} // namespace
+
+TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and support characteristic meet") {
+    // The convergence–confinement method. Ground: its reaction curve p(u) is linear,
+    // p = p0 − k_g u, with k_g measured on the unlined model and checked against the
+    // closed form of a hole of radius a in ground held at b (plane strain):
+    //   u = A a + B/a, A = −B/b², 2(λ + μ)A − 2μ B/a² = p0.
+    // Support: a thin ring, p = K_ring u, K_ring = E' t / a² (E' = E/(1 − ν²)), in
+    // series with the interface springs k_n. They meet at p = K p0 / (K + k_g), and
+    // the ring's thrust is T = p a.
+    const double p0 = 10e6, a = 1.0, b = 10.0, E = 5e9, nu = 0.25;
+    const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+    const double B = p0 / (-2.0 * (lambda + mu) / (b * b) - 2.0 * mu / (a * a)), A = -B / (b * b);
+    const double u_closed = -(A * a + B / a);
+    auto run = [&](bool lined, double capacity = 0.0) {
+        const auto m = build(lined_opening(lined, capacity));
+        auto s = std::make_unique<Solver>(m.blocks, m.file.analysis);
+        Quiet quiet;
+        const auto reports = run_stages(*s, m.file.analysis.stages, quiet);
+        CHECK(reports.back().converged);
+        return s;
+    };
+    const auto unlined = run(false);
+    const double u0 = wall_convergence(*unlined);
+    MESSAGE("unlined wall convergence " << u0 * 1e3 << " mm, closed form (round boundary at 10 m) " << u_closed * 1e3
+                                        << " mm");
+    CHECK(u0 == doctest::Approx(u_closed).epsilon(0.02));
+    const double k_ground = p0 / u0;
+
+    const auto lined = run(true);
+    const auto& L = lined->liners();
+    const double e_liner = 30e9 / (1 - 0.04), t = 0.2;
+    const double k_ring = e_liner * t / (a * a), k = 1.0 / (1.0 / k_ring + 1.0 / 1e12);
+    const double p_expected = k * p0 / (k + k_ground);
+    double p_mean = 0.0, thrust = 0.0;
+    for (int i = 0; i < L.node_count(); ++i) p_mean -= L.normal_stress[i] / L.node_count();
+    for (int e = 0; e < L.element_count(); ++e) thrust += L.thrust[e] / L.element_count();
+    const double u1 = wall_convergence(*lined);
+    MESSAGE("lined: support pressure " << p_mean / 1e6 << " MPa (GRC-SCC " << p_expected / 1e6 << " MPa), thrust "
+                                       << thrust / 1e3 << " kN/m (p a = " << p_mean * a / 1e3 << "), convergence "
+                                       << u1 * 1e3 << " mm (" << (p0 - p_expected) / k_ground * 1e3 << ")");
+    CHECK(p_mean == doctest::Approx(p_expected).epsilon(0.01));
+    CHECK(thrust == doctest::Approx(p_mean * a).epsilon(0.01));
+    CHECK(u1 == doctest::Approx((p0 - p_expected) / k_ground).epsilon(0.01));
+    // No bending under an isotropic load.
+    const auto summary = lined->liner_summary();
+    REQUIRE(summary.size() == 1);
+    CHECK(summary[0].max_moment < 0.001 * thrust * t);
+    CHECK(summary[0].open == 0);
+    CHECK(summary[0].yielded == 0);
+
+    // A lining that yields at half that thrust (3 MN/m): it carries its capacity,
+    // p = T_y / a, and the ground converges to its reaction curve at that pressure.
+    // The support's relaxation is 10 times slower here: the explicit quasi-static
+    // loading overshoots a perfectly plastic ring, which then unloads below its
+    // capacity (2,000 relaxation steps: 2,459 kN/m, 18% below; 20,000: 0.7%).
+    const auto yielding = run(true, 3e6);
+    const auto& Y = yielding->liners();
+    double p_yield = 0.0, thrust_yield = 0.0;
+    for (int i = 0; i < Y.node_count(); ++i) p_yield -= Y.normal_stress[i] / Y.node_count();
+    for (int e = 0; e < Y.element_count(); ++e) thrust_yield += Y.thrust[e] / Y.element_count();
+    const double u_yield = wall_convergence(*yielding);
+    MESSAGE("yielding liner: thrust " << thrust_yield / 1e3 << " kN/m (capacity 3000), pressure " << p_yield / 1e6
+                                      << " MPa, convergence " << u_yield * 1e3 << " mm ("
+                                      << (p0 - 3e6 / a) / k_ground * 1e3 << ")");
+    CHECK(thrust_yield == doctest::Approx(3e6).epsilon(0.01));
+    CHECK(p_yield == doctest::Approx(3e6 / a).epsilon(0.01));
+    CHECK(u_yield == doctest::Approx((p0 - 3e6 / a) / k_ground).epsilon(0.01));
+    CHECK(yielding->liner_summary()[0].yielded == Y.element_count());
+}
+
+TEST_CASE("a lined opening resumes exactly from a checkpoint, and runs to the same bits on 2 threads") {
+    const auto m = build(lined_opening(true));
+    const std::vector<StageSpec> before(m.file.analysis.stages.begin(), m.file.analysis.stages.begin() + 3);
+    REQUIRE(before.back().kind == StageSpec::Kind::install);
+    auto solver = [&](int threads) {
+        AnalysisSpec an = m.file.analysis;
+        an.solver.threads = threads;
+        auto s = std::make_unique<Solver>(m.blocks, an);
+        Quiet quiet;
+        run_stages(*s, before, quiet);
+        return s;
+    };
+    auto one = solver(1);
+    REQUIRE(one->liners().node_count() > 0);
+    for (int k = 0; k < 500; ++k) one->step();
+    std::ostringstream saved;
+    one->save_state(saved);
+    for (int k = 0; k < 1000; ++k) one->step();
+    auto resumed = solver(1);
+    std::istringstream in(saved.str());
+    resumed->load_state(in);
+    while (resumed->steps() < one->steps()) resumed->step();
+    CHECK(resumed->state_hash() == one->state_hash());
+    auto two = solver(2);
+    while (two->steps() < one->steps()) two->step();
+    CHECK(two->state_hash() == one->state_hash());
+}
