@@ -101,7 +101,7 @@ void Solver::visit_state(Self& s, Visit&& v) {
     v(s.z_.stress), v(s.z_.strain);
     v(s.c_.vertex_block), v(s.c_.vertex_id), v(s.c_.edge_block), v(s.c_.edge_id), v(s.c_.edge_end);
     v(s.c_.length), v(s.c_.property), v(s.c_.history);
-    v(s.relax_block_force_), v(s.relax_block_moment_), v(s.relax_node_force_), v(s.relax_total_), v(s.relax_left_);
+    v(s.relax_block_force_), v(s.relax_block_moment_), v(s.relax_node_force_), v(s.relax_total_), v(s.relax_left_), v(s.relax_keep_);
     v(s.dt_), v(s.time_), v(s.ratio_), v(s.work_), v(s.steps_);
     v(s.boundary_force_);
     v(s.detected_at_), v(s.detected_theta_), v(s.detected_vertex_), v(s.active_);

@@ -125,6 +125,7 @@ struct StageSpec {
     long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps)
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
+    double keep = 0.0;                 ///< excavate: fraction of the support kept for good (a support pressure)
     std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
 };
 

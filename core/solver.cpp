@@ -528,22 +528,23 @@ void Solver::initialize_stress(const StressFieldSpec& field) {
     }
 }
 
-void Solver::excavate(const std::vector<std::string>& regions, long relax_steps) {
+void Solver::excavate(const std::vector<std::string>& regions, long relax_steps, double keep) {
     for (int i = 0; i < b_.count(); ++i)
         if (selected(regions, region_names_[b_.region[i]]) && !regions.empty()) b_.removed[i] = 1;
     refresh_normals();
     // Forces the removed blocks exert on the others become relaxing loads, summed
     // per block and node in contact order.
-    relax_block_force_.assign(relax_steps > 0 ? b_.count() : 0, {});
-    relax_block_moment_.assign(relax_steps > 0 ? b_.count() : 0, 0.0);
-    relax_node_force_.assign(relax_steps > 0 ? n_.count() : 0, {});
+    const bool relaxing = relax_steps > 0 || keep > 0.0;
+    relax_block_force_.assign(relaxing ? b_.count() : 0, {});
+    relax_block_moment_.assign(relaxing ? b_.count() : 0, 0.0);
+    relax_node_force_.assign(relaxing ? n_.count() : 0, {});
     std::vector<std::uint8_t> drop(c_.size(), 0);
     for (int i = 0; i < c_.size(); ++i) {
         const int A = c_.vertex_block[i], B = c_.edge_block[i];
         if (!b_.removed[A] && !b_.removed[B]) continue;
         drop[i] = 1;
         if (b_.removed[A] && b_.removed[B]) continue;
-        if (relax_steps <= 0) continue;
+        if (!relaxing) continue;
         const Vec2 x = b_.vertex[c_.vertex_id[i]];
         const Vec2 f = contact::contact_force(c_, i);
         const int kept = b_.removed[A] ? B : A;
@@ -568,6 +569,7 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps)
     for (int k = 0; k < n_.count(); ++k)
         if (b_.removed[n_.block[k]]) n_.velocity[k] = {};
     relax_total_ = relax_left_ = relax_steps;
+    relax_keep_ = keep;
     update_timestep();
 }
 
@@ -601,7 +603,11 @@ void Solver::compute_forces() {
     if (z_.size() > 0) fem::zone_pass(z_, n_.position.data(), n_.velocity.data(), dt_, b_.removed.data());
 #pragma omp barrier
     const Vec2 g = settings_.gravity;
-    const double relax = relax_left_ > 0 ? double(relax_left_) / double(relax_total_ + 1) : 0.0;
+    // The support of the excavated rock: relaxed linearly to the fraction kept (a
+    // fictitious support pressure, the convergence–confinement method's 1 − λ).
+    const double relax = relax_left_ > 0 ? relax_keep_ + (1.0 - relax_keep_) * double(relax_left_) / double(relax_total_ + 1)
+                         : relax_block_force_.empty() && relax_node_force_.empty() ? 0.0
+                                                                                    : relax_keep_;
     const int nb = b_.count(), nn = n_.count();
 #pragma omp for schedule(static) nowait
     for (int i = 0; i < nb; ++i) {
@@ -634,7 +640,7 @@ void Solver::compute_forces() {
 }
 
 void Solver::release_relaxation() {
-    if (relax_left_ > 0 && --relax_left_ == 0) {
+    if (relax_left_ > 0 && --relax_left_ == 0 && relax_keep_ == 0.0) {
         relax_block_force_.clear();
         relax_block_moment_.clear();
         relax_node_force_.clear();

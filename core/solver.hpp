@@ -66,8 +66,9 @@ public:
     /// Joint stresses from a stress field, with the matching elastic displacements.
     void initialize_stress(const StressFieldSpec& field);
     /// Removes the blocks of these regions; the forces they exerted on the rest are
-    /// relaxed linearly to zero over relax_steps steps.
-    void excavate(const std::vector<std::string>& regions, long relax_steps);
+    /// relaxed linearly over relax_steps steps to the fraction `keep` of them, which
+    /// stays (a support pressure: the convergence–confinement method's 1 − λ).
+    void excavate(const std::vector<std::string>& regions, long relax_steps, double keep = 0.0);
     void step();
     /// Installs the named [[bolt]] sets (core/bolts.hpp): nodes along each bolt,
     /// each tied to the rock it lies in now, unstressed. Throws InputError (key
@@ -294,6 +295,7 @@ private:
     std::vector<Vec2> relax_block_force_, relax_node_force_;
     std::vector<double> relax_block_moment_;
     long relax_total_ = 0, relax_left_ = 0;
+    double relax_keep_ = 0.0; ///< fraction of the excavated rock's support kept for good
     double first_dt_ = 0.0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
     // Detection: tolerance, property of new contacts, motion since the last pass.

@@ -436,3 +436,24 @@ TEST_CASE("a lined opening resumes exactly from a checkpoint, and runs to the sa
     while (two->steps() < one->steps()) two->step();
     CHECK(two->state_hash() == one->state_hash());
 }
+
+TEST_CASE("a support pressure: keeping a fraction of the excavated rock's support scales the elastic convergence") {
+    // Linear elastic ground: keeping 40% of the in-situ support on the wall (the
+    // convergence–confinement method's fictitious pressure (1 − λ) p0 with λ = 0.6)
+    // leaves 60% of the free convergence, for good (the support does not relax on).
+    const auto free = build(lined_opening(false));
+    std::string text = lined_opening(false);
+    text.insert(text.find("steps = 0\n"), "keep = 0.4\n");
+    const auto held = build(text);
+    auto run = [](const Built& m) {
+        auto s = std::make_unique<Solver>(m.blocks, m.file.analysis);
+        Quiet quiet;
+        const auto reports = run_stages(*s, m.file.analysis.stages, quiet);
+        CHECK(reports.back().converged);
+        return s;
+    };
+    const auto a = run(free), b = run(held);
+    const double u_free = wall_convergence(*a), u_held = wall_convergence(*b);
+    MESSAGE("free convergence " << u_free * 1e3 << " mm, with 40% of the support kept " << u_held * 1e3 << " mm");
+    CHECK(u_held == doctest::Approx(0.6 * u_free).epsilon(2e-3));
+}
