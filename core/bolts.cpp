@@ -70,6 +70,21 @@ BoltHost Solver::find_host(Vec2 p, double reach) const {
     return best;
 }
 
+void Solver::tie_reaction(const BoltHost& h, Vec2 x, Vec2 f, Vec2& reaction, double& moment) const {
+    reaction = -f;
+    moment = h.zone < 0 ? -cross(x - b_.centroid[h.block], f) : 0.0;
+}
+
+void Solver::add_tie_stiffness(const BoltHost& h, double stiffness, std::vector<double>& k, std::vector<double>& kr,
+                               std::vector<double>& kn) const {
+    if (h.zone < 0) {
+        k[h.block] += stiffness;
+        kr[h.block] += stiffness * norm2(host_position(h) - b_.centroid[h.block]);
+    } else {
+        for (int j = 0; j < 3; ++j) kn[z_.node[h.zone][j]] += std::abs(h.weight[j]) * stiffness;
+    }
+}
+
 Vec2 Solver::host_position(const BoltHost& h) const {
     if (h.zone < 0) return b_.centroid[h.block] + rotation(b_.theta[h.block])(h.local);
     const auto& t = z_.node[h.zone];
@@ -200,9 +215,7 @@ void Solver::bolt_pass() {
         if (set.cable && axial < 0.0) {
             axial = 0.0;
         } else if (set.yield_force > 0.0 && std::abs(axial) > set.yield_force) {
-            const double sign = axial > 0.0 ? 1.0 : -1.0;
-            B.plastic[s] = strain - sign * set.yield_force / set.ea;
-            axial = sign * set.yield_force;
+            axial = support::plastic_return(axial, set.yield_force, set.ea, strain, B.plastic[s]);
             B.state[s] = BoltState::yielded;
         }
         B.axial[s] = axial;
@@ -226,16 +239,12 @@ void Solver::bolt_pass() {
             const Vec2 t = axis / norm(axis);
             const double s = dot(d, t);
             double q = set.bond_stiffness * (s - B.slip[k]);
-            if (!B.tied[k] && set.bond_strength > 0.0 && std::abs(q) > set.bond_strength) {
-                const double sign = q > 0.0 ? 1.0 : -1.0;
-                B.slip[k] = s - sign * set.bond_strength / set.bond_stiffness;
-                q = sign * set.bond_strength;
-            }
+            if (!B.tied[k] && set.bond_strength > 0.0)
+                q = support::plastic_return(q, set.bond_strength, set.bond_stiffness, s, B.slip[k]);
             B.bond[k] = q;
             const Vec2 f = B.length[k] * (q * t + set.normal_stiffness * (d - s * t));
             B.force[k] += f;
-            B.reaction[k] = -f;
-            B.reaction_moment[k] = h.zone < 0 ? -cross(x - b_.centroid[h.block], f) : 0.0;
+            tie_reaction(h, x, f, B.reaction[k], B.reaction_moment[k]);
         }
     }
 }
@@ -244,15 +253,14 @@ double Solver::integrate_bolts(double& work) {
     auto& B = bolts_;
     const double alpha = settings_.damping, dt = dt_;
     const Vec2 g = settings_.gravity;
-    auto damped = [alpha](double f, double v) { return f - alpha * std::abs(f) * double((v > 0.0) - (v < 0.0)); };
     double unbalanced = 0.0;
     for (int k = 0; k < B.node_count(); ++k) {
         const Vec2 weight = (B.sets[B.node_set[k]].line_mass * B.length[k]) * g;
         const Vec2 f = B.force[k] + weight + B.applied[k];
         unbalanced = std::max({unbalanced, std::abs(f.x), std::abs(f.y)});
         Vec2& v = B.velocity[k];
-        v.x += damped(f.x, v.x) / B.mass[k] * dt;
-        v.y += damped(f.y, v.y) / B.mass[k] * dt;
+        v.x += support::damped(f.x, v.x, alpha) / B.mass[k] * dt;
+        v.y += support::damped(f.y, v.y, alpha) / B.mass[k] * dt;
         B.position[k] += dt * v;
         work += dot(weight + B.applied[k], v) * dt;
     }
@@ -276,12 +284,7 @@ void Solver::add_bolt_stiffness(std::vector<double>& k, std::vector<double>& kr,
         if (h.block < 0 || b_.removed[h.block]) continue;
         const double kg = B.length[i] * std::max(set.bond_stiffness, set.normal_stiffness);
         own[i] += kg;
-        if (h.zone < 0) {
-            k[h.block] += kg;
-            kr[h.block] += kg * norm2(host_position(h) - b_.centroid[h.block]);
-        } else {
-            for (int j = 0; j < 3; ++j) kn[z_.node[h.zone][j]] += std::abs(h.weight[j]) * kg;
-        }
+        add_tie_stiffness(h, kg, k, kr, kn);
     }
     for (int i = 0; i < B.node_count(); ++i) {
         const double real = B.sets[B.node_set[i]].line_mass * B.length[i];

@@ -31,6 +31,7 @@
 #include "base/vec2.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -68,6 +69,22 @@ struct BoltSetSpec {
     bool face_plate = false;       ///< head tied to its rock without slip
     bool end_anchor = false;       ///< toe tied to its rock without slip
 };
+
+namespace support {
+/// Perfectly plastic return shared by the support laws: the trial value within
+/// ±limit, else clamped there and `plastic` moved so that stiffness ×
+/// (total − plastic) gives the clamped value.
+inline double plastic_return(double trial, double limit, double stiffness, double total, double& plastic) {
+    if (!(std::abs(trial) > limit)) return trial;
+    const double clamped = trial > 0.0 ? limit : -limit;
+    plastic = total - clamped / stiffness;
+    return clamped;
+}
+/// Local non-viscous damping (Cundall), as the blocks get it: f reduced by α|f| against v.
+inline double damped(double f, double v, double alpha) {
+    return f - alpha * std::abs(f) * double((v > 0.0) - (v < 0.0));
+}
+} // namespace support
 
 /// The bolts of a set as (head, toe) pairs, the ring expanded.
 std::vector<std::array<Vec2, 2>> expand_bolts(const BoltSetSpec& spec);

@@ -100,12 +100,8 @@ void Solver::liner_pass() {
         const double ta = L.theta[a] - beta, tb = L.theta[b] - beta;
         const double strain = (l - l0) / l0;
         double tension = set.ea * (strain - L.plastic_strain[e]);
-        if (set.thrust_capacity > 0.0 && -tension > set.thrust_capacity) {
-            tension = -set.thrust_capacity;
-            L.plastic_strain[e] = strain - tension / set.ea;
-            L.yielded[e] |= 1;
-        } else if (set.thrust_capacity > 0.0 && tension > set.tension_capacity) {
-            tension = set.tension_capacity;
+        if (set.thrust_capacity > 0.0 && (-tension > set.thrust_capacity || tension > set.tension_capacity)) {
+            tension = std::clamp(tension, -set.thrust_capacity, set.tension_capacity);
             L.plastic_strain[e] = strain - tension / set.ea;
             L.yielded[e] |= 1;
         }
@@ -151,18 +147,12 @@ void Solver::liner_pass() {
             double sn = set.kn * dn;
             if (!L.separated[k] && sn > set.tensile) L.separated[k] = 1;
             if (L.separated[k]) sn = std::min(sn, 0.0);
-            double tau = set.ks * (ds - L.shear_slip[k]);
             const double limit = (L.separated[k] ? 0.0 : set.cohesion) + set.tan_friction * std::max(-sn, 0.0);
-            if (std::abs(tau) > limit) {
-                const double sign = tau > 0.0 ? 1.0 : -1.0;
-                L.shear_slip[k] = ds - sign * limit / set.ks;
-                tau = sign * limit;
-            }
+            const double tau = support::plastic_return(set.ks * (ds - L.shear_slip[k]), limit, set.ks, ds, L.shear_slip[k]);
             L.normal_stress[k] = sn;
             const Vec2 f = L.length[k] * (sn * n + tau * t);
             L.force[k] += f;
-            L.reaction[k] = -f;
-            L.reaction_moment[k] = h.zone < 0 ? -cross(x - b_.centroid[h.block], f) : 0.0;
+            tie_reaction(h, x, f, L.reaction[k], L.reaction_moment[k]);
         }
     }
 }
@@ -171,7 +161,6 @@ double Solver::integrate_liners(double& work) {
     auto& L = liners_;
     const double alpha = settings_.damping, dt = dt_;
     const Vec2 g = settings_.gravity;
-    auto damped = [alpha](double f, double v) { return f - alpha * std::abs(f) * double((v > 0.0) - (v < 0.0)); };
     double unbalanced = 0.0;
     for (int k = 0; k < L.node_count(); ++k) {
         const Vec2 weight = (L.sets[L.node_set[k]].line_mass * L.length[k]) * g;
@@ -180,14 +169,14 @@ double Solver::integrate_liners(double& work) {
         if (held != Vec2{}) f -= dot(f, held) * held; // the symmetry plane's reaction
         unbalanced = std::max({unbalanced, std::abs(f.x), std::abs(f.y)});
         Vec2& v = L.velocity[k];
-        v.x += damped(f.x, v.x) / L.mass[k] * dt;
-        v.y += damped(f.y, v.y) / L.mass[k] * dt;
+        v.x += support::damped(f.x, v.x, alpha) / L.mass[k] * dt;
+        v.y += support::damped(f.y, v.y, alpha) / L.mass[k] * dt;
         if (held != Vec2{}) {
             v -= dot(v, held) * held;
             L.omega[k] = 0.0;
         } else {
             unbalanced = std::max(unbalanced, std::abs(L.moment[k]) / std::max(L.length[k], 1e-12));
-            L.omega[k] += damped(L.moment[k], L.omega[k]) / L.inertia[k] * dt;
+            L.omega[k] += support::damped(L.moment[k], L.omega[k], alpha) / L.inertia[k] * dt;
         }
         L.position[k] += dt * v;
         L.theta[k] += dt * L.omega[k];
@@ -222,12 +211,7 @@ void Solver::add_liner_stiffness(std::vector<double>& k, std::vector<double>& kr
         if (h.block >= 0 && !b_.removed[h.block]) {
             const double kg = L.length[i] * std::max(set.kn, set.ks);
             own[i] += kg;
-            if (h.zone < 0) {
-                k[h.block] += kg;
-                kr[h.block] += kg * norm2(host_position(h) - b_.centroid[h.block]);
-            } else {
-                for (int j = 0; j < 3; ++j) kn[z_.node[h.zone][j]] += std::abs(h.weight[j]) * kg;
-            }
+            add_tie_stiffness(h, kg, k, kr, kn);
         }
         const double real = set.line_mass * L.length[i], real_inertia = set.line_inertia * L.length[i];
         L.mass[i] = mass_factor > 0.0 ? std::max(own[i] * mass_factor, 1e-300) : real;

@@ -247,6 +247,11 @@ private:
                              double mass_factor);
     double liner_time_limit() const;
     Vec2 host_position(const BoltHost& h) const;
+    /// A tie's force f on its support node at rock point x: the opposite on the rock.
+    void tie_reaction(const BoltHost& h, Vec2 x, Vec2 f, Vec2& reaction, double& moment) const;
+    /// A tie's stiffness added to its rock's (block translation and rotation, or zone nodes).
+    void add_tie_stiffness(const BoltHost& h, double stiffness, std::vector<double>& block,
+                           std::vector<double>& rotation, std::vector<double>& node) const;
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
 

@@ -21,6 +21,7 @@
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
+#include <vtkSmartPointer.h>
 #include <vtkPoints.h>
 #include <vtkStringArray.h>
 #include <vtkUnsignedCharArray.h>
@@ -498,41 +499,56 @@ void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
     write_grid(grid, file);
 }
 
-void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
-    const auto& B = s.bolts();
-    const auto nodes = static_cast<vtkIdType>(B.node_count()), n = static_cast<vtkIdType>(B.segment_count());
+namespace {
+/// A grid of line cells between structure nodes (bolts, liners): points at the
+/// nodes (z = 0), cell i from ends(i).first to ends(i).second.
+template <class Ends>
+vtkSmartPointer<vtkUnstructuredGrid> line_grid(const std::vector<Vec2>& nodes, vtkIdType n, Ends&& ends) {
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(nodes);
-    auto bond = double_array("bond_kN_per_m", nodes), slip = double_array("slip", nodes);
-    for (vtkIdType k = 0; k < nodes; ++k) {
-        points->SetPoint(k, B.position[k].x, B.position[k].y, 0.0);
-        bond->SetValue(k, B.bond[k] * B.sets[B.node_set[k]].spacing / 1e3);
-        slip->SetValue(k, B.slip[k]);
-    }
+    points->SetNumberOfPoints(static_cast<vtkIdType>(nodes.size()));
+    for (std::size_t k = 0; k < nodes.size(); ++k) points->SetPoint(vtkIdType(k), nodes[k].x, nodes[k].y, 0.0);
     vtkNew<vtkIdTypeArray> offsets, connectivity;
     offsets->SetNumberOfValues(n + 1);
     connectivity->SetNumberOfValues(2 * n);
+    for (vtkIdType i = 0; i < n; ++i) {
+        const auto [a, b] = ends(i);
+        offsets->SetValue(i, 2 * i);
+        connectivity->SetValue(2 * i, a);
+        connectivity->SetValue(2 * i + 1, b);
+    }
+    offsets->SetValue(n, 2 * n);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+    auto grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
+    grid->SetPoints(points);
+    grid->SetCells(VTK_LINE, cells);
+    return grid;
+}
+} // namespace
+
+void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
+    const auto& B = s.bolts();
+    const auto nodes = static_cast<vtkIdType>(B.node_count()), n = static_cast<vtkIdType>(B.segment_count());
+    auto grid = line_grid(B.position, n, [&](vtkIdType i) {
+        return std::pair<vtkIdType, vtkIdType>{B.segment_node[i], B.segment_node[i] + 1};
+    });
+    auto bond = double_array("bond_kN_per_m", nodes), slip = double_array("slip", nodes);
+    for (vtkIdType k = 0; k < nodes; ++k) {
+        bond->SetValue(k, B.bond[k] * B.sets[B.node_set[k]].spacing / 1e3);
+        slip->SetValue(k, B.slip[k]);
+    }
     auto axial = double_array("axial_force_kN", n);
     auto state = int_array("state", n), set = int_array("set", n), bolt = int_array("bolt", n);
     int b = 0;
     for (vtkIdType i = 0; i < n; ++i) {
         const int a = B.segment_node[i];
         while (a >= B.first[b + 1]) ++b;
-        offsets->SetValue(i, 2 * i);
-        connectivity->SetValue(2 * i, a);
-        connectivity->SetValue(2 * i + 1, a + 1);
         axial->SetValue(i, B.axial[i] * B.sets[B.node_set[a]].spacing / 1e3);
         state->SetValue(i, B.state[i]);
         set->SetValue(i, B.node_set[a]);
         bolt->SetValue(i, b);
     }
-    offsets->SetValue(n, 2 * n);
-    vtkNew<vtkCellArray> cells;
-    cells->SetData(offsets, connectivity);
-    vtkNew<vtkUnstructuredGrid> grid;
-    grid->SetPoints(points);
-    grid->SetCells(VTK_LINE, cells);
     add_cell_arrays(grid, axial, state, set, bolt);
     grid->GetPointData()->AddArray(bond);
     grid->GetPointData()->AddArray(slip);
@@ -545,40 +561,30 @@ void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
 void write_state_liners_vtu(const Solver& s, const fs::path& file) {
     const auto& L = s.liners();
     const auto nodes = static_cast<vtkIdType>(L.node_count()), n = static_cast<vtkIdType>(L.element_count());
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(nodes);
+    // Element e's liner, and so its second node (a closed ring's last element wraps).
+    std::vector<int> liner_of(n);
+    for (int e = 0, l = 0; e < n; ++e) {
+        while (L.element_node[e] >= L.first[l + 1]) ++l;
+        liner_of[e] = l;
+    }
+    auto grid = line_grid(L.position, n, [&](vtkIdType e) {
+        const int a = L.element_node[e], l = liner_of[e];
+        return std::pair<vtkIdType, vtkIdType>{a, a + 1 < L.first[l + 1] ? a + 1 : L.first[l]};
+    });
     auto normal = double_array("interface_normal_MPa", nodes);
     auto open = int_array("interface_open", nodes);
     for (vtkIdType k = 0; k < nodes; ++k) {
-        points->SetPoint(k, L.position[k].x, L.position[k].y, 0.0);
         normal->SetValue(k, L.normal_stress[k] / 1e6);
         open->SetValue(k, L.separated[k] && L.normal_stress[k] == 0.0);
     }
-    vtkNew<vtkIdTypeArray> offsets, connectivity;
-    offsets->SetNumberOfValues(n + 1);
-    connectivity->SetNumberOfValues(2 * n);
     auto thrust = double_array("thrust_kN_per_m", n), moment = double_array("moment_kNm_per_m", n);
     auto liner = int_array("liner", n), yielded = int_array("yielded", n);
-    int l = 0;
     for (vtkIdType e = 0; e < n; ++e) {
-        const int a = L.element_node[e];
-        while (a >= L.first[l + 1]) ++l;
-        const int b = a + 1 < L.first[l + 1] ? a + 1 : L.first[l];
-        offsets->SetValue(e, 2 * e);
-        connectivity->SetValue(2 * e, a);
-        connectivity->SetValue(2 * e + 1, b);
         thrust->SetValue(e, L.thrust[e] / 1e3);
         moment->SetValue(e, (std::abs(L.moment_a[e]) >= std::abs(L.moment_b[e]) ? L.moment_a[e] : -L.moment_b[e]) / 1e3);
-        liner->SetValue(e, l);
+        liner->SetValue(e, liner_of[e]);
         yielded->SetValue(e, L.yielded[e]);
     }
-    offsets->SetValue(n, 2 * n);
-    vtkNew<vtkCellArray> cells;
-    cells->SetData(offsets, connectivity);
-    vtkNew<vtkUnstructuredGrid> grid;
-    grid->SetPoints(points);
-    grid->SetCells(VTK_LINE, cells);
     add_cell_arrays(grid, thrust, moment, liner, yielded);
     grid->GetPointData()->AddArray(normal);
     grid->GetPointData()->AddArray(open);

@@ -228,9 +228,15 @@ int run_sweep(const SweepOptions& o) {
                 std::string others;
                 for (std::size_t q = 1; q < r.set.size(); ++q)
                     others += (others.empty() ? "" : ", ") + r.set[q].first + " = " + r.set[q].second;
-                auto& ser = by_seed[{others, r.seed_offset}];
-                ser.label = others.empty() ? "seed offset " + std::to_string(r.seed_offset)
-                                           : others + (o.seeds > 1 ? ", seed offset " + std::to_string(r.seed_offset) : "");
+                // Several seeds: each run a point (one series per value of the other
+                // keys) beside the mean's line; one seed: a line per value.
+                auto& ser = by_seed[{others, o.seeds > 1 ? 0L : r.seed_offset}];
+                if (o.seeds > 1) {
+                    ser.label = others.empty() ? "each seed" : others + ", each seed";
+                    ser.style = io::Series::Style::points;
+                } else {
+                    ser.label = others.empty() ? "seed offset " + std::to_string(r.seed_offset) : others;
+                }
                 ser.x.push_back(x), ser.y.push_back(y);
                 auto& m = mean[others][x];
                 m.first += y, ++m.second;
