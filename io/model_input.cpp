@@ -372,8 +372,6 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 
 // --- the analysis tables -----------------------------------------------------------
 
-constexpr std::string_view pascals = " Pa";
-constexpr std::string_view pascals_per_metre = " Pa/m";
 
 // In the order of the enums of core/model_spec.hpp and meshing::JointTag.
 constexpr std::array<std::string_view, 2> solver_modes{"quasi_static", "dynamic"};
@@ -382,15 +380,8 @@ constexpr std::array<std::string_view, 3> laws{"elastic", "coulomb", "softening"
 constexpr std::array<std::string_view, 5> joint_tags{"inner", "radial", "peripheral", "real_joint",
                                                      "interface"};
 constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
-constexpr std::array<std::string_view, 14> quantities{"unbalanced_ratio",  "displacement_x",
-                                                      "displacement_y",    "velocity_x",
-                                                      "velocity_y",        "rotation",
-                                                      "boundary_force_x",  "boundary_force_y",
-                                                      "cracks_tensile",    "cracks_shear",
-                                                      "kinetic_energy",    "strain_energy",
-                                                      "dissipated_energy", "work"};
-constexpr std::array<std::string_view, 6> stage_types{"initialize", "solve", "excavate", "cycle",
-                                                      "elastic",    "install"};
+
+
 
 SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
                        const Names& properties) {
@@ -579,21 +570,6 @@ JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Pa
     return a;
 }
 
-constexpr std::array<std::string_view, 7> stress_keys{"sxx",     "syy",     "sxy",    "y_ref",
-                                                      "dsxx_dy", "dsyy_dy", "dsxy_dy"};
-
-StressFieldSpec read_stress(const Ctx& c, const toml::table& t, const Path& p) {
-    StressFieldSpec s;
-    s.sxx = number(c, t, p, "sxx", unbounded(pascals)).value_or(0.0);
-    s.syy = number(c, t, p, "syy", unbounded(pascals)).value_or(0.0);
-    s.sxy = number(c, t, p, "sxy", unbounded(pascals)).value_or(0.0);
-    s.y_ref = number(c, t, p, "y_ref", unbounded(metres)).value_or(0.0);
-    s.dsxx_dy = number(c, t, p, "dsxx_dy", unbounded(pascals_per_metre)).value_or(0.0);
-    s.dsyy_dy = number(c, t, p, "dsyy_dy", unbounded(pascals_per_metre)).value_or(0.0);
-    s.dsxy_dy = number(c, t, p, "dsxy_dy", unbounded(pascals_per_metre)).value_or(0.0);
-    return s;
-}
-
 Box2 read_box(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "a box { min = [x, y], max = [x, y] }");
     static constexpr std::array<std::string_view, 2> keys{"min", "max"};
@@ -639,116 +615,6 @@ BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& n
                c.in_owner() + "a velocity boundary needs at least one of vx, vy, omega "
                               "(the components it prescribes; 0 fixes one)");
     return b;
-}
-
-HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& names,
-                         const Names& boundaries) {
-    static constexpr std::array<std::string_view, 4> all_keys{"name", "quantity", "point",
-                                                              "boundary"};
-    static constexpr std::array<std::string_view, 3> point_keys{"name", "quantity", "point"};
-    static constexpr std::array<std::string_view, 3> boundary_keys{"name", "quantity", "boundary"};
-    check_keys(c, t, p, all_keys);
-    HistorySpec h;
-    using Q = HistorySpec::Quantity;
-    h.name = read_name(c, t, p, names);
-    h.quantity = static_cast<Q>(choice(c, t, p, "quantity", quantities, "history quantity"));
-    const std::string_view q = quantities[static_cast<std::size_t>(h.quantity)];
-    const bool at_point = h.quantity >= Q::displacement_x && h.quantity <= Q::rotation;
-    const bool at_boundary = h.quantity == Q::boundary_force_x || h.quantity == Q::boundary_force_y;
-    check_keys(c, t, p,
-               at_point      ? Keys(point_keys)
-               : at_boundary ? Keys(boundary_keys)
-                             : Keys(all_keys).first(2),
-               all_keys, article(q) + " history");
-    if (at_point) {
-        const toml::node& n = need(c, t, p, "point",
-                                   "a point [x, y]: the " + std::string(q) +
-                                       " of the block containing (or nearest to) it is recorded");
-        h.point = to_vec2(c, n, p.key("point"));
-    }
-    if (at_boundary) {
-        const Path bp = p.key("boundary");
-        const toml::node& n = need(c, t, p, "boundary", "the name of a [[boundary]]");
-        h.boundary = to_str(c, n, bp);
-        check_ref(c, line(n), bp, h.boundary, boundaries);
-    }
-    return h;
-}
-
-StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
-                     const Names& regions, const Names& supports) {
-    static constexpr std::array<std::string_view, 18> all_keys{
-        "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy", "dsyy_dy",
-        "dsxy_dy", "ratio", "max_steps", "until", "quiet_steps", "regions", "relax_steps", "steps", "supports",
-        "keep"};
-    static constexpr std::array<std::string_view, 3> install_keys{"name", "type", "supports"};
-    static constexpr std::array<std::string_view, 9> initialize_keys{
-        "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
-    static constexpr std::array<std::string_view, 6> solve_keys{"name",  "type",       "ratio",
-                                                                "max_steps", "until", "quiet_steps"};
-    static constexpr std::array<std::string_view, 2> until_options{"ratio", "rest"};
-    static constexpr std::array<std::string_view, 6> excavate_keys{"name", "type", "regions",
-                                                                   "relax_steps", "steps", "keep"};
-    static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
-    static constexpr std::array<std::string_view, 2> elastic_keys{"name", "type"};
-    check_keys(c, t, p, all_keys);
-    StageSpec s;
-    using Kind = StageSpec::Kind;
-    const Path np = p.key("name");
-    int name_line = line(t);
-    if (const toml::node* n = find(c, t, p, "name")) {
-        s.name = to_str(c, *n, np);
-        if (s.name.empty()) c.fail(*n, np, "must be a non-empty string, got \"\"");
-        name_line = line(*n);
-    } else {
-        s.name = "stage " + std::to_string(index + 1);
-    }
-    add_name(c, names, s.name, name_line, np, line(t));
-    c.owner = "stage " + quoted(s.name);
-    s.kind = static_cast<Kind>(choice(c, t, p, "type", stage_types, "stage type"));
-    const Keys keys = s.kind == Kind::initialize ? Keys(initialize_keys)
-                      : s.kind == Kind::solve    ? Keys(solve_keys)
-                      : s.kind == Kind::excavate ? Keys(excavate_keys)
-                      : s.kind == Kind::cycle    ? Keys(cycle_keys)
-                      : s.kind == Kind::install  ? Keys(install_keys)
-                                                 : Keys(elastic_keys);
-    check_keys(c, t, p, keys, all_keys,
-               article(stage_types[static_cast<std::size_t>(s.kind)]) + " stage");
-    constexpr std::int64_t long_max = std::numeric_limits<long>::max();
-    switch (s.kind) {
-    case Kind::initialize:
-        s.stress = read_stress(c, t, p);
-        break;
-    case Kind::solve:
-        s.ratio = number(c, t, p, "ratio",
-                         Range{.lo = 0, .hi = 1, .lo_open = true, .hi_open = true, .unit = ""})
-                      .value_or(s.ratio);
-        s.max_steps = integer(c, t, p, "max_steps", 1, long_max).value_or(s.max_steps);
-        if (const toml::node* n = find(c, t, p, "until"))
-            s.until_rest = to_choice(c, *n, p.key("until"), until_options, "stopping rule") == 1;
-        s.quiet_steps = integer(c, t, p, "quiet_steps", StageMonitor::sample_every, long_max).value_or(s.quiet_steps);
-        break;
-    case Kind::excavate:
-        s.regions = name_list(c, t, p, "regions", regions, "");
-        s.relax_steps = integer(c, t, p, "relax_steps", 0, long_max).value_or(0);
-        // Steps run in this stage: fewer than relax_steps stops part-way through the
-        // relaxation (which goes on in the next stages), e.g. to install support.
-        s.steps = integer(c, t, p, "steps", 0, long_max).value_or(s.relax_steps);
-        s.keep = number(c, t, p, "keep", below(0, 1, "")).value_or(0.0);
-        if (s.steps > s.relax_steps)
-            c.fail(*find(c, t, p, "steps"), p.key("steps"),
-                   "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));
-        break;
-    case Kind::cycle:
-        s.steps = required_integer(c, t, p, "steps", 1, long_max);
-        break;
-    case Kind::elastic:
-        break;
-    case Kind::install:
-        s.supports = name_list(c, t, p, "supports", supports, "");
-        break;
-    }
-    return s;
 }
 
 /// A deformable region (one with a mesh) needs the elasticity of its material. A region

@@ -483,10 +483,34 @@ template <class F> void read_tables(Ctx& c, const toml::table& doc, std::string_
     c.owner.clear();
 }
 
+// --- stress fields (boundaries and initialize stages) -----------------------------
+
+constexpr std::string_view pascals = " Pa";
+constexpr std::string_view pascals_per_metre = " Pa/m";
+
+constexpr std::array<std::string_view, 7> stress_keys{"sxx",     "syy",     "sxy",    "y_ref",
+                                                      "dsxx_dy", "dsyy_dy", "dsxy_dy"};
+
+inline StressFieldSpec read_stress(const Ctx& c, const toml::table& t, const Path& p) {
+    StressFieldSpec s;
+    s.sxx = number(c, t, p, "sxx", unbounded(pascals)).value_or(0.0);
+    s.syy = number(c, t, p, "syy", unbounded(pascals)).value_or(0.0);
+    s.sxy = number(c, t, p, "sxy", unbounded(pascals)).value_or(0.0);
+    s.y_ref = number(c, t, p, "y_ref", unbounded(metres)).value_or(0.0);
+    s.dsxx_dy = number(c, t, p, "dsxx_dy", unbounded(pascals_per_metre)).value_or(0.0);
+    s.dsyy_dy = number(c, t, p, "dsyy_dy", unbounded(pascals_per_metre)).value_or(0.0);
+    s.dsxy_dy = number(c, t, p, "dsxy_dy", unbounded(pascals_per_metre)).value_or(0.0);
+    return s;
+}
+
 // --- section readers (one file each) ---------------------------------------------
 
 /// [[bolt]] tables (io/read_bolts.cpp): appended to `bolts`; their names to `names`.
 void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names);
+/// A [[history]] table and a [[stage]] table (io/read_stages.cpp).
+HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& names, const Names& boundaries);
+StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
+                     const Names& regions, const Names& supports);
 /// [[liner]] tables (io/read_liners.cpp).
 void read_liners(Ctx& c, const toml::table& doc, std::vector<LinerSpec>& liners, Names& names);
 

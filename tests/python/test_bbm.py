@@ -200,6 +200,17 @@ def test_bolt_arrays_of_the_bolted_tunnel():
     assert np.abs(b.bond).max() > 0
 
 
+def test_liner_arrays_of_the_shotcreted_tunnel():
+    m = bbm.Model(str(SOURCE / "examples/support/tunnel_voronoi_bolted_shotcrete.toml"), threads=2)
+    m.run()
+    l = m.liners
+    assert l.names == ["shotcrete"]
+    assert l.position.shape == (l.node_count, 2) and l.moment.shape == (l.element_count, 2)
+    # The lining is in compression, within its 3 MN/m capacity, pressed on by the rock.
+    assert 0 < l.thrust.min() and l.thrust.max() <= 3e6 * (1 + 1e-9)
+    assert l.interface_normal_stress.min() < 0
+
+
 def test_envelope_small_specimen():
     """bbm.envelope() returns envelope.json as a dict: the fits and every run."""
     e = bbm.envelope(width=2.0, height=4.0, confinements=[2e6, 5e6], realizations=1, threads=1)
