@@ -744,7 +744,69 @@ int ModelSource::line_of(const std::string& key) const {
     return 0;
 }
 
+namespace {
+
+/// TOML allows characters beyond ASCII only in strings and comments. Anywhere else
+/// toml++ 3.3 may test them as whitespace, and its test reaches
+/// __builtin_unreachable for most code points (undefined behaviour, found by
+/// fuzzing "1×" in a value): such a file is refused here first, at its line.
+/// Returns the offending line (0 = none) and code point.
+std::pair<int, char32_t> non_ascii_outside_strings(std::string_view text) {
+    int line = 1;
+    std::size_t i = 0;
+    auto starts = [&](std::string_view s) { return text.substr(i, s.size()) == s; };
+    auto skip_to = [&](std::string_view end, bool escapes) { // past the end of a string
+        while (i < text.size() && !starts(end)) {
+            if (text[i] == '\n') ++line;
+            i += escapes && text[i] == '\\' ? 2 : 1;
+        }
+        i += end.size();
+    };
+    while (i < text.size()) {
+        const unsigned char c = static_cast<unsigned char>(text[i]);
+        if (c == '\n') {
+            ++line, ++i;
+        } else if (c == '#') {
+            while (i < text.size() && text[i] != '\n') ++i;
+        } else if (starts("\"\"\"")) {
+            i += 3, skip_to("\"\"\"", true);
+        } else if (starts("\'\'\'")) {
+            i += 3, skip_to("\'\'\'", false);
+        } else if (c == '"' || c == '\'') {
+            ++i;
+            while (i < text.size() && text[i] != char(c) && text[i] != '\n') i += c == '"' && text[i] == '\\' ? 2 : 1;
+            if (i < text.size() && text[i] == char(c)) ++i;
+        } else if (c >= 0x80) {
+            // The code point, for the message (UTF-8; a broken sequence shows its first byte).
+            char32_t cp = c;
+            const int extra = c >= 0xF0 ? 3 : c >= 0xE0 ? 2 : c >= 0xC0 ? 1 : 0;
+            if (extra > 0 && i + std::size_t(extra) < text.size() + 1) {
+                cp = c & (0x3F >> extra);
+                for (int k = 1; k <= extra && i + std::size_t(k) < text.size(); ++k)
+                    cp = (cp << 6) | (static_cast<unsigned char>(text[i + std::size_t(k)]) & 0x3F);
+            }
+            return {line, cp};
+        } else {
+            ++i;
+        }
+    }
+    return {0, 0};
+}
+
+void refuse_non_ascii_outside_strings(std::string_view text, const std::string& name) {
+    const auto [line, cp] = non_ascii_outside_strings(text);
+    if (line == 0) return;
+    char code[16];
+    std::snprintf(code, sizeof code, "U+%04X", unsigned(cp));
+    throw InputError(name, line, "",
+                     std::string("TOML syntax error: a character beyond ASCII (") + code +
+                         ") outside a string or comment; TOML allows them only in strings and comments");
+}
+
+} // namespace
+
 ModelFile parse_model(std::string_view text, const std::string& name) {
+    refuse_non_ascii_outside_strings(text, name);
     toml::table doc;
     try {
         doc = toml::parse(text, std::string_view{name});
@@ -856,6 +918,10 @@ std::vector<KeyStep> split_key(const std::string& key, const std::string& flag) 
 /// A value as TOML would read it on the right of '=' (2e6, "trigon", [1, 2], true);
 /// a bare word that is not TOML becomes a string.
 toml::node_view<toml::node> parse_value(const std::string& text, toml::table& holder) {
+    if (non_ascii_outside_strings(text).first != 0) { // not TOML: a bare word
+        holder = toml::table{{"v", text}};
+        return holder["v"];
+    }
     try {
         holder = toml::parse("v = " + text);
     } catch (const toml::parse_error&) {
@@ -868,6 +934,7 @@ toml::node_view<toml::node> parse_value(const std::string& text, toml::table& ho
 
 std::string edit_model_text(std::string_view text, const std::string& name,
                             const std::vector<std::pair<std::string, std::string>>& set, long seed_offset) {
+    refuse_non_ascii_outside_strings(text, name);
     toml::table doc;
     try {
         doc = toml::parse(text, std::string_view{name});

@@ -233,6 +233,20 @@ pattern = { type = "brick", size = 0.1 }
     CHECK(mf.title.empty());
 }
 
+TEST_CASE("characters beyond ASCII: fine in strings and comments, a syntax error elsewhere (not undefined behaviour)") {
+    // Found by fuzzing: "1×" in a value sent toml++ 3.3 to __builtin_unreachable.
+    const auto ok = parse_model("# σ1 at 5 MPa: 40 MPa, φ 34°\n[model]\ntitle = \"σ × φ\" # ν\n"
+                                "[[region]]\nname = \"a\"\noutline = { type = \"rectangle\", min = [0, 0], max = [1, 1] }\n"
+                                "pattern = { type = \"single\" }\n",
+                                "t.toml");
+    CHECK(ok.title == "σ × φ");
+    const auto e = error_of("[model]\nmax_segment = 1×\n");
+    REQUIRE(e.has_value());
+    CHECK(e->line() == 2);
+    CHECK(std::string(e->what()).find("a character beyond ASCII (U+00D7) outside a string or comment") !=
+          std::string::npos);
+}
+
 TEST_CASE("TOML syntax errors give the line of the parser") {
     const std::string text = std::string(one_region) + "seed = = 3\n";
     const auto e = error_of(text);
