@@ -28,9 +28,10 @@ namespace bbm {
 namespace {
 // "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
 // count (a resumed run renumbered its contacts at another step: issue 27); 3 the
-// stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners.
+// stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners; 5 a
+// constant support pressure (excavate's `pressure`).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '5';
+constexpr std::uint64_t format = '6';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -102,6 +103,7 @@ void Solver::visit_state(Self& s, Visit&& v) {
     v(s.c_.vertex_block), v(s.c_.vertex_id), v(s.c_.edge_block), v(s.c_.edge_id), v(s.c_.edge_end);
     v(s.c_.length), v(s.c_.property), v(s.c_.history);
     v(s.relax_block_force_), v(s.relax_block_moment_), v(s.relax_node_force_), v(s.relax_total_), v(s.relax_left_), v(s.relax_keep_);
+    v(s.pressure_block_force_), v(s.pressure_block_moment_), v(s.pressure_node_force_);
     v(s.dt_), v(s.time_), v(s.ratio_), v(s.work_), v(s.steps_);
     v(s.boundary_force_);
     v(s.detected_at_), v(s.detected_theta_), v(s.detected_vertex_), v(s.active_);

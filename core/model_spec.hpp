@@ -126,6 +126,7 @@ struct StageSpec {
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
     double keep = 0.0;                 ///< excavate: fraction of the support kept for good (a support pressure)
+    double pressure = 0.0;             ///< excavate: Pa on the new boundary, normal to it, for good
     std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
 };
 

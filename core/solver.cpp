@@ -528,7 +528,7 @@ void Solver::initialize_stress(const StressFieldSpec& field) {
     }
 }
 
-void Solver::excavate(const std::vector<std::string>& regions, long relax_steps, double keep) {
+void Solver::excavate(const std::vector<std::string>& regions, long relax_steps, double keep, double pressure) {
     for (int i = 0; i < b_.count(); ++i)
         if (selected(regions, region_names_[b_.region[i]]) && !regions.empty()) b_.removed[i] = 1;
     refresh_normals();
@@ -538,28 +538,44 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
     relax_block_force_.assign(relaxing ? b_.count() : 0, {});
     relax_block_moment_.assign(relaxing ? b_.count() : 0, 0.0);
     relax_node_force_.assign(relaxing ? n_.count() : 0, {});
+    pressure_block_force_.assign(pressure > 0.0 ? b_.count() : 0, {});
+    pressure_block_moment_.assign(pressure > 0.0 ? b_.count() : 0, 0.0);
+    pressure_node_force_.assign(pressure > 0.0 ? n_.count() : 0, {});
+    // A force on the kept side of contact i at x: to its block, or to the node of
+    // its vertex, or shared by its edge's two nodes.
+    auto add_to_kept = [&](int i, Vec2 x, Vec2 fk, std::vector<Vec2>& block_force, std::vector<double>& block_moment,
+                           std::vector<Vec2>& node_force) {
+        const int A = c_.vertex_block[i];
+        const int kept = b_.removed[A] ? c_.edge_block[i] : A;
+        if (!b_.deformable[kept]) {
+            block_force[kept] += fk;
+            block_moment[kept] += cross(x - b_.centroid[kept], fk);
+        } else if (kept == A) {
+            node_force[b_.vertex_node[c_.vertex_id[i]]] += fk;
+        } else {
+            const Vec2 p = b_.vertex[c_.edge_id[i]], q = b_.vertex[c_.edge_end[i]];
+            const double w = std::clamp(dot(x - p, q - p) / norm2(q - p), 0.0, 1.0);
+            node_force[b_.vertex_node[c_.edge_id[i]]] += (1.0 - w) * fk;
+            node_force[b_.vertex_node[c_.edge_end[i]]] += w * fk;
+        }
+    };
     std::vector<std::uint8_t> drop(c_.size(), 0);
     for (int i = 0; i < c_.size(); ++i) {
         const int A = c_.vertex_block[i], B = c_.edge_block[i];
         if (!b_.removed[A] && !b_.removed[B]) continue;
         drop[i] = 1;
         if (b_.removed[A] && b_.removed[B]) continue;
-        if (!relaxing) continue;
         const Vec2 x = b_.vertex[c_.vertex_id[i]];
-        const Vec2 f = contact::contact_force(c_, i);
-        const int kept = b_.removed[A] ? B : A;
-        const Vec2 fk = b_.removed[A] ? -1.0 * f : f;
-        if (!b_.deformable[kept]) {
-            relax_block_force_[kept] += fk;
-            relax_block_moment_[kept] += cross(x - b_.centroid[kept], fk);
-        } else if (kept == A) {
-            relax_node_force_[b_.vertex_node[c_.vertex_id[i]]] += fk;
-        } else {
-            const Vec2 p = b_.vertex[c_.edge_id[i]], q = b_.vertex[c_.edge_end[i]];
-            const double w = std::clamp(dot(x - p, q - p) / norm2(q - p), 0.0, 1.0);
-            relax_node_force_[b_.vertex_node[c_.edge_id[i]]] += (1.0 - w) * fk;
-            relax_node_force_[b_.vertex_node[c_.edge_end[i]]] += w * fk;
-        }
+        const double sign = b_.removed[A] ? -1.0 : 1.0; // forces on A, seen from the kept side
+        if (relaxing)
+            add_to_kept(i, x, sign * contact::contact_force(c_, i), relax_block_force_, relax_block_moment_,
+                        relax_node_force_);
+        // The pressure pushes the kept side away from the removed one: along the
+        // contact's normal (B's outward normal, towards A) on A, against it on B,
+        // over the contact's length.
+        if (pressure > 0.0)
+            add_to_kept(i, x, sign * pressure * c_.length[i] * c_.normal[i], pressure_block_force_,
+                        pressure_block_moment_, pressure_node_force_);
     }
     c_.remove_if_flagged(drop);
     rebuild_contact_index();
@@ -608,6 +624,7 @@ void Solver::compute_forces() {
     const double relax = relax_left_ > 0 ? relax_keep_ + (1.0 - relax_keep_) * double(relax_left_) / double(relax_total_ + 1)
                          : relax_block_force_.empty() && relax_node_force_.empty() ? 0.0
                                                                                     : relax_keep_;
+    const bool pressure = !pressure_block_force_.empty();
     const int nb = b_.count(), nn = n_.count();
 #pragma omp for schedule(static) nowait
     for (int i = 0; i < nb; ++i) {
@@ -617,6 +634,7 @@ void Solver::compute_forces() {
         f += b_.applied[i] + b_.real_mass[i] * g;
         m += b_.applied_moment[i];
         if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
+        if (pressure) f += pressure_block_force_[i], m += pressure_block_moment_[i];
         if (bolts)
             for (int t = bolt_block_first_[i]; t < bolt_block_first_[i + 1]; ++t) {
                 const int tie = bolt_block_tie_[t];
@@ -630,6 +648,7 @@ void Solver::compute_forces() {
     for (int k = 0; k < nn; ++k) {
         Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
         if (relax > 0.0) f += relax * relax_node_force_[k];
+        if (pressure) f += pressure_node_force_[k];
         if (bolts)
             for (int t = bolt_node_first_[k]; t < bolt_node_first_[k + 1]; ++t) {
                 const auto [tie, weight] = bolt_node_tie_[t];
@@ -934,10 +953,11 @@ Solver::Memory Solver::memory() const {
                      b_.applied_moment, b_.mass, b_.inertia, b_.real_mass, b_.real_inertia, b_.area, b_.fixed,
                      b_.fixed_velocity, b_.fixed_omega, b_.removed, b_.deformable, b_.region, b_.material, b_.first,
                      body_, radius_, detected_at_, detected_theta_, active_, relax_block_force_, relax_block_moment_,
+                     pressure_block_force_, pressure_block_moment_,
                      stiffness_scratch_.block, stiffness_scratch_.rotation, c_.block_first);
     m.vertices = bytes(b_.local, b_.vertex, b_.inv_edge_length, b_.vertex_node, detected_vertex_);
     m.nodes = bytes(n_.position, n_.position0, n_.velocity, n_.force, n_.applied, n_.mass, n_.real_mass, n_.fixed,
-                    n_.fixed_velocity, n_.block, relax_node_force_, stiffness_scratch_.node, c_.node_first,
+                    n_.fixed_velocity, n_.block, relax_node_force_, pressure_node_force_, stiffness_scratch_.node, c_.node_first,
                     z_.node_first);
     m.zones = bytes(z_.node, z_.elasticity, z_.stress, z_.strain, z_.block, z_.density, z_.node_entry, z_.nodal_force,
                     z_.partial_sum);

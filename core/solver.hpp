@@ -68,7 +68,10 @@ public:
     /// Removes the blocks of these regions; the forces they exerted on the rest are
     /// relaxed linearly over relax_steps steps to the fraction `keep` of them, which
     /// stays (a support pressure: the convergence–confinement method's 1 − λ).
-    void excavate(const std::vector<std::string>& regions, long relax_steps, double keep = 0.0);
+    /// `pressure` (Pa) pushes on the new boundary, normal to it, from now on and for
+    /// good (a support pressure in Pa); a later excavate replaces both.
+    void excavate(const std::vector<std::string>& regions, long relax_steps, double keep = 0.0,
+                  double pressure = 0.0);
     void step();
     /// Installs the named [[bolt]] sets (core/bolts.hpp): nodes along each bolt,
     /// each tied to the rock it lies in now, unstressed. Throws InputError (key
@@ -301,6 +304,10 @@ private:
     std::vector<double> relax_block_moment_;
     long relax_total_ = 0, relax_left_ = 0;
     double relax_keep_ = 0.0; ///< fraction of the excavated rock's support kept for good
+    /// A constant support pressure on the excavated boundary, as forces per block
+    /// and per node (empty when none).
+    std::vector<Vec2> pressure_block_force_, pressure_node_force_;
+    std::vector<double> pressure_block_moment_;
     double first_dt_ = 0.0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
     // Detection: tolerance, property of new contacts, motion since the last pass.

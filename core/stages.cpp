@@ -60,7 +60,7 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             obs.stage_started(s, st);
             switch (st.kind) {
             case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
-            case StageSpec::Kind::excavate: s.excavate(st.regions, st.relax_steps, st.keep); break;
+            case StageSpec::Kind::excavate: s.excavate(st.regions, st.relax_steps, st.keep, st.pressure); break;
             case StageSpec::Kind::elastic: r.method = s.solve_elastic().method; break;
             case StageSpec::Kind::install: s.install_supports(st.supports); break;
             case StageSpec::Kind::solve:

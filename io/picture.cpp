@@ -264,12 +264,12 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
         for (int e = 0; e < liners.element_count(); ++e) {
             const int a = liners.element_node[e];
             while (a >= liners.first[l + 1]) ++l;
-            const int b = a + 1 < liners.first[l + 1] ? a + 1 : liners.first[l];
+            const int next = a + 1 < liners.first[l + 1] ? a + 1 : liners.first[l];
             const double f = thrust_max > 0 ? std::abs(liners.thrust[e]) / thrust_max : 0.0;
             cairo_set_source_rgb(cr, 0.55 - 0.45 * f, 0.75 - 0.55 * f, 0.95 - 0.35 * f);
             cairo_set_line_width(cr, 5.0 * px);
             cairo_move_to(cr, liners.position[a].x, liners.position[a].y);
-            cairo_line_to(cr, liners.position[b].x, liners.position[b].y);
+            cairo_line_to(cr, liners.position[next].x, liners.position[next].y);
             cairo_stroke(cr);
         }
     }

@@ -56,18 +56,18 @@ HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& nam
 
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
                      const Names& regions, const Names& supports) {
-    static constexpr std::array<std::string_view, 18> all_keys{
+    static constexpr std::array<std::string_view, 19> all_keys{
         "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy", "dsyy_dy",
         "dsxy_dy", "ratio", "max_steps", "until", "quiet_steps", "regions", "relax_steps", "steps", "supports",
-        "keep"};
+        "keep",    "pressure"};
     static constexpr std::array<std::string_view, 3> install_keys{"name", "type", "supports"};
     static constexpr std::array<std::string_view, 9> initialize_keys{
         "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
     static constexpr std::array<std::string_view, 6> solve_keys{"name",  "type",       "ratio",
                                                                 "max_steps", "until", "quiet_steps"};
     static constexpr std::array<std::string_view, 2> until_options{"ratio", "rest"};
-    static constexpr std::array<std::string_view, 6> excavate_keys{"name", "type", "regions",
-                                                                   "relax_steps", "steps", "keep"};
+    static constexpr std::array<std::string_view, 7> excavate_keys{"name",  "type", "regions",  "relax_steps",
+                                                                   "steps", "keep", "pressure"};
     static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
     static constexpr std::array<std::string_view, 2> elastic_keys{"name", "type"};
     check_keys(c, t, p, all_keys);
@@ -114,6 +114,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         // relaxation (which goes on in the next stages), e.g. to install support.
         s.steps = integer(c, t, p, "steps", 0, long_max).value_or(s.relax_steps);
         s.keep = number(c, t, p, "keep", below(0, 1, "")).value_or(0.0);
+        s.pressure = number(c, t, p, "pressure", at_least(0, " Pa")).value_or(0.0);
         if (s.steps > s.relax_steps)
             c.fail(*find(c, t, p, "steps"), p.key("steps"),
                    "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));

@@ -1032,6 +1032,20 @@ TEST_CASE("history and stage mistakes") {
                 "stage name 'stage 1' is already used by stage[0] (line 5)");
 }
 
+TEST_CASE("excavate: a support kept as a fraction or as a pressure, and their mistakes") {
+    const auto mf = parse_model(with("[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\nrelax_steps = 100\n"
+                                     "keep = 0.25\npressure = 2e6\n"),
+                                "t.toml");
+    CHECK(mf.analysis.stages[0].keep == 0.25);
+    CHECK(mf.analysis.stages[0].pressure == 2e6);
+    check_error(with("[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\nkeep = 1.0\n"), "keep",
+                "stage[0].keep", "must be in [0, 1), got 1");
+    check_error(with("[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\npressure = -1e6\n"), "pressure",
+                "stage[0].pressure", "must be >= 0 Pa, got -1e+06");
+    check_error(with("[[stage]]\ntype = \"cycle\"\nsteps = 10\npressure = 1e6\n"), "pressure",
+                "stage[0].pressure", "");
+}
+
 TEST_CASE("bolts: a set, its installation, and its mistakes") {
     const std::string set = "[[bolt]]\nname = \"rebar\"\nbolts = [[[0.0, 0.0], [2.0, 0.0]]]\n"
                             "diameter = 0.025\nyield_force = 200e3\nbond_stiffness = 1e9\nspacing = 1.5\n";
@@ -1047,6 +1061,8 @@ TEST_CASE("bolts: a set, its installation, and its mistakes") {
     CHECK(b.spacing == 1.5);
     CHECK(b.bond_strength == 0.0);
     CHECK(mf.analysis.stages[0].steps == 40);
+    CHECK(mf.analysis.stages[0].keep == 0.0);
+    CHECK(mf.analysis.stages[0].pressure == 0.0);
     CHECK(mf.analysis.stages[1].kind == bbm::StageSpec::Kind::install);
     CHECK(mf.analysis.stages[1].supports == std::vector<std::string>{"rebar"});
 
