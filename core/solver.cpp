@@ -170,6 +170,14 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
                 prop = int(it - property_names_.begin());
             }
         }
+        // A fracture set's own property overrides the rules.
+        if (j.fracture_set >= 0 && !a.fracture_sets[j.fracture_set].property.empty()) {
+            const auto& name = a.fracture_sets[j.fracture_set].property;
+            const auto it = std::find(property_names_.begin(), property_names_.end(), name);
+            if (it == property_names_.end())
+                throw InputError("", 0, "region.dfn.property", "unknown joint property '" + name + "'");
+            prop = int(it - property_names_.begin());
+        }
         if (prop < 0)
             throw InputError("", 0, "joint_assignment",
                              std::string("no joint property is assigned to ") + meshing::to_string(j.tag) +

@@ -298,8 +298,8 @@ MeshSpec read_mesh(const Ctx& c, const toml::node& node, const Path& p) {
 RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
                        std::optional<std::string>& material) {
     const toml::table& t = to_table(c, node, p, "a [[region]] table");
-    static constexpr std::array<std::string_view, 9> keys{
-        "name", "outline", "holes", "minus", "pattern", "joints", "joint_set", "material", "mesh"};
+    static constexpr std::array<std::string_view, 10> keys{
+        "name", "outline", "holes", "minus", "pattern", "joints", "joint_set", "dfn", "material", "mesh"};
     check_keys(c, t, p, keys);
     RegionSpec r;
     const Path np = p.key("name");
@@ -324,6 +324,9 @@ RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
               [&](const toml::node& n, const Path& ep) {
                   r.joint_sets.push_back(read_joint_set(c, n, ep));
               });
+    std::vector<std::string> sets;
+    read_list(c, t, p, "dfn", "an array of fracture set tables ([[region.dfn]])",
+              [&](const toml::node& n, const Path& ep) { r.dfn.push_back(read_dfn_set(c, n, ep, sets)); });
     if (const toml::node* m = find(c, t, p, "mesh")) r.mesh = read_mesh(c, *m, p.key("mesh"));
     return r;
 }
@@ -377,8 +380,8 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 constexpr std::array<std::string_view, 2> solver_modes{"quasi_static", "dynamic"};
 constexpr std::array<std::string_view, 2> contact_lengths{"edge", "overlap"};
 constexpr std::array<std::string_view, 3> laws{"elastic", "coulomb", "softening"};
-constexpr std::array<std::string_view, 5> joint_tags{"inner", "radial", "peripheral", "real_joint",
-                                                     "interface"};
+constexpr std::array<std::string_view, 6> joint_tags{"inner", "radial", "peripheral", "real_joint",
+                                                     "interface", "fracture"};
 constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
 
 
@@ -671,6 +674,13 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     read_tables(c, doc, "joint_assignment", [&](const toml::table& t, const Path& p, std::size_t) {
         an.joint_assignments.push_back(read_joint_assignment(c, t, p, properties, regions));
     });
+    for (std::size_t i = 0; i < mf.geometry.regions.size(); ++i)
+        for (std::size_t k = 0; k < mf.geometry.regions[i].dfn.size(); ++k)
+            if (const auto& name = mf.geometry.regions[i].dfn[k].property; !name.empty()) {
+                const std::string rel = "dfn[" + std::to_string(k) + "].property";
+                check_ref(c, mf.source.key_line[i].at(rel), Path{"region[" + std::to_string(i) + "]." + rel, ""}, name,
+                          properties);
+            }
     Names boundaries{"boundary", "boundaries", "boundary", {}, {}};
     read_tables(c, doc, "boundary", [&](const toml::table& t, const Path& p, std::size_t) {
         an.boundaries.push_back(read_boundary(c, t, p, boundaries, regions));

@@ -29,6 +29,7 @@ Rgb joint_colour(meshing::JointTag t) {
     case T::peripheral: return {0.10, 0.25, 0.65};
     case T::real_joint: return {0.85, 0.10, 0.10};
     case T::interface: return {0.0, 0.0, 0.0};
+    case T::fracture: return {0.80, 0.40, 0.0};
     }
     return {0, 0, 0};
 }
@@ -139,7 +140,8 @@ void draw_blocks(const meshing::BlockAssembly& a, const std::filesystem::path& f
         for (const auto& j : a.joints) {
             const Rgb c = joint_colour(j.tag);
             cairo_set_source_rgb(cr, c.r, c.g, c.b);
-            const bool strong = j.tag == meshing::JointTag::real_joint || j.tag == meshing::JointTag::interface;
+            const bool strong = j.tag == meshing::JointTag::real_joint || j.tag == meshing::JointTag::interface ||
+                                j.tag == meshing::JointTag::fracture;
             cairo_set_line_width(cr, (strong ? 2.0 : 0.8) * px);
             cairo_move_to(cr, j.p0.x, j.p0.y);
             cairo_line_to(cr, j.p1.x, j.p1.y);

@@ -53,7 +53,7 @@ constexpr PatternKind all_pattern_kinds[] = {PatternKind::voronoi,   PatternKind
                                              PatternKind::delaunay,  PatternKind::hexagonal,
                                              PatternKind::brick,     PatternKind::single};
 constexpr JointTag all_joint_tags[] = {JointTag::inner, JointTag::radial, JointTag::peripheral,
-                                       JointTag::real_joint, JointTag::interface};
+                                       JointTag::real_joint, JointTag::interface, JointTag::fracture};
 
 fs::path tmp_path(const fs::path& file) {
     fs::path t = file;
@@ -555,6 +555,26 @@ void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
     const std::vector<std::string> states{"elastic", "yielded", "broken"};
     grid->GetFieldData()->AddArray(string_array("state_names", states, [](const std::string& x) { return x; }));
     grid->GetFieldData()->AddArray(string_array("set_names", s.bolt_set_names(), [](const std::string& x) { return x; }));
+    write_grid(grid, file);
+}
+
+void write_fractures_vtu(const meshing::BlockAssembly& a, const fs::path& file) {
+    const auto n = static_cast<vtkIdType>(a.fracture_traces.size());
+    std::vector<Vec2> ends;
+    ends.reserve(2 * a.fracture_traces.size());
+    for (const auto& t : a.fracture_traces) ends.push_back(t.a), ends.push_back(t.b);
+    auto grid = line_grid(ends, n, [](vtkIdType i) { return std::pair<vtkIdType, vtkIdType>{2 * i, 2 * i + 1}; });
+    auto set = int_array("set", n), region = int_array("region", n);
+    auto length = double_array("length", n);
+    for (vtkIdType i = 0; i < n; ++i) {
+        const int s = a.fracture_trace_set[i];
+        set->SetValue(i, s);
+        region->SetValue(i, a.fracture_sets[s].region);
+        length->SetValue(i, norm(a.fracture_traces[i].b - a.fracture_traces[i].a));
+    }
+    add_cell_arrays(grid, set, region, length);
+    grid->GetFieldData()->AddArray(
+        string_array("set_names", a.fracture_sets, [](const meshing::BlockAssembly::FractureSet& s) { return s.name; }));
     write_grid(grid, file);
 }
 

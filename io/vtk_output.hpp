@@ -40,6 +40,10 @@ void write_blocks_vtu(const meshing::BlockAssembly& a, const std::filesystem::pa
 /// One VTK_LINE per JointRecord (p0 to p1), cell data tag, block_a, block_b, length.
 void write_joints_vtu(const meshing::BlockAssembly& a, const std::filesystem::path& file);
 
+/// The discrete fracture network as built: one VTK_LINE per trace (clipped to its
+/// region), cell data set, region, length; field data set_names.
+void write_fractures_vtu(const meshing::BlockAssembly& a, const std::filesystem::path& file);
+
 /// A ParaView collection: each step is (time, path of a .vtu relative to the .pvd's
 /// directory). Files sharing a time become parts 0, 1, ... of that time step, so
 /// blocks and joints of one step can sit in one collection.

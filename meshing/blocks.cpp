@@ -22,6 +22,7 @@ const char* to_string(JointTag t) {
     case JointTag::peripheral: return "peripheral";
     case JointTag::real_joint: return "real_joint";
     case JointTag::interface: return "interface";
+    case JointTag::fracture: return "fracture";
     }
     return "?";
 }
@@ -242,7 +243,10 @@ struct RegionBlocks {
 
 /// Real joints that end inside a rock block split the inner blocks they cross,
 /// along their line; the part beyond the tip becomes an ordinary inner joint.
-void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& dangling, double tol) {
+/// Returns the number of blocks a trace should have split but could not (not
+/// simple polygons): reported in GenerationStats, never hidden.
+int split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& dangling, double tol) {
+    int skipped = 0;
     for (const auto& s : dangling) {
         Box2 sb;
         sb.add(s.a);
@@ -252,7 +256,25 @@ void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& danglin
             const Box2 b = bounding_box(rb.polygons[k]);
             if (b.hi.x < sb.lo.x || b.lo.x > sb.hi.x || b.hi.y < sb.lo.y || b.lo.y > sb.hi.y) continue;
             if (!segment_enters(rb.polygons[k], s.a, s.b)) continue;
-            auto pieces = cgal::split_by_line(rb.polygons[k], s.a, s.b);
+            // CGAL's Boolean operations need a simple polygon; a block that is not
+            // is reported by the caller's area check instead of crashing here.
+            if (!cgal::is_simple(rb.polygons[k])) {
+                ++skipped;
+                continue;
+            }
+            std::vector<std::vector<Vec2>> pieces;
+            // A line through a vertex of a concave block can leave a piece of two
+            // lobes touching at that vertex: two blocks.
+            for (auto& piece : cgal::split_by_line(rb.polygons[k], s.a, s.b)) {
+                auto loops = cgal::split_at_repeats(piece);
+                const bool lobes = loops.size() > 1 && std::all_of(loops.begin(), loops.end(), [](const auto& l) {
+                                       return signed_area(l) > 0;
+                                   });
+                if (lobes)
+                    for (auto& l : loops) pieces.push_back(std::move(l));
+                else
+                    pieces.push_back(std::move(piece));
+            }
             // A line through (or within rounding of) a vertex leaves a sliver piece
             // whose rounded vertices coincide: drop repeated vertices and slivers.
             std::erase_if(pieces, [&](std::vector<Vec2>& piece) {
@@ -263,7 +285,13 @@ void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& danglin
                 piece = std::move(clean);
                 return piece.size() < 3 || signed_area(piece) <= tol * tol;
             });
-            if (pieces.size() < 2) continue;
+            if (pieces.size() < 2) {
+                // The line runs along one of the block's edges (an earlier piece of
+                // the same trace split it): the tips still become vertices there.
+                insert_vertex_on_edge(rb.polygons[k], s.a, tol);
+                insert_vertex_on_edge(rb.polygons[k], s.b, tol);
+                continue;
+            }
             for (auto& piece : pieces) {
                 insert_vertex_on_edge(piece, s.a, tol);
                 insert_vertex_on_edge(piece, s.b, tol);
@@ -275,6 +303,7 @@ void split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& danglin
             }
         }
     }
+    return skipped;
 }
 
 /// Index of a point along a Hilbert curve over a box, 16 bits per axis. Unlike a
@@ -361,6 +390,10 @@ void mesh_deformable_blocks(BlockAssembly& a, const ModelGeometrySpec& spec,
     out.region_names = std::move(a.region_names);
     out.region_size = std::move(a.region_size);
     out.real_segments = std::move(a.real_segments);
+    out.fracture_sets = std::move(a.fracture_sets);
+    out.fracture_traces = std::move(a.fracture_traces);
+    out.fracture_trace_set = std::move(a.fracture_trace_set);
+    out.fracture_stats = std::move(a.fracture_stats);
     for (int b = 0; b < a.block_count(); ++b) {
         const int r = a.region[b];
         if (!size[r]) {
@@ -597,7 +630,31 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
             const auto traces = joint_set_traces(js, box);
             segments.insert(segments.end(), traces.begin(), traces.end());
         }
+        if (!reg.dfn.empty()) {
+            FractureNetwork net;
+            try {
+                net = generate_fracture_network(reg.dfn, domain[r]);
+            } catch (const std::invalid_argument& e) {
+                throw GeometryError(r, "dfn", e.what());
+            }
+            const int set_base = int(a.fracture_sets.size());
+            for (const auto& s : reg.dfn) a.fracture_sets.push_back({s.name, s.property, r});
+            for (std::size_t i = 0; i < net.traces.size(); ++i) {
+                a.fracture_traces.push_back(net.traces[i]);
+                a.fracture_trace_set.push_back(set_base + net.trace_set[i]);
+            }
+            a.fracture_stats.insert(a.fracture_stats.end(), net.stats.begin(), net.stats.end());
+            segments.insert(segments.end(), net.traces.begin(), net.traces.end());
+        }
         const auto cut = cgal::cut_by_segments(domain[r], segments);
+        if (!cut.pinched.empty())
+            throw GeometryError(r, reg.dfn.empty() ? "joints" : "dfn",
+                                "the real joints and fractures cut region '" + reg.name + "' into " +
+                                    std::to_string(cut.pinched.size()) +
+                                    " rock block(s) that touch themselves at a point (first at (" +
+                                    fmt(cut.pinched[0].x) + ", " + fmt(cut.pinched[0].y) +
+                                    ")), which bbm cannot fill yet: a denser network than it handles "
+                                    "(another seed or a lower intensity avoids it)");
         a.real_segments.insert(a.real_segments.end(), cut.separating.begin(), cut.separating.end());
         a.real_segments.insert(a.real_segments.end(), cut.dangling.begin(), cut.dangling.end());
 
@@ -613,12 +670,27 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
                 rb.parent.push_back(offset + fill.parent[k]);
             }
         }
-        split_by_dangling(rb, cut.dangling, tol);
+        st.unsplit_blocks += split_by_dangling(rb, cut.dangling, tol);
         order_along_curve(rb);
         const int parent_base = a.block_count();
         for (std::size_t k = 0; k < rb.polygons.size(); ++k)
             a.add_block(rb.polygons[k], r, reg.pattern.kind, parent_base + rb.parent[k]);
         check_region_filled(reg, r, a.block_count() - parent_base, estimate[r], cgal::area(domain[r]));
+        // The blocks tile the region exactly; a cut that went wrong (an invalid
+        // polygon handed to CGAL by a network denser than the cutting handles)
+        // shows here and is refused rather than simulated.
+        if (!reg.dfn.empty() || !reg.joint_sets.empty() || !reg.joints.empty()) {
+            double covered = 0.0;
+            for (int b = parent_base; b < a.block_count(); ++b) covered += a.area[b];
+            const double want = cgal::area(domain[r]);
+            if (std::abs(covered - want) > 1e-7 * want)
+                throw GeometryError(r, reg.dfn.empty() ? "joint_set" : "dfn",
+                                    "cutting region '" + reg.name + "' by its joints and fractures went wrong: its " +
+                                        std::to_string(a.block_count() - parent_base) + " blocks cover " +
+                                        fmt(covered) + " m² of its " + fmt(want) +
+                                        " m² (a network denser than bbm's cutting handles yet; another seed or a "
+                                        "lower intensity avoids it)");
+        }
         if (reg.pattern.kind != PatternSpec::Kind::single) {
             const double min_edge = pattern.min_edge >= 0 ? pattern.min_edge : 0.1 * pattern.size;
             for (int b = parent_base; b < a.block_count(); ++b) {

@@ -27,6 +27,7 @@
 #pragma once
 
 #include "base/vec2.hpp"
+#include "meshing/dfn.hpp"
 #include "meshing/fe_mesh.hpp"
 #include "meshing/spec.hpp"
 
@@ -44,6 +45,7 @@ enum class JointTag : std::uint8_t {
     peripheral, ///< trigon: between triangles of different Voronoi cells
     real_joint, ///< on a real discontinuity (explicit segment or joint set)
     interface,  ///< between blocks of different regions
+    fracture,   ///< on a fracture of a discrete fracture network ([[region.dfn]])
 };
 const char* to_string(JointTag t);
 const char* to_string(PatternSpec::Kind k);
@@ -55,6 +57,7 @@ struct JointRecord {
     int edge_a = -1, edge_b = -1;
     Vec2 p0{}, p1{};
     JointTag tag = JointTag::inner;
+    int fracture_set = -1; ///< fracture joints: index into BlockAssembly::fracture_sets
     double length() const { return norm(p1 - p0); }
 };
 
@@ -73,6 +76,17 @@ struct BlockAssembly {
     std::vector<double> region_size;
     /// Segments of real discontinuities after cutting (for output and checks).
     std::vector<SegmentSpec> real_segments;
+    /// Discrete fracture networks: every region's sets in order, their traces
+    /// (clipped to the region, before cutting) and what was built against what
+    /// was asked (meshing/dfn.hpp).
+    struct FractureSet {
+        std::string name, property; ///< property "" = by the assignment rules
+        int region = -1;
+    };
+    std::vector<FractureSet> fracture_sets;
+    std::vector<SegmentSpec> fracture_traces;
+    std::vector<int> fracture_trace_set; ///< per trace: index into fracture_sets
+    std::vector<FractureSetStats> fracture_stats; ///< per set
 
     // Deformable blocks (regions with a mesh): the polygon of such a block is the
     // boundary loop of its triangle mesh (its vertices are FE nodes). The nodes of a
@@ -103,6 +117,9 @@ struct GenerationStats {
     /// Edges still shorter than their region's minimum (e.g. a short edge of the
     /// outline itself); reported, never hidden.
     int short_edges_left = 0;
+    /// Blocks a trace ending inside them should have split along its line but that
+    /// were no simple polygon (dense fracture networks): the trace stops short there.
+    int unsplit_blocks = 0;
     /// Deformable blocks: triangles made, and the time spent subdividing and meshing.
     int zones = 0;
     double seconds_meshing = 0;

@@ -321,11 +321,37 @@ std::vector<Vec2> ring_without_antennas(Circ first) {
     std::vector<Vec2> r;
     Circ c = first;
     do {
-        if (c->twin()->face() != c->face()) r.push_back(to_vec(c->source()->point()));
+        if (c->twin()->face() != c->face()) {
+            // Two vertices closer than the rounding (crossings a hair apart in a
+            // dense fracture network) become one.
+            const Vec2 q = to_vec(c->source()->point());
+            if (r.empty() || !(r.back() == q)) r.push_back(q);
+        }
     } while (++c != first);
+    while (r.size() > 1 && r.front() == r.back()) r.pop_back();
     return r;
 }
 } // namespace
+
+/// A closed walk that passes a vertex twice (a face pinched at a crossing: in a
+/// dense fracture network, two opposite corners of an X belong to one face that
+/// wraps around a small neighbour) split into simple loops at its repeated vertices.
+std::vector<std::vector<Vec2>> split_at_repeats(const std::vector<Vec2>& ring) {
+    std::vector<std::vector<Vec2>> loops;
+    std::vector<Vec2> path;
+    for (const Vec2 q : ring) {
+        const auto again = std::find(path.begin(), path.end(), q);
+        if (again != path.end()) {
+            loops.emplace_back(again, path.end());
+            path.erase(again + 1, path.end());
+        } else {
+            path.push_back(q);
+        }
+    }
+    if (path.size() >= 3) loops.push_back(std::move(path));
+    std::erase_if(loops, [](const std::vector<Vec2>& l) { return l.size() < 3; });
+    return loops;
+}
 
 CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments) {
     CutResult out;
@@ -360,11 +386,24 @@ CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments
         std::vector<Vec2> obstacles;
         for (const auto& h : face.holes) obstacles.insert(obstacles.end(), h.begin(), h.end());
         if (!detail::domain_contains(d, interior_point(face.outer, obstacles))) continue;
+        inside.push_back(f);
+        // A face pinched at a vertex (in a dense fracture network two opposite
+        // corners of an X crossing can belong to one face that wraps around a small
+        // neighbour), or one that rounding made cross itself, is no polygon the
+        // pattern can fill: say where, rather than fail inside CGAL.
+        if (const auto loops = split_at_repeats(face.outer); loops.size() > 1 || !is_simple(face.outer)) {
+            Vec2 at = face.outer.front();
+            for (std::size_t i = 1; i < face.outer.size(); ++i)
+                if (std::find(face.outer.begin(), face.outer.begin() + long(i), face.outer[i]) !=
+                    face.outer.begin() + long(i))
+                    at = face.outer[i];
+            out.pinched.push_back(at);
+            continue;
+        }
         if (signed_area(face.outer) < 0) std::reverse(face.outer.begin(), face.outer.end());
         for (auto& h : face.holes)
             if (signed_area(h) > 0) std::reverse(h.begin(), h.end());
         out.faces.push_back(std::move(face));
-        inside.push_back(f);
     }
     auto is_inside = [&](Arrangement::Face_const_handle f) {
         return std::find(inside.begin(), inside.end(), f) != inside.end();
@@ -372,6 +411,7 @@ CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments
     for (auto e = arr.edges_begin(); e != arr.edges_end(); ++e) {
         const auto f1 = e->face(), f2 = e->twin()->face();
         const SegmentSpec s{to_vec(e->source()->point()), to_vec(e->target()->point())};
+        if (s.a == s.b) continue; // an edge shorter than the rounding (crossings a hair apart)
         if (f1 == f2) {
             if (is_inside(f1)) out.dangling.push_back(s);
         } else if (is_inside(f1) && is_inside(f2)) {

@@ -45,6 +45,11 @@ private:
     Impl* impl_;
 };
 
+/// A closed walk that passes a vertex more than once split into simple loops there
+/// (a "relatively simple" polygon, as CGAL's Boolean operations may return one:
+/// two pieces touching at a point).
+std::vector<std::vector<Vec2>> split_at_repeats(const std::vector<Vec2>& ring);
+
 /// Splits a polygon with holes into simple polygons (cuts through each hole).
 std::vector<std::vector<Vec2>> split_holes(const PolygonWithHoles& p);
 
@@ -56,6 +61,9 @@ struct CutResult {
     Domain faces;                        ///< the rock blocks
     std::vector<SegmentSpec> separating; ///< joint pieces with different faces on both sides
     std::vector<SegmentSpec> dangling;   ///< joint pieces with the same face on both sides
+    /// Faces left out: pinched at a vertex (touching themselves) or not simple
+    /// after rounding; a point of each. Callers must refuse a cut with any.
+    std::vector<Vec2> pinched;
 };
 CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments);
 

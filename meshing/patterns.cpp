@@ -30,8 +30,15 @@ std::vector<std::pair<Vec2, Vec2>> face_edges(const PolygonWithHoles& f) {
 void clip_into(const cgal::Clipper& clipper, std::span<const Vec2> poly, int parent, FaceFill& out) {
     for (const auto& piece : clipper.clip(poly)) {
         if (piece.holes.empty()) {
-            out.polygons.push_back(piece.outer);
-            out.parent.push_back(parent);
+            // Two pieces touching at a point are two blocks.
+            auto loops = cgal::split_at_repeats(piece.outer);
+            const bool all_outer = std::all_of(loops.begin(), loops.end(),
+                                               [](const std::vector<Vec2>& l) { return signed_area(l) > 0; });
+            if (loops.size() < 2 || !all_outer) loops = {piece.outer};
+            for (auto& l : loops) {
+                out.polygons.push_back(std::move(l));
+                out.parent.push_back(parent);
+            }
         } else {
             for (auto& p : cgal::split_holes(piece)) {
                 out.polygons.push_back(std::move(p));

@@ -101,6 +101,49 @@ struct SegmentSpec {
     Vec2 a{}, b{};
 };
 
+/// The trace-length distribution of a fracture set (meshing/dfn.hpp).
+struct FractureLengthSpec {
+    enum class Kind { fixed, power_law, lognormal, exponential };
+    Kind kind = Kind::fixed;
+    double value = 0.0;      ///< fixed: every trace this long (m)
+    double exponent = 0.0;   ///< power_law: density ∝ l^−exponent on [min, max]
+    double mean = 0.0;       ///< lognormal, exponential: mean of the untruncated law (m)
+    double std_dev = 0.0;    ///< lognormal: its standard deviation (m)
+    double min = 0.0, max = 0.0; ///< truncation (m); max 0 = the region's diagonal (not power_law)
+};
+
+/// The trace-angle distribution of a fracture set, degrees counter-clockwise from +x.
+struct FractureOrientationSpec {
+    enum class Kind { von_mises, uniform, list };
+    Kind kind = Kind::von_mises;
+    double mean = 0.0;          ///< von_mises: mean angle
+    double concentration = 0.0; ///< von_mises: κ, density ∝ exp(κ cos(θ − mean)); 0 = uniform
+    std::vector<double> angles, weights; ///< list: angles picked with these weights (default equal)
+};
+
+/// One set of a discrete fracture network ([[region.dfn]]): stochastic traces with
+/// random centres, orientations and lengths at a target intensity, or traces read
+/// from a file (CSV: x1, y1, x2, y2[, set]).
+struct DfnSetSpec {
+    std::string name;
+    enum class Centres { poisson, clustered };
+    Centres centres = Centres::poisson;
+    double cluster_size = 0.0;   ///< clustered: mean fractures per cluster
+    double cluster_radius = 0.0; ///< clustered: standard deviation of a fracture's offset from its cluster's centre (m)
+    FractureOrientationSpec orientation;
+    FractureLengthSpec length;
+    double p21 = 0.0;            ///< target trace length per unit area (1/m) ...
+    long count = 0;              ///< ... or number of fracture centres in the region
+    /// Fractures that cross a fracture of one of these earlier sets end there, at
+    /// each crossing with this probability (on each side of the centre).
+    std::vector<int> terminate_at;
+    double terminate_probability = 0.0;
+    std::string property;        ///< joint property of its traces ("" = by the assignment rules)
+    std::uint64_t seed = 1;
+    std::vector<SegmentSpec> traces; ///< given traces (from a file); non-empty = not generated
+    std::string file;            ///< where `traces` came from (for the report)
+};
+
 /// The triangle mesh of a region's deformable blocks (SPEC §6). A region with a mesh
 /// has deformable blocks: every block of its pattern is meshed into constant-strain
 /// triangles (with pattern `single`, the pieces of the region are the blocks: an
@@ -125,6 +168,7 @@ struct RegionSpec {
     PatternSpec pattern;
     std::vector<SegmentSpec> joints;
     std::vector<JointSetSpec> joint_sets;
+    std::vector<DfnSetSpec> dfn; ///< fracture sets, in order (a set may end at the earlier ones)
     MeshSpec mesh;
 };
 

@@ -216,18 +216,21 @@ void build_joints(BlockAssembly& a) {
     const double cell = 2.0 * total / double(edges.size());
     const SegmentGrid grid(std::move(segs), cell);
 
-    std::vector<std::pair<Vec2, Vec2>> real;
+    std::vector<std::pair<Vec2, Vec2>> real, fracture;
     for (const auto& s : a.real_segments) real.push_back({s.a, s.b});
-    const SegmentGrid real_grid(std::move(real), cell);
-    auto on_real_joint = [&](Vec2 p0, Vec2 p1) {
+    for (const auto& s : a.fracture_traces) fracture.push_back({s.a, s.b});
+    const SegmentGrid real_grid(std::move(real), cell), fracture_grid(std::move(fracture), cell);
+    // The segment of `grid` that the joint p0p1 lies on (its middle on it, parallel), or −1.
+    auto on_segment = [&](const SegmentGrid& g, Vec2 p0, Vec2 p1) {
         const Vec2 m = 0.5 * (p0 + p1);
-        bool hit = false;
+        int hit = -1;
         Box2 b;
         b.add(m);
-        real_grid.for_each_near(b, [&](int s) {
-            const auto& [ra, rb] = real_grid.segments()[s];
-            hit = hit || (distance_to_segment(m, ra, rb) <= tol &&
-                          std::abs(cross(rb - ra, p1 - p0)) <= tol * norm(rb - ra));
+        g.for_each_near(b, [&](int s) {
+            const auto& [ra, rb] = g.segments()[s];
+            if (hit < 0 && distance_to_segment(m, ra, rb) <= tol &&
+                std::abs(cross(rb - ra, p1 - p0)) <= tol * norm(rb - ra))
+                hit = s;
         });
         return hit;
     };
@@ -265,7 +268,10 @@ void build_joints(BlockAssembly& a) {
             j.p1 = (sp < len) ? F.p : E.q;
             if (a.region[E.block] != a.region[F.block]) {
                 j.tag = JointTag::interface;
-            } else if (on_real_joint(j.p0, j.p1)) {
+            } else if (const int hit = on_segment(fracture_grid, j.p0, j.p1); hit >= 0) {
+                j.tag = JointTag::fracture;
+                j.fracture_set = a.fracture_trace_set[hit];
+            } else if (on_segment(real_grid, j.p0, j.p1) >= 0) {
                 j.tag = JointTag::real_joint;
             } else if (a.pattern[E.block] == PatternSpec::Kind::trigon) {
                 j.tag = a.parent[E.block] == a.parent[F.block] ? JointTag::radial : JointTag::peripheral;

@@ -68,6 +68,26 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
     }
     std::map<std::string, int> tags;
     for (const auto& j : a.joints) ++tags[meshing::to_string(j.tag)];
+    // The fracture network as built against what was asked (meshing/dfn.hpp).
+    json fracture_sets = json::array();
+    for (std::size_t k = 0; k < a.fracture_stats.size(); ++k) {
+        const auto& f = a.fracture_stats[k];
+        fracture_sets.push_back({{"name", f.name},
+                                 {"region", a.region_names[a.fracture_sets[k].region]},
+                                 {"fractures", f.fractures},
+                                 {"traces", f.traces},
+                                 {"P20", f.p20},
+                                 {"P21", f.p21},
+                                 {"P21_target", f.p21_target},
+                                 {"P10_x", f.p10_x},
+                                 {"P10_y", f.p10_y},
+                                 {"mean_angle", f.mean_angle},
+                                 {"concentration", f.concentration},
+                                 {"mean_length", f.mean_length},
+                                 {"std_length", f.std_length},
+                                 {"mean_length_target", f.mean_length_target},
+                                 {"mean_trace_length", f.mean_trace}});
+    }
     return {{"blocks", a.block_count()},
             {"joints", a.joints.size()},
             {"joints_by_tag", tags},
@@ -78,7 +98,9 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
             {"min_edge_length", inner_blocks ? min_edge : 0.0},
             {"collapsed_edges", st.collapsed_edges},
             {"short_edges_left", st.short_edges_left},
+            {"unsplit_blocks", st.unsplit_blocks},
             {"regions", regions},
+            {"fracture_sets", fracture_sets},
             {"seconds", {{"regions", st.seconds_regions},
                          {"patterns", st.seconds_patterns},
                          {"topology", st.seconds_topology},
@@ -112,6 +134,7 @@ int run_mesh(const MeshCommand& command, bool quiet, bool check_only) {
     io::make_output_directory(out);
     io::write_blocks_vtu(blocks, out / "blocks.vtu");
     io::write_joints_vtu(blocks, out / "joints.vtu");
+    if (!blocks.fracture_traces.empty()) io::write_fractures_vtu(blocks, out / "fractures.vtu");
     io::draw_blocks(blocks, out / "blocks.png", picture);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const auto summary = mesh_summary(blocks, stats, seconds);
@@ -125,7 +148,24 @@ int run_mesh(const MeshCommand& command, bool quiet, bool check_only) {
                         r["name"].get<std::string>().c_str(), r["pattern"].get<std::string>().c_str(),
                         r["blocks"].get<int>(), r["area"].get<double>(), r["mean_feret_diameter"].get<double>(),
                         r["equal_area_diameter"].get<double>());
-        std::printf("  wrote %s/{blocks.vtu, joints.vtu, blocks.png, summary.json}\n", out.string().c_str());
+        if (stats.unsplit_blocks > 0)
+            std::printf("  warning: %d blocks that a trace ends in could not be split along it (not simple "
+                        "polygons): those traces stop short of their tips\n",
+                        stats.unsplit_blocks);
+        for (const auto& f : summary["fracture_sets"]) {
+            std::printf("  fracture set %-8s %6d fractures, P21 %.4g /m", f["name"].get<std::string>().c_str(),
+                        f["fractures"].get<int>(), f["P21"].get<double>());
+            if (f["P21_target"].get<double>() > 0) std::printf(" (asked %.4g)", f["P21_target"].get<double>());
+            std::printf(", P20 %.4g /m², P10 %.4g (x) %.4g (y) /m, mean angle %.1f° (κ %.3g), length %.3g ± %.3g m",
+                        f["P20"].get<double>(), f["P10_x"].get<double>(), f["P10_y"].get<double>(),
+                        f["mean_angle"].get<double>(), f["concentration"].get<double>(), f["mean_length"].get<double>(),
+                        f["std_length"].get<double>());
+            if (f["mean_length_target"].get<double>() > 0)
+                std::printf(" (asked mean %.3g)", f["mean_length_target"].get<double>());
+            std::printf("\n");
+        }
+        std::printf("  wrote %s/{blocks.vtu, joints.vtu%s, blocks.png, summary.json}\n", out.string().c_str(),
+                    blocks.fracture_traces.empty() ? "" : ", fractures.vtu");
     }
     return 0;
 }

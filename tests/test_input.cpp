@@ -1275,3 +1275,85 @@ TEST_CASE("mesh and elasticity mistakes") {
     check_error(with("[[material]]\nname = \"rock\"\nyung = 1e10\n"), "yung", "material[0].yung",
                 "did you mean 'young'?");
 }
+
+TEST_CASE("fracture sets: a generated set, a set read from a CSV file, and their mistakes") {
+    const std::string set = "[[region.dfn]]\nname = \"J1\"\norientation = { distribution = \"von_mises\", mean = 30.0, "
+                            "concentration = 20.0 }\nlength = { distribution = \"power_law\", exponent = 2.5, min = "
+                            "0.1, max = 1.0 }\np21 = 2.0\nseed = 7\n";
+    const auto mf = parse_model(with(set + "\n[[region.dfn]]\nname = \"J2\"\norientation = { distribution = \"list\", "
+                                           "angles = [100.0, -10.0], weights = [2.0, 1.0] }\nlength = { distribution "
+                                           "= \"lognormal\", mean = 0.5, std = 0.2 }\ncount = 40\ncentres = "
+                                           "\"clustered\"\ncluster = { size = 5, radius = 0.1 }\nterminate = { at = "
+                                           "[\"J1\"], probability = 0.3 }\n"),
+                                "t.toml");
+    const auto& dfn = mf.geometry.regions[0].dfn;
+    REQUIRE(dfn.size() == 2);
+    CHECK(dfn[0].p21 == 2.0);
+    CHECK(dfn[0].seed == 7);
+    CHECK(dfn[0].length.kind == bbm::meshing::FractureLengthSpec::Kind::power_law);
+    CHECK(dfn[0].length.exponent == 2.5);
+    CHECK(dfn[1].count == 40);
+    CHECK(dfn[1].orientation.angles == std::vector<double>{100.0, 170.0});
+    CHECK(dfn[1].centres == bbm::meshing::DfnSetSpec::Centres::clustered);
+    CHECK(dfn[1].terminate_at == std::vector<int>{0});
+    CHECK(dfn[1].terminate_probability == 0.3);
+
+    check_error(with(set + "count = 10\n"), "[[region.dfn]]", "region[0].dfn[0]",
+                "give the set's intensity as 'p21' (trace length per m²) or 'count', one of them");
+    check_error(with("[[region.dfn]]\nname = \"J\"\norientation = { distribution = \"uniform\" }\nlength = { "
+                     "distribution = \"pareto\", min = 1.0 }\np21 = 1.0\n"),
+                "length =", "region[0].dfn[0].length.distribution", "unknown length distribution 'pareto'");
+    check_error(with("[[region.dfn]]\nname = \"J\"\norientation = { distribution = \"uniform\" }\nlength = { "
+                     "distribution = \"power_law\", exponent = 2.0, max = 1.0 }\np21 = 1.0\n"),
+                "length =", "region[0].dfn[0].length.min", "missing required key 'min'");
+    check_error(with("[[region.dfn]]\nname = \"J\"\norientation = { distribution = \"uniform\" }\nlength = { "
+                     "distribution = \"lognormal\", mean = 1.0, std = 0.5, exponent = 2.0 }\np21 = 1.0\n"),
+                "length =", "region[0].dfn[0].length.exponent",
+                "does not apply to a lognormal length distribution");
+    check_error(with("[[region.dfn]]\nname = \"J\"\norientation = { distribution = \"uniform\" }\nlength = { "
+                     "distribution = \"exponential\", mean = 1.0, min = 2.0, max = 2.0 }\np21 = 1.0\n"),
+                "length =", "region[0].dfn[0].length.max", "must be above min = 2 m, got 2");
+    check_error(with(set + "terminate = { at = [\"J2\"], probability = 0.5 }\n"), "terminate", "region[0].dfn[0].terminate.at[0]",
+                "a fracture set ends only at an earlier set of its region; there is none before 'J1', got 'J2'");
+    check_error(with("[[region.dfn]]\nname = \"J\"\norientation = { distribution = \"list\", angles = [0.0, 90.0], "
+                     "weights = [1.0] }\nlength = { distribution = \"fixed\", value = 1.0 }\ncount = 3\n"),
+                "orientation =", "region[0].dfn[0].orientation.weights", "must give one weight per angle");
+    check_error(with("[[region.dfn]]\nname = \"J\"\ncentres = \"clustered\"\norientation = { distribution = "
+                     "\"uniform\" }\nlength = { distribution = \"fixed\", value = 1.0 }\ncount = 3\n"),
+                "[[region.dfn]]", "region[0].dfn[0].cluster", "clustered centres need cluster");
+    check_error(with(set + "property = \"joints\"\n" + std::string(bond)), "property = \"joints\"",
+                "region[0].dfn[0].property", "unknown joint property 'joints'");
+    check_error(with(set + "[[region.dfn]]\nname = \"J1\" # again\n"), "\"J1\" # again",
+                "region[0].dfn[1].name", "fracture set name 'J1' is already used by dfn[0]");
+
+    // Traces from a CSV file (a header, comments, a set column), and its mistakes:
+    // the CSV file's own line.
+    const std::string csv = "/tmp/bbm_test_traces.csv";
+    {
+        std::ofstream out(csv);
+        out << "x1,y1,x2,y2,set\n# mapped on the wall\n-0.5, 0.0, 0.5, 0.1, A\n0.0,-0.5,0.1,0.5,B\n\n0.2,0.2,0.4,0.4,A\n";
+    }
+    const auto traced = parse_model(with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + csv + "\"\nset = \"A\"\n"), "t.toml");
+    REQUIRE(traced.geometry.regions[0].dfn[0].traces.size() == 2);
+    CHECK(traced.geometry.regions[0].dfn[0].traces[1].b.x == 0.4);
+    check_error(with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + csv + "\"\nset = \"C\"\n"), "file =",
+                "region[0].dfn[0].file", "has no traces of set 'C'");
+    check_error(with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + csv + "\"\np21 = 1.0\n"), "p21",
+                "region[0].dfn[0].p21", "does not apply to a fracture set read from a file");
+    {
+        std::ofstream out(csv);
+        out << "-0.5, 0.0, 0.5, 0.1\n0.0,-0.5,0.1\n";
+    }
+    try {
+        parse_model(with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + csv + "\"\n"), "t.toml");
+        FAIL("no error for a short CSV row");
+    } catch (const InputError& e) {
+        CHECK(e.file() == csv);
+        CHECK(e.line() == 2);
+        CHECK(e.key() == "region[0].dfn[0].file");
+        CHECK(std::string(e.what()).find("expected x1, y1, x2, y2[, set]") != std::string::npos);
+    }
+    std::remove(csv.c_str());
+    check_error(with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + csv + "\"\n"), "file =", "region[0].dfn[0].file",
+                "cannot open the trace file");
+}

@@ -227,7 +227,7 @@ TEST_CASE("joints.vtu: one line per joint, with tag, blocks and length") {
 
     auto* tag_names = vtkStringArray::SafeDownCast(grid->GetFieldData()->GetAbstractArray("tag_names"));
     REQUIRE(tag_names != nullptr);
-    REQUIRE(tag_names->GetNumberOfValues() == static_cast<int>(JointTag::interface) + 1);
+    REQUIRE(tag_names->GetNumberOfValues() == static_cast<int>(JointTag::fracture) + 1);
     for (int k = 0; k <= static_cast<int>(JointTag::interface); ++k)
         CHECK(tag_names->GetValue(k) == meshing::to_string(static_cast<JointTag>(k)));
 }

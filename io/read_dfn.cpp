@@ -1,0 +1,236 @@
+// bbm io: the [[region.dfn]] tables of a model file — fracture sets of a discrete
+// fracture network, generated (meshing/dfn.hpp) or read from a CSV file of traces
+// (docs/input.md "Fracture networks").
+#include "io/reader.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace bbm::io::reader {
+
+using meshing::DfnSetSpec;
+using meshing::FractureLengthSpec;
+using meshing::FractureOrientationSpec;
+using meshing::SegmentSpec;
+
+namespace {
+
+constexpr std::array<std::string_view, 4> length_laws{"fixed", "power_law", "lognormal", "exponential"};
+constexpr std::array<std::string_view, 3> angle_laws{"von_mises", "uniform", "list"};
+constexpr std::array<std::string_view, 2> centre_kinds{"poisson", "clustered"};
+
+FractureLengthSpec read_length(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a length table { distribution = ..., ... }");
+    using K = FractureLengthSpec::Kind;
+    FractureLengthSpec l;
+    l.kind = static_cast<K>(choice(c, t, p, "distribution", length_laws, "length distribution"));
+    static constexpr std::array<std::string_view, 7> all{"distribution", "value", "exponent", "mean",
+                                                         "std",          "min",   "max"};
+    static constexpr std::array<std::string_view, 2> fixed_keys{"distribution", "value"};
+    static constexpr std::array<std::string_view, 4> power_keys{"distribution", "exponent", "min", "max"};
+    static constexpr std::array<std::string_view, 5> lognormal_keys{"distribution", "mean", "std", "min", "max"};
+    static constexpr std::array<std::string_view, 4> exponential_keys{"distribution", "mean", "min", "max"};
+    const Keys keys = l.kind == K::fixed       ? Keys(fixed_keys)
+                      : l.kind == K::power_law ? Keys(power_keys)
+                      : l.kind == K::lognormal ? Keys(lognormal_keys)
+                                               : Keys(exponential_keys);
+    check_keys(c, t, p, keys, all,
+               "a " + std::string(length_laws[static_cast<std::size_t>(l.kind)]) + " length distribution");
+    switch (l.kind) {
+    case K::fixed: l.value = required_number(c, t, p, "value", above(0, metres)); break;
+    case K::power_law:
+        l.exponent = required_number(c, t, p, "exponent", above(0, ""));
+        l.min = required_number(c, t, p, "min", above(0, metres));
+        l.max = required_number(c, t, p, "max", above(0, metres));
+        break;
+    case K::lognormal:
+        l.mean = required_number(c, t, p, "mean", above(0, metres));
+        l.std_dev = required_number(c, t, p, "std", above(0, metres));
+        [[fallthrough]];
+    case K::exponential:
+        if (l.kind == K::exponential) l.mean = required_number(c, t, p, "mean", above(0, metres));
+        l.min = number(c, t, p, "min", at_least(0, metres)).value_or(0.0);
+        l.max = number(c, t, p, "max", above(0, metres)).value_or(0.0);
+        break;
+    }
+    if (l.max > 0.0 && !(l.max > l.min))
+        c.fail(*t.get("max"), p.key("max"), "must be above min = " + fmt(l.min) + " m, got " + fmt(l.max));
+    return l;
+}
+
+FractureOrientationSpec read_orientation(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "an orientation table { distribution = ..., ... }");
+    using K = FractureOrientationSpec::Kind;
+    FractureOrientationSpec o;
+    o.kind = static_cast<K>(choice(c, t, p, "distribution", angle_laws, "orientation distribution"));
+    static constexpr std::array<std::string_view, 5> all{"distribution", "mean", "concentration", "angles",
+                                                         "weights"};
+    static constexpr std::array<std::string_view, 3> von_mises_keys{"distribution", "mean", "concentration"};
+    static constexpr std::array<std::string_view, 1> uniform_keys{"distribution"};
+    static constexpr std::array<std::string_view, 3> list_keys{"distribution", "angles", "weights"};
+    const Keys keys = o.kind == K::von_mises ? Keys(von_mises_keys)
+                      : o.kind == K::uniform ? Keys(uniform_keys)
+                                             : Keys(list_keys);
+    check_keys(c, t, p, keys, all,
+               "a " + std::string(angle_laws[static_cast<std::size_t>(o.kind)]) + " orientation distribution");
+    if (o.kind == K::von_mises) {
+        o.mean = required_number(c, t, p, "mean", unbounded(degrees));
+        o.concentration = required_number(c, t, p, "concentration", at_least(0, ""));
+    } else if (o.kind == K::list) {
+        auto numbers = [&](std::string_view key, const Range& r, std::vector<double>& out) {
+            const toml::node* n = key == "angles" ? &need(c, t, p, key, "an array of angles in degrees")
+                                                  : find(c, t, p, key);
+            if (!n) return;
+            const Path kp = p.key(key);
+            const toml::array& a = to_array(c, *n, kp, "an array of numbers");
+            if (a.empty()) c.fail(*n, kp, "must list at least one number, got an empty array");
+            for_each_element(c, a, kp, [&](const toml::node& e, const Path& ep) { out.push_back(checked_number(c, e, ep, r)); });
+        };
+        numbers("angles", unbounded(degrees), o.angles);
+        numbers("weights", above(0, ""), o.weights);
+        if (!o.weights.empty() && o.weights.size() != o.angles.size())
+            c.fail(*t.get("weights"), p.key("weights"),
+                   "must give one weight per angle: " + std::to_string(o.angles.size()) + " angles, " +
+                       std::to_string(o.weights.size()) + " weights");
+        for (double& a : o.angles) a = std::fmod(std::fmod(a, 180.0) + 180.0, 180.0);
+    }
+    return o;
+}
+
+/// Traces from a CSV file: x1, y1, x2, y2[, set] per line; blank lines, lines
+/// starting with '#' and a header line are skipped. With `only`, the rows whose
+/// fifth column is that set.
+std::vector<SegmentSpec> read_trace_file(const Ctx& c, const toml::node& n, const Path& p, const std::string& name,
+                                         const std::optional<std::string>& only) {
+    namespace fs = std::filesystem;
+    const fs::path path = fs::path(c.file).parent_path() / name;
+    std::ifstream in(path);
+    if (!in) c.fail(n, p, "cannot open the trace file " + path.string());
+    std::vector<SegmentSpec> traces;
+    std::string text;
+    int line_no = 0;
+    bool seen_data = false;
+    while (std::getline(in, text)) {
+        ++line_no;
+        if (!text.empty() && text.back() == '\r') text.pop_back();
+        const auto first = text.find_first_not_of(" \t");
+        if (first == std::string::npos || text[first] == '#') continue;
+        std::vector<std::string> cells;
+        std::stringstream row(text);
+        for (std::string cell; std::getline(row, cell, ',');) {
+            const auto a = cell.find_first_not_of(" \t"), b = cell.find_last_not_of(" \t");
+            cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
+        }
+        double v[4];
+        bool numeric = cells.size() >= 4;
+        for (int k = 0; numeric && k < 4; ++k) {
+            std::size_t used = 0;
+            try {
+                v[k] = std::stod(cells[k], &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            numeric = used == cells[k].size() && used > 0 && std::isfinite(v[k]);
+        }
+        if (!numeric && !seen_data) { // a header
+            seen_data = true;
+            continue;
+        }
+        seen_data = true;
+        if (!numeric || cells.size() > 5)
+            throw InputError(path.string(), line_no, p.full,
+                             "expected x1, y1, x2, y2[, set] (numbers, then an optional set name), got \"" + text +
+                                 "\"");
+        if (only && (cells.size() < 5 || cells[4] != *only)) continue;
+        const SegmentSpec s{{v[0], v[1]}, {v[2], v[3]}};
+        if (s.a == s.b)
+            throw InputError(path.string(), line_no, p.full, "the trace's two ends are the same point");
+        traces.push_back(s);
+    }
+    if (traces.empty())
+        c.fail(n, p,
+               "the trace file " + path.string() + " has no traces" +
+                   (only ? " of set " + reader::quoted(*only) : std::string()));
+    return traces;
+}
+
+} // namespace
+
+meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier) {
+    const toml::table& t = to_table(c, node, p, "a fracture set table ([[region.dfn]])");
+    static constexpr std::array<std::string_view, 12> all{"name",  "seed",      "centres",  "cluster",
+                                                          "orientation", "length", "p21", "count",
+                                                          "terminate", "property", "file", "set"};
+    static constexpr std::array<std::string_view, 10> generated_keys{
+        "name", "seed", "centres", "cluster", "orientation", "length", "p21", "count", "terminate", "property"};
+    static constexpr std::array<std::string_view, 4> file_keys{"name", "file", "set", "property"};
+    const bool from_file = t.contains("file");
+    check_keys(c, t, p, from_file ? Keys(file_keys) : Keys(generated_keys), all,
+               from_file ? "a fracture set read from a file" : "a generated fracture set");
+    DfnSetSpec s;
+    const Path np = p.key("name");
+    const toml::node& name = need(c, t, p, "name", "a non-empty string");
+    s.name = to_str(c, name, np);
+    if (s.name.empty()) c.fail(name, np, "must be a non-empty string, got \"\"");
+    for (std::size_t j = 0; j < earlier.size(); ++j)
+        if (earlier[j] == s.name)
+            c.fail(name, np, "fracture set name " + reader::quoted(s.name) + " is already used by dfn[" + std::to_string(j) + "]");
+    if (const toml::node* n = find(c, t, p, "property")) {
+        s.property = to_str(c, *n, p.key("property"));
+        if (s.property.empty()) c.fail(*n, p.key("property"), "must be a non-empty string, got \"\"");
+    }
+    if (from_file) {
+        const toml::node& f = *find(c, t, p, "file");
+        s.file = to_str(c, f, p.key("file"));
+        std::optional<std::string> only;
+        if (const toml::node* n = find(c, t, p, "set")) only = to_str(c, *n, p.key("set"));
+        s.traces = read_trace_file(c, f, p.key("file"), s.file, only);
+        earlier.push_back(s.name);
+        return s;
+    }
+    s.seed = seed(c, t, p).value_or(1);
+    if (const toml::node* n = find(c, t, p, "centres"))
+        s.centres = static_cast<DfnSetSpec::Centres>(to_choice(c, *n, p.key("centres"), centre_kinds, "centres"));
+    const toml::node* cluster = find(c, t, p, "cluster");
+    if (s.centres == DfnSetSpec::Centres::clustered) {
+        if (!cluster) c.fail(t, p.key("cluster"), "clustered centres need cluster = { size = ..., radius = ... }");
+        const Path cp = p.key("cluster");
+        const toml::table& ct = to_table(c, *cluster, cp, "a cluster table { size = ..., radius = ... }");
+        static constexpr std::array<std::string_view, 2> cluster_keys{"size", "radius"};
+        check_keys(c, ct, cp, cluster_keys);
+        s.cluster_size = required_number(c, ct, cp, "size", above(0, ""));
+        s.cluster_radius = required_number(c, ct, cp, "radius", above(0, metres));
+    } else if (cluster) {
+        c.fail(*cluster, p.key("cluster"), "applies to clustered centres only (centres = \"clustered\")");
+    }
+    s.orientation = read_orientation(c, need(c, t, p, "orientation", "an orientation table"), p.key("orientation"));
+    s.length = read_length(c, need(c, t, p, "length", "a length table"), p.key("length"));
+    const auto p21 = number(c, t, p, "p21", above(0, " 1/m"));
+    const auto count = integer(c, t, p, "count", 1, 100'000'000);
+    if (p21.has_value() == count.has_value())
+        c.fail(t, p, c.in_owner() + "give the set's intensity as 'p21' (trace length per m²) or 'count', one of them");
+    s.p21 = p21.value_or(0.0);
+    s.count = long(count.value_or(0));
+    if (const toml::node* n = find(c, t, p, "terminate")) {
+        const Path tp = p.key("terminate");
+        const toml::table& tt = to_table(c, *n, tp, "a table { at = [set names], probability = ... }");
+        static constexpr std::array<std::string_view, 2> terminate_keys{"at", "probability"};
+        check_keys(c, tt, tp, terminate_keys);
+        string_list(c, tt, tp, "at", "earlier fracture set", "", [&](const std::string& m, const toml::node& e, const Path& ep) {
+            const auto it = std::ranges::find(earlier, m);
+            if (it == earlier.end())
+                c.fail(e, ep,
+                       "a fracture set ends only at an earlier set of its region; " +
+                           (earlier.empty() ? std::string("there is none before ") + reader::quoted(s.name)
+                                            : "earlier sets are: " + join(std::vector<std::string_view>(earlier.begin(), earlier.end()))) +
+                           ", got " + reader::quoted(m));
+            s.terminate_at.push_back(int(it - earlier.begin()));
+        });
+        s.terminate_probability = required_number(c, tt, tp, "probability", Range{.lo = 0, .hi = 1, .lo_open = true, .unit = ""});
+    }
+    earlier.push_back(s.name);
+    return s;
+}
+
+} // namespace bbm::io::reader
