@@ -487,6 +487,20 @@ std::vector<SizeEstimate> check_model_size(const ModelGeometrySpec& spec, const 
                 }
         const RegionSpec& reg = spec.regions[r];
         estimate[r] = estimate_region(reg, cgal::area(domain[r]), toward_perimeter);
+        // A fracture network: the fractures drawn, and the blocks its traces add by
+        // splitting those they cross (about one per 0.8 block size of trace).
+        for (std::size_t k = 0; k < reg.dfn.size(); ++k) {
+            const auto size = dfn::expected_size(reg.dfn[k], domain[r]);
+            const double limit = spec.max_elements > 0 ? spec.max_elements : default_max_elements();
+            if (!(size.fractures <= limit))
+                throw GeometryError(r, "dfn[" + std::to_string(k) + "]",
+                                    "fracture set '" + reg.dfn[k].name + "' would draw about " + fmt(size.fractures) +
+                                        " fractures, over the limit of " + fmt(limit) +
+                                        " elements; give a lower intensity or raise the limit ([model] "
+                                        "max_elements, --max-elements)");
+            if (reg.pattern.kind != PatternSpec::Kind::single && reg.pattern.size > 0.0)
+                estimate[r].blocks += size.p21 * cgal::area(domain[r]) / (0.8 * reg.pattern.size);
+        }
         if (reg.pattern.kind != PatternSpec::Kind::single && estimate[r].blocks < 2)
             throw GeometryError(r, "pattern.size",
                                 "block size " + fmt(reg.pattern.size) + " m is too large for region '" + reg.name +

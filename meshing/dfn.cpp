@@ -316,6 +316,17 @@ std::vector<SegmentSpec> clip_to_domain(Vec2 a, Vec2 b, const cgal::Domain& doma
 
 } // namespace dfn
 
+namespace dfn {
+SetSize expected_size(const DfnSetSpec& s, const cgal::Domain& domain) {
+    if (!s.traces.empty()) return {double(s.traces.size()), 0.0};
+    const Box2 box = box_of(domain);
+    const double diagonal = norm(box.hi - box.lo), area = cgal::area(domain);
+    const double mean = mean_length(s.length, diagonal), longest = upper(s.length, diagonal);
+    const double density = s.p21 > 0.0 ? s.p21 / mean : double(s.count) / area;
+    return {density * (box.width() + longest) * (box.height() + longest), density * mean};
+}
+} // namespace dfn
+
 FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, const cgal::Domain& domain) {
     FractureNetwork net;
     const Box2 box = box_of(domain);
@@ -340,7 +351,7 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
         Box2 grown = box;
         grown.lo = grown.lo - Vec2{0.5 * longest, 0.5 * longest};
         grown.hi = grown.hi + Vec2{0.5 * longest, 0.5 * longest};
-        const long n = std::lround(density * grown.width() * grown.height());
+        const long n = std::lround(density * grown.width() * grown.height()); // dfn::expected_size
         std::vector<Vec2> centre(n);
         if (s.centres == DfnSetSpec::Centres::poisson) {
             for (auto& c : centre) c = {rng.uniform(grown.lo.x, grown.hi.x), rng.uniform(grown.lo.y, grown.hi.y)};

@@ -71,6 +71,13 @@ double length_cdf(const FractureLengthSpec& s, double diagonal, double x);
 /// P(θ ≤ x) of the angle law, x in degrees within [mean − 90, mean + 90) (von
 /// Mises) or [0, 180) (uniform, list).
 double angle_cdf(const FractureOrientationSpec& s, double x);
+/// Before generating: the fractures a set will draw (centres over the region's box
+/// grown by half the longest fracture) and the trace length per m² it will leave in
+/// the region (0 for given traces: their count is known).
+struct SetSize {
+    double fractures = 0.0, p21 = 0.0;
+};
+SetSize expected_size(const DfnSetSpec& s, const cgal::Domain& domain);
 /// Pieces of segment ab inside the domain.
 std::vector<SegmentSpec> clip_to_domain(Vec2 a, Vec2 b, const cgal::Domain& domain);
 } // namespace dfn

@@ -277,3 +277,50 @@ property = "bond"
     CHECK(trace_length[0] / 100.0 == doctest::Approx(a.fracture_stats[0].p21).epsilon(1e-9));
     CHECK(bridges > 100);
 }
+
+TEST_CASE("a network too large or too dense for the cutting is refused with the reason, before or instead of a crash") {
+    const auto model = [](const std::string& sets) {
+        return std::string(R"(
+[model]
+max_elements = 1000000
+
+[[region]]
+name = "rock mass"
+outline = { type = "rectangle", min = [0.0, 0.0], max = [40.0, 40.0] }
+pattern = { type = "voronoi", size = 0.5, seed = 3 }
+)") + sets + R"(
+[[joint_property]]
+name = "bond"
+law = "elastic"
+kn = 1e12
+ks = 1e12
+
+[[joint_assignment]]
+property = "bond"
+)";
+    };
+    const auto set = [](const std::string& name, double angle, long count, int seed, const std::string& extra) {
+        return "[[region.dfn]]\nname = \"" + name + "\"\norientation = { distribution = \"von_mises\", mean = " +
+               std::to_string(angle) + ", concentration = 10.0 }\nlength = { distribution = \"power_law\", exponent = "
+               "2.5, min = 0.5, max = 5.0 }\ncount = " + std::to_string(count) + "\nseed = " + std::to_string(seed) +
+               "\n" + extra;
+    };
+    auto error_of = [](const std::string& text) -> std::string {
+        auto mf = io::parse_model(text, "dense.toml");
+        try {
+            (void)generate_blocks(mf.geometry);
+        } catch (const GeometryError& e) {
+            return e.key() + ": " + e.what();
+        }
+        return "";
+    };
+    // Ten million fractures: refused from the estimate, before any is drawn.
+    const std::string huge = error_of(model(set("J1", 20.0, 10'000'000, 4, "")));
+    MESSAGE(huge);
+    CHECK(huge.find("dfn[0]: fracture set 'J1' would draw about") == 0);
+    // 5,000 + 5,000 fractures: faces pinched at crossings, refused with where.
+    const std::string dense = error_of(model(set("J1", 20.0, 5000, 4, "") +
+                                             set("J2", 110.0, 5000, 5, "terminate = { at = [\"J1\"], probability = 0.5 }\n")));
+    MESSAGE(dense);
+    CHECK(dense.find("dfn: the real joints and fractures cut region 'rock mass' into") == 0);
+}
