@@ -5,6 +5,7 @@
 //   bbm compare A.toml B.toml ...   run several models, tabulate and plot them
 //   bbm ucs | tension | biaxial | brazilian [flags]   numerical lab tests (SPEC §8)
 //   bbm envelope [flags]            the strength envelope: UCS, tension, biaxial; Hoek-Brown and Mohr-Coulomb fits
+//   bbm shear [flags]               direct shear of a joint or a non-persistent joint (CNL / CNS)
 //   bbm calibrate [flags]           micro-properties from macro targets
 //   bbm sweep MODEL --set KEY=V1,V2 --seeds S   runs over key values and seeds
 // Under mpirun the independent runs (realizations, calibration runs, compared
@@ -21,6 +22,7 @@
 #include "studies/envelope.hpp"
 #include "studies/ranks.hpp"
 #include "studies/run_model.hpp"
+#include "studies/shear.hpp"
 #include "studies/sweep.hpp"
 
 #include <CLI/CLI.hpp>
@@ -159,6 +161,15 @@ int run_cli(int argc, char** argv) {
                     "in --out.");
     studies::add_envelope_options(envelope_cmd, envelope_values, quiet);
 
+    studies::ShearCli shear_values;
+    auto* shear_cmd = app.add_subcommand(
+        "shear", "Direct shear test of a joint across a bonded-block specimen, persistent or with rock bridges "
+                 "(--persistence, --bridges), under constant normal load or constant normal stiffness "
+                 "(--normal-stiffness), at one or more normal stresses (--normal-stress 2e6,5e6,10e6). Writes "
+                 "summary.json (peak and residual strength, dilation, Coulomb fits), shear.csv, shear_stress.png, "
+                 "dilation.png and per run failure.png and result.pvd in --out.");
+    studies::add_shear_options(shear_cmd, shear_values, quiet);
+
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     const std::pair<const char*, const char*> labtests[] = {
         {"ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, the paper's calibration run "
@@ -208,6 +219,7 @@ int run_cli(int argc, char** argv) {
             return studies::run_model(run_options);
         }
         if (*envelope_cmd) return studies::run_envelope(envelope_values, quiet, check_only);
+        if (*shear_cmd) return studies::run_shear(shear_values, quiet, check_only);
         if (*calibrate_cmd) {
             studies::note_given_joint_values(*calibrate_cmd, calibrate_values);
             return studies::run_calibrate(calibrate_values, quiet, check_only);

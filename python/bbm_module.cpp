@@ -17,6 +17,7 @@
 #include "studies/commands.hpp"
 #include "studies/envelope.hpp"
 #include "studies/model.hpp"
+#include "studies/shear.hpp"
 
 #include <nlohmann/json.hpp>
 #include <pybind11/functional.h>
@@ -532,6 +533,32 @@ PYBIND11_MODULE(_bbm, mod) {
             json = studies::run_envelope_args(args, quiet).summary_json;
         }
         return py::module_::import("json").attr("loads")(json);
+    });
+    mod.def("_shear", [](const std::vector<std::string>& args, bool quiet) {
+        studies::ShearStudy study;
+        {
+            py::gil_scoped_release release;
+            study = studies::run_shear_args(args, quiet);
+        }
+        // Every run's curve as numpy arrays, in the order of summary["runs"].
+        py::list curves;
+        for (const auto& r : study.results) {
+            const auto n = py::ssize_t(r.curve.size());
+            auto step = fresh<std::int64_t>(n);
+            auto u = fresh<double>(n), tau = fresh<double>(n), sn = fresh<double>(n), dv = fresh<double>(n);
+            auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const auto& p = r.curve[i];
+                step.mutable_at(i) = p.step, u.mutable_at(i) = p.displacement, tau.mutable_at(i) = p.shear_stress;
+                sn.mutable_at(i) = p.normal_stress, dv.mutable_at(i) = p.dilation;
+                tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
+            }
+            py::dict c;
+            c["step"] = step, c["shear_displacement"] = u, c["shear_stress"] = tau, c["normal_stress"] = sn;
+            c["dilation"] = dv, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
+            curves.append(c);
+        }
+        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), curves);
     });
     mod.def("_calibrate", [](const std::vector<std::string>& args, bool quiet) {
         std::string json;

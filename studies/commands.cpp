@@ -408,7 +408,7 @@ void apply_pattern_flags(LabTestCli& c) {
     const std::map<std::string, meshing::PatternSpec::Kind> kinds{
         {"voronoi", meshing::PatternSpec::Kind::voronoi}, {"trigon", meshing::PatternSpec::Kind::trigon},
         {"delaunay", meshing::PatternSpec::Kind::delaunay}, {"hexagonal", meshing::PatternSpec::Kind::hexagonal},
-        {"brick", meshing::PatternSpec::Kind::brick}};
+        {"brick", meshing::PatternSpec::Kind::brick}, {"single", meshing::PatternSpec::Kind::single}};
     c.o.pattern = kinds.at(c.pattern);
     c.o.size_measure =
         c.size_measure == "area" ? meshing::PatternSpec::SizeMeasure::area : meshing::PatternSpec::SizeMeasure::feret;
@@ -468,11 +468,15 @@ void check_specimen_size(const LabTestCli& c) {
 
 } // namespace
 
+void apply_specimen_flags(LabTestCli& c) {
+    apply_pattern_flags(c);
+    apply_softening_flags(c);
+}
+
 void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind) {
     auto& o = c.o;
     o.kind = kind;
-    apply_pattern_flags(c);
-    apply_softening_flags(c);
+    apply_specimen_flags(c);
     o.rough_platens = c.platens == "rough";
     if (o.platen_friction >= 0.0 && (kind == LabTestOptions::Kind::tension || kind == LabTestOptions::Kind::brazilian))
         throw InputError("--platen-friction", 0, "",

@@ -76,6 +76,8 @@ LabTestStudy run_labtest_args(const std::string& command, const std::vector<std:
 /// and the specimen checked before anything is generated. Throws InputError
 /// naming the flag.
 void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind);
+/// --pattern, --size-measure and the softening flags applied to c.o (checked).
+void apply_specimen_flags(LabTestCli& c);
 /// A result as it travels between ranks (JSON text; doubles round-trip exactly), and back.
 std::string labtest_record_text(const LabTestResult& r);
 LabTestResult labtest_from_record_text(const std::string& text);

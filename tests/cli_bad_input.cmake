@@ -30,3 +30,13 @@ execute_process(COMMAND ${BBM} --config ${DIR}/ucs.toml ucs --quiet --out ${DIR}
 if(NOT status EQUAL 2 OR NOT err MATCHES "ucs.toml" OR NOT err MATCHES "widht")
   message(FATAL_ERROR "a bad key in --config should give status 2 naming file and key, got ${status}: ${err}")
 endif()
+# bbm shear: a bad combination of flags names the flag, exits 2 and keeps earlier output.
+execute_process(COMMAND ${BBM} shear --pattern single --persistence 0.5 --quiet --out ${DIR}/out
+                RESULT_VARIABLE status ERROR_VARIABLE err)
+if(NOT status EQUAL 2 OR NOT err MATCHES "--persistence")
+  message(FATAL_ERROR "bbm shear with a single pattern and rock bridges should name --persistence (${status}): ${err}")
+endif()
+file(READ ${DIR}/out/summary.json kept)
+if(NOT kept STREQUAL "earlier good output\n")
+  message(FATAL_ERROR "bbm shear changed earlier output")
+endif()

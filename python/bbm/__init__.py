@@ -28,10 +28,11 @@ from ._bbm import (  # noqa: F401  (re-exported)
     NumericalError,
     ZoneArrays,
 )
-from ._bbm import _calibrate, _envelope, _labtest
+from ._bbm import _calibrate, _envelope, _labtest, _shear
 
 __all__ = [
     "Model", "InputError", "NumericalError", "ucs", "tension", "biaxial", "brazilian", "calibrate", "to_toml",
+    "envelope", "shear",
 ]
 
 
@@ -191,6 +192,21 @@ def envelope(quiet=True, **options):
     the crack-initiation and crack-damage lines and every run. Files are written
     only with ``out``."""
     return _envelope(_option_args(options), quiet)
+
+
+def shear(quiet=True, **options):
+    """Direct shear test of a joint across a bonded-block specimen, as ``bbm
+    shear``: ``persistence`` (rock bridges for k < 1, ``bridges`` of them),
+    ``normal_stress`` (Pa; a list for a series), ``normal_stiffness`` (Pa/m; 0 =
+    constant normal load), the plane's ``joint_friction``, ``joint_cohesion``...
+    Returns the dict of summary.json (``levels``, ``peak_coulomb``,
+    ``residual_coulomb``, ``runs``) with each run's curve (``shear_displacement``,
+    ``shear_stress``, ``normal_stress``, ``dilation``, cracks) as numpy arrays in
+    ``runs[i]["curve"]``. Files are written only with ``out``."""
+    summary, curves = _shear(_option_args(options), quiet)
+    for run, curve in zip(summary["runs"], curves):
+        run["curve"] = curve
+    return summary
 
 
 def calibrate(quiet=True, **options):

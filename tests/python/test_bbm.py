@@ -5,6 +5,7 @@ Run by CTest (python.pytest) with PYTHONPATH=build/python, BBM_EXE (the bbm
 program) and BBM_SOURCE_DIR set."""
 
 import json
+import math
 import os
 import pathlib
 import subprocess
@@ -12,6 +13,7 @@ import sys
 import tomllib
 
 import numpy as np
+
 import pytest
 
 import bbm
@@ -220,6 +222,21 @@ def test_envelope_small_specimen():
     assert e["hoek_brown"]["valid"] and e["hoek_brown"]["mi"] > 0
     assert e["mohr_coulomb"]["valid"] and 0 < e["mohr_coulomb"]["friction_deg"] < 90
     assert 0 < e["tension"]["over_ucs"] < 0.3
+
+
+def test_shear_coulomb_joint():
+    """bbm.shear(): a planar 30-degree joint between rigid halves, two normal
+    stresses: peaks sigma_n tan 30, a Coulomb fit through the origin, curves as arrays."""
+    s = bbm.shear(pattern="single", normal_stress=[2e6, 4e6], max_displacement=3e-4, joint_friction=30.0)
+    assert len(s["runs"]) == 2
+    for run in s["runs"]:
+        assert run["peak_shear_stress"] == pytest.approx(run["normal_stress"] * math.tan(math.radians(30.0)), rel=1e-3)
+        curve = run["curve"]
+        assert curve["shear_stress"].shape == curve["shear_displacement"].shape
+        assert curve["shear_displacement"][-1] >= 3e-4
+    assert s["peak_coulomb"]["friction_deg"] == pytest.approx(30.0, abs=0.05)
+    with pytest.raises(bbm.InputError, match="--persistence"):
+        bbm.shear(pattern="single", persistence=0.5)
 
 
 def test_callback_exception_stops_and_propagates():
