@@ -194,3 +194,21 @@ JointState state_of(const JointHistory& h) {
 }
 
 } // namespace bbm::contact
+
+namespace bbm {
+
+std::vector<double> strength_class_factors(double m, int classes) {
+    std::vector<double> f(std::max(classes, 1), 1.0);
+    if (!(m > 0.0)) return f;
+    double mean = 0.0;
+    for (std::size_t k = 0; k < f.size(); ++k) {
+        const double q = (double(k) + 0.5) / double(f.size());
+        f[k] = std::pow(-std::log1p(-q), 1.0 / m);
+        mean += f[k];
+    }
+    mean /= double(f.size());
+    for (double& x : f) x /= mean;
+    return f;
+}
+
+} // namespace bbm

@@ -139,19 +139,47 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         laws_.push_back(contact::make_law(p));
         property_names_.push_back(p.name);
     }
+    // The specs behind laws_, derived sets included.
+    std::vector<JointPropertySpec> specs = an.joint_properties;
+    auto derive = [&](JointPropertySpec p) {
+        laws_.push_back(contact::make_law(p));
+        property_names_.push_back(p.name);
+        specs.push_back(std::move(p));
+        return int(laws_.size()) - 1;
+    };
     // Joints between blocks that take a fraction f of the deformation are stiffer
     // by 1/(1 − f): one derived set per (set, f).
     std::map<std::pair<int, double>, int> split_sets;
     auto split_property = [&](int prop, double f) {
         if (f <= 0.0) return prop;
         if (auto it = split_sets.find({prop, f}); it != split_sets.end()) return it->second;
-        JointPropertySpec p = an.joint_properties[prop];
+        JointPropertySpec p = specs[prop];
         p.kn /= 1.0 - f;
         p.ks /= 1.0 - f;
         p.name += " (deformable fraction " + std::to_string(f) + ")";
-        laws_.push_back(contact::make_law(p));
-        property_names_.push_back(p.name);
-        return split_sets[{prop, f}] = int(laws_.size()) - 1;
+        return split_sets[{prop, f}] = derive(std::move(p));
+    };
+    // Heterogeneous strengths: the joint's class (a derived set with the class's
+    // strength factor) from the set's seed and the joint's index — the same on
+    // every run, thread count and restart.
+    std::map<std::pair<int, int>, int> class_sets;
+    auto strength_class = [&](int prop, std::size_t joint) {
+        const JointPropertySpec& base = specs[prop];
+        if (!(base.weibull_modulus > 0.0) || base.law == JointPropertySpec::Law::elastic) return prop;
+        const int classes = std::max(1, base.strength_classes);
+        std::uint64_t z = base.strength_seed * 0x9E3779B97F4A7C15ull + joint + 0x632BE59BD9B4E019ull;
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull; // splitmix64's finaliser
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        const int k = int(z % std::uint64_t(classes));
+        if (auto it = class_sets.find({prop, k}); it != class_sets.end()) return it->second;
+        const double f = strength_class_factors(base.weibull_modulus, classes)[k];
+        JointPropertySpec p = base;
+        p.tensile *= f;
+        p.cohesion *= f;
+        p.weibull_modulus = 0.0;
+        p.name += " (strength class " + std::to_string(k + 1) + " of " + std::to_string(classes) + ")";
+        return class_sets[{prop, k}] = derive(std::move(p));
     };
 
     // Joint records -> point contacts, one at each end with half the joint length.
@@ -183,6 +211,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
                              std::string("no joint property is assigned to ") + meshing::to_string(j.tag) +
                                  " joints between regions '" + region_names_[a.region[j.block_a]] + "' and '" +
                                  region_names_[a.region[j.block_b]] + "'");
+        prop = strength_class(prop, std::size_t(&j - a.joints.data()));
         prop = split_property(prop, std::min(fraction_of(j.block_a), fraction_of(j.block_b)));
         const double half = 0.5 * j.length();
         mean_edge += j.length();

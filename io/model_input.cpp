@@ -515,8 +515,24 @@ double peak(const Ctx& c, const toml::table& t, const Path& p, std::string_view 
     return v;
 }
 
+/// weibull_modulus, strength_classes, strength_seed: heterogeneous strengths.
+void read_heterogeneity(const Ctx& c, const toml::table& t, const Path& p, JointPropertySpec& j) {
+    if (const auto m = number(c, t, p, "weibull_modulus", above(0, ""))) {
+        if (!(j.cohesion > 0 || j.tensile > 0))
+            c.fail(*t.get("weibull_modulus"), p.key("weibull_modulus"),
+                   "heterogeneous strengths need a bond: cohesion or tensile > 0");
+        j.weibull_modulus = *m;
+    } else {
+        for (const char* key : {"strength_classes", "strength_seed"})
+            if (t.contains(key)) c.fail(*t.get(key), p.key(key), "goes with weibull_modulus");
+    }
+    j.strength_classes = int(integer(c, t, p, "strength_classes", 1, 1000).value_or(j.strength_classes));
+    j.strength_seed = std::uint64_t(
+        integer(c, t, p, "strength_seed", 0, std::numeric_limits<std::int64_t>::max()).value_or(1));
+}
+
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 10> all_keys{"name",
+    static constexpr std::array<std::string_view, 13> all_keys{"name",
                                                                "law",
                                                                "kn",
                                                                "ks",
@@ -524,6 +540,9 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
                                                                "residual_friction",
                                                                "cohesion",
                                                                "tensile",
+                                                               "weibull_modulus",
+                                                               "strength_classes",
+                                                               "strength_seed",
                                                                "tension_softening",
                                                                "shear_softening"};
     check_keys(c, t, p, all_keys);
@@ -532,7 +551,7 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
     j.name = read_name(c, t, p, names);
     j.law = static_cast<Law>(choice(c, t, p, "law", laws, "joint law"));
     const Keys keys = j.law == Law::elastic   ? Keys(all_keys).first(4)
-                      : j.law == Law::coulomb ? Keys(all_keys).first(8)
+                      : j.law == Law::coulomb ? Keys(all_keys).first(11)
                                               : Keys(all_keys);
     check_keys(c, t, p, keys, all_keys,
                article(laws[static_cast<std::size_t>(j.law)]) + " joint property");
@@ -544,12 +563,13 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
     if (j.law == Law::coulomb) {
         j.cohesion = number(c, t, p, "cohesion", at_least(0, pascals)).value_or(0.0);
         j.tensile = number(c, t, p, "tensile", at_least(0, pascals)).value_or(0.0);
-        return j;
+    } else {
+        j.cohesion = peak(c, t, p, "cohesion", "shear softening");
+        j.tensile = peak(c, t, p, "tensile", "tension softening");
+        j.tension_softening = read_curve(c, t, p, "tension_softening");
+        j.shear_softening = read_curve(c, t, p, "shear_softening");
     }
-    j.cohesion = peak(c, t, p, "cohesion", "shear softening");
-    j.tensile = peak(c, t, p, "tensile", "tension softening");
-    j.tension_softening = read_curve(c, t, p, "tension_softening");
-    j.shear_softening = read_curve(c, t, p, "shear_softening");
+    read_heterogeneity(c, t, p, j);
     return j;
 }
 
@@ -1002,6 +1022,14 @@ std::string edit_model_text(std::string_view text, const std::string& name,
                 if (type != "voronoi" && type != "trigon" && type != "delaunay") continue;
                 const auto seed = (*pattern)["seed"].value_or(std::int64_t{1});
                 pattern->insert_or_assign("seed", seed + seed_offset);
+            }
+        // Heterogeneous joint strengths draw from strength_seed + offset.
+        if (auto* properties = doc["joint_property"].as_array())
+            for (auto& j : *properties) {
+                auto* t = j.as_table();
+                if (!t || !(*t)["weibull_modulus"]) continue;
+                const auto seed = (*t)["strength_seed"].value_or(std::int64_t{1});
+                t->insert_or_assign("strength_seed", seed + seed_offset);
             }
     }
     std::ostringstream out;

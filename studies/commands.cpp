@@ -230,6 +230,12 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
     sub->add_option("--residual-friction", o.joint.residual_friction, "Friction after failure (degrees; default: --friction)")
         ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--weibull-m", o.joint.weibull_modulus,
+                    "Heterogeneous bonds: tensile strength and cohesion of each joint times a Weibull factor of "
+                    "this modulus and mean 1 (small: heterogeneous; 0: every joint the same)")
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--strength-classes", o.joint.strength_classes, "Heterogeneous bonds: classes the Weibull law is discretised into")
+        ->check(cli::whole_at_least(1))->capture_default_str();
     sub->add_option("--tension-softening", c.tension_softening, "Tension softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
@@ -284,6 +290,23 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
                     "Confined tests: stop this much axial strain past the peak once the specimen has failed (0: go on "
                     "to --max-strain or --stop-fraction; bbm envelope uses 1e-3)")
         ->check(cli::non_negative());
+    sub->add_option_function<double>(
+           "--joint-set-angle", [&o](const double& a) { o.joint_set = true, o.joint_set_angle = a; },
+           "A persistent joint set across the specimen at this angle from horizontal (degrees; a single plane "
+           "of weakness through the centre unless --joint-set-spacing), a Coulomb joint (--joint-set-friction, "
+           "--joint-set-cohesion, --joint-set-tensile: a brittle weak bond when > 0)")
+        ->check(cli::in_range(0.0, 180.0));
+    sub->add_option("--joint-set-spacing", o.joint_set_spacing, "Joint set: spacing along the normal (m; 0 = one joint)")
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--joint-set-friction", o.joint_set_joint.friction, "Joint set: friction angle (degrees)")
+        ->check(cli::in_range(0.0, 89.9))->capture_default_str();
+    sub->add_option("--joint-set-residual-friction", o.joint_set_joint.residual_friction,
+                    "Joint set: friction after its bond fails (degrees; default --joint-set-friction)")
+        ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--joint-set-cohesion", o.joint_set_joint.cohesion, "Joint set: cohesion (Pa)")
+        ->check(cli::non_negative())->capture_default_str();
+    sub->add_option("--joint-set-tensile", o.joint_set_joint.tensile, "Joint set: tensile strength (Pa)")
+        ->check(cli::non_negative())->capture_default_str();
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--threads", c.threads,
@@ -303,6 +326,7 @@ nlohmann::json labtest_json(const LabTestResult& r) {
             {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
             {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
             {"post_peak_locking", r.post_peak_locking},
+            {"joint_slip_stress", r.joint_slip_stress}, {"joint_slip_stress_half", r.joint_slip_stress_half},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
                                    {"within_30_of_vertical", r.cracks_near_vertical},
@@ -332,6 +356,7 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.tensile_strength = j["tensile_strength"], r.blocks = j["blocks"], r.contacts = j["contacts"];
     r.steps = j["steps"], r.wall_seconds = j["wall_seconds"], r.peak_passed = j["peak_passed"];
     r.post_peak_locking = j["post_peak_locking"];
+    r.joint_slip_stress = j["joint_slip_stress"], r.joint_slip_stress_half = j["joint_slip_stress_half"];
     r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
     const auto& o = j["crack_orientation"];
     r.crack_orientation = o["counts"].get<std::array<int, 12>>();
@@ -482,6 +507,10 @@ void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind) {
         throw InputError("--platen-friction", 0, "",
                          std::string("applies to ucs and biaxial only: ") + labtest_name(kind) +
                              " needs platens that hold the specimen (use --platens rough or smooth)");
+    if (o.joint_set && kind == LabTestOptions::Kind::brazilian)
+        throw InputError("--joint-set-angle", 0, "", "a joint set crosses rectangular specimens: not the brazilian disc");
+    if (o.joint_set && o.joint_set_spacing > 0 && o.joint_set_spacing < o.size)
+        throw InputError("--joint-set-spacing", 0, "", "closer than a block size (--size)");
     check_specimen_size(c);
 }
 

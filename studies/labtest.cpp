@@ -29,6 +29,32 @@ bool uses_platen_blocks(const LabTestOptions& o) {
     return o.platen_friction >= 0.0 && (o.kind == LabTestOptions::Kind::ucs || o.kind == LabTestOptions::Kind::biaxial);
 }
 
+std::vector<meshing::SegmentSpec> joint_set_traces(const LabTestOptions& o) {
+    const double a = o.joint_set_angle * std::numbers::pi / 180.0;
+    const Vec2 t{std::cos(a), std::sin(a)}, n{-t.y, t.x}, centre{0.5 * o.width, 0.5 * o.height};
+    const double reach = std::hypot(o.width, o.height);
+    const int lines = o.joint_set_spacing > 0 ? int(reach / o.joint_set_spacing) + 1 : 0;
+    std::vector<meshing::SegmentSpec> traces;
+    for (int k = -lines; k <= lines; ++k) {
+        // The line centre + k s n + λ t clipped to the rectangle (Liang–Barsky).
+        const Vec2 p = centre + (k * o.joint_set_spacing) * n;
+        double lo = -reach, hi = reach;
+        const double start[2] = {p.x, p.y}, dir[2] = {t.x, t.y}, box_lo[2] = {0.0, 0.0}, box_hi[2] = {o.width, o.height};
+        for (int i = 0; i < 2; ++i) {
+            if (std::abs(dir[i]) < 1e-12) {
+                if (start[i] <= box_lo[i] || start[i] >= box_hi[i]) lo = hi; // outside
+                continue;
+            }
+            double l0 = (box_lo[i] - start[i]) / dir[i], l1 = (box_hi[i] - start[i]) / dir[i];
+            if (l0 > l1) std::swap(l0, l1);
+            lo = std::max(lo, l0), hi = std::min(hi, l1);
+        }
+        // Not the slivers a trace through a corner would cut off.
+        if (hi - lo > o.size) traces.push_back({p + lo * t, p + hi * t});
+    }
+    return traces;
+}
+
 meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
     meshing::ModelGeometrySpec g;
     g.max_elements = o.max_elements;
@@ -54,6 +80,7 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
         r.mesh.enabled = true;
         r.mesh.size = o.mesh_size > 0.0 ? o.mesh_size : 0.5 * o.size;
     }
+    if (o.joint_set && o.kind != LabTestOptions::Kind::brazilian) r.joints = joint_set_traces(o);
     g.regions.push_back(r);
     if (uses_platen_blocks(o)) {
         // One block each, a block size thick, sharing the specimen's faces.
@@ -88,6 +115,8 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     }
     an.materials.push_back(rock);
     an.joint_properties.push_back(o.joint);
+    // Heterogeneous bonds are a property of the specimen: drawn with its seed.
+    an.joint_properties.back().strength_seed = o.seed;
     const bool platen_blocks = uses_platen_blocks(o);
     if (platen_blocks) {
         JointPropertySpec platen;
@@ -101,6 +130,14 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     }
     // The bond between specimen blocks (a later rule wins over the platen one).
     an.joint_assignments.push_back({o.joint.name, {}, {"specimen"}});
+    if (o.joint_set) {
+        JointPropertySpec set = o.joint_set_joint;
+        set.name = "joint_set";
+        if (!(set.kn > 0)) set.kn = o.joint.kn;
+        if (!(set.ks > 0)) set.ks = o.joint.ks;
+        an.joint_properties.push_back(set);
+        an.joint_assignments.push_back({set.name, {meshing::JointTag::real_joint}, {"specimen"}});
+    }
     // Contacts that form during the test (fragments touching anew) are the rock's
     // broken joints: unbonded, with the bond's stiffness and residual friction
     // (not the solver's built-in 30°); with deformable blocks, as stiff as the
@@ -382,6 +419,20 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             if (angle <= 30.0 || angle >= 150.0) ++r.cracks_near_horizontal;
         }
     };
+    // The joint set's contacts: the share of their length sliding at its limit.
+    int set_property = -1;
+    for (std::size_t k = 0; k < s.property_names().size(); ++k)
+        if (o.joint_set && s.property_names()[k] == "joint_set") set_property = int(k);
+    auto joint_set_sliding = [&] {
+        const auto& c = s.contacts();
+        double all = 0.0, sliding = 0.0;
+        for (int i = 0; i < c.size(); ++i) {
+            if (c.property[i] != set_property) continue;
+            all += c.length[i];
+            if (c.history[i].slipping) sliding += c.length[i];
+        }
+        return all > 0.0 ? sliding / all : 0.0;
+    };
     // Biaxial: the confinement first, ramped with the platens held, then settled
     // (applied at once it is a shock that cracks the specimen before any axial load).
     MovingPlaten platen(s);
@@ -476,6 +527,11 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         StressStrainPoint p = measure(strain, rate);
         p.unbalanced_ratio = ratio_max;
         r.curve.push_back(p);
+        if (set_property >= 0 && !(r.joint_slip_stress > 0.0)) {
+            const double sliding = joint_set_sliding();
+            if (sliding >= 0.5 && !(r.joint_slip_stress_half > 0.0)) r.joint_slip_stress_half = p.axial_stress;
+            if (sliding >= 0.9) r.joint_slip_stress = p.axial_stress;
+        }
         if (o.servo) {
             const int cracks_now = p.cracks_tensile + p.cracks_shear;
             const double made = cracks_now - cracks_last_record;

@@ -112,6 +112,14 @@ struct LabTestOptions {
     double young = 20.0e9;              ///< target modulus E of the rock mass, Pa
     double poisson = 0.2;               ///< Poisson's ratio of the blocks
     double mesh_size = 0.0;
+    /// A persistent joint set across a rectangular specimen (Jaeger's single
+    /// plane of weakness when one joint): traces at joint_set_angle degrees from
+    /// horizontal, joint_set_spacing apart along their normal, one through the
+    /// specimen's centre (spacing 0: that one alone), cut before the blocks, with
+    /// the property joint_set_joint (kn, ks: the bond's when 0).
+    bool joint_set = false;
+    double joint_set_angle = 60.0, joint_set_spacing = 0.0;
+    JointPropertySpec joint_set_joint{"joint_set", JointPropertySpec::Law::coulomb};
 
     /// The paper's Voronoi calibration run (SPEC §8).
     static LabTestOptions paper_ucs();
@@ -143,6 +151,12 @@ struct LabTestResult {
     std::array<int, 12> crack_orientation{};
     int cracks_near_vertical = 0, cracks_near_horizontal = 0; ///< within 30° of each
     int cracks_near_vertical_at_peak = 0, cracks_near_horizontal_at_peak = 0; ///< the same, up to the peak
+    /// With a joint set: the axial stress at which the set's joints first slide
+    /// over half, and over 90%, of their length (bond broken or intact, at their
+    /// frictional limit): the plane of weakness's strength, read where a
+    /// laboratory reads it — the knee where the whole plane slips, before the
+    /// pieces jam against the platens. 0: never.
+    double joint_slip_stress_half = 0.0, joint_slip_stress = 0.0;
     bool peak_passed = false;
     /// After failure the stress climbed back above the peak (a jammed rubble core):
     /// the run stopped there and peak_stress is the peak before failure.
@@ -152,6 +166,9 @@ struct LabTestResult {
 
 /// Whether the test has separate platen blocks (platen_friction ≥ 0, compression).
 bool uses_platen_blocks(const LabTestOptions& o);
+
+/// The traces of the persistent joint set (o.joint_set), clipped to the specimen.
+std::vector<meshing::SegmentSpec> joint_set_traces(const LabTestOptions& o);
 
 /// Geometry and analysis of a lab test.
 meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o);

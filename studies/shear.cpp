@@ -69,6 +69,7 @@ AnalysisSpec shear_analysis(const ShearTestOptions& o) {
     an.materials.push_back(rock);
     JointPropertySpec bond = o.rock, plane = o.plane;
     bond.name = "bond", plane.name = "plane";
+    bond.strength_seed = o.seed; // heterogeneous bonds: drawn with the specimen's seed
     an.joint_properties = {bond, plane};
     an.joint_assignments.push_back({"bond", {}, {}});
     an.joint_assignments.push_back({"plane", {meshing::JointTag::real_joint}, {}});
@@ -272,6 +273,8 @@ void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
     sub->add_option("--friction", c.o.joint.friction, "Rock bonds: friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
     sub->add_option("--residual-friction", c.o.joint.residual_friction, "Rock bonds: friction after failure (degrees; default --friction)")
         ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--weibull-m", c.o.joint.weibull_modulus, "Rock bonds: Weibull modulus of their strengths (0: uniform; as the lab tests)")
+        ->check(cli::non_negative())->capture_default_str();
     sub->add_option("--tension-softening", c.tension_softening, "Rock bonds: tension softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--shear-softening", c.shear_softening, "Rock bonds: shear softening b1,a1,a2 (SPEC §4)")

@@ -260,3 +260,27 @@ TEST_CASE("smooth platens hold the bottom face's middle blocks horizontally") {
         CHECK(held_y > held_x);  // both faces are held vertically
     }
 }
+
+TEST_CASE("a single plane of weakness slides where Jaeger's closed form says (biaxial, 4 x 8 m, sigma3 5 MPa)") {
+    // σ1 = σ3 + 2 σ3 tan φj / ((1 − tan φj cot β) sin 2β), φj 30°, cj 0: 18.66 MPa at
+    // β 45°, 15.00 MPa at 60° (the least). Measured: 18.60, 14.92 MPa.
+    for (double beta : {45.0, 60.0}) {
+        LabTestOptions o = LabTestOptions::paper_ucs();
+        o.kind = LabTestOptions::Kind::biaxial;
+        o.width = 4.0, o.height = 8.0;
+        o.confinement = 5e6;
+        o.rough_platens = false;
+        o.joint_set = true;
+        o.joint_set_angle = beta;
+        o.joint_set_joint.kn = o.joint.kn, o.joint_set_joint.ks = o.joint.ks;
+        o.joint_set_joint.friction = 30.0;
+        o.max_strain = 2e-3;
+        o.threads = 2;
+        const auto r = run_labtest(o);
+        const double b = beta * std::numbers::pi / 180.0, mu = std::tan(std::numbers::pi / 6.0);
+        const double jaeger = 5e6 + 2.0 * mu * 5e6 / ((1.0 - mu / std::tan(b)) * std::sin(2.0 * b));
+        CAPTURE(beta);
+        CHECK(r.joint_slip_stress == doctest::Approx(jaeger).epsilon(0.02));
+        CHECK(r.joint_slip_stress_half > 0.8 * jaeger);
+    }
+}
