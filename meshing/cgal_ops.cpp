@@ -316,20 +316,43 @@ Vec2 interior_point(const std::vector<Vec2>& ring, const std::vector<Vec2>& obst
     return 0.5 * (v + far);
 }
 
+/// The closed loops of one boundary walk (CCB) of an arrangement face, antennas
+/// (edges with the face on both sides: fractures ending inside it) left out.
+/// Where an antenna leads from the walk to a closed cycle of fractures (a block
+/// enclosed by fractures and tied to the rest by one more), the walk makes an
+/// excursion around that cycle; it is its own loop — a hole of the face — not part
+/// of the ring, whose corner it would otherwise cut. A loop goes on from an edge to
+/// the first later edge of the walk that starts where it ends.
 template <class Circ>
-std::vector<Vec2> ring_without_antennas(Circ first) {
-    std::vector<Vec2> r;
+std::vector<std::vector<Vec2>> loops_without_antennas(Circ first) {
+    using Halfedge = decltype(&*first);
+    std::vector<Halfedge> edges;
     Circ c = first;
     do {
-        if (c->twin()->face() != c->face()) {
+        if (c->twin()->face() != c->face()) edges.push_back(&*c);
+    } while (++c != first);
+    const std::size_t n = edges.size();
+    std::vector<char> used(n, 0);
+    std::vector<std::vector<Vec2>> loops;
+    for (std::size_t start = 0; start < n; ++start) {
+        if (used[start]) continue;
+        std::vector<Vec2> r;
+        for (std::size_t e = start; !used[e];) {
+            used[e] = 1;
             // Two vertices closer than the rounding (crossings a hair apart in a
             // dense fracture network) become one.
-            const Vec2 q = to_vec(c->source()->point());
+            const Vec2 q = to_vec(edges[e]->source()->point());
             if (r.empty() || !(r.back() == q)) r.push_back(q);
+            std::size_t next = (e + 1) % n;
+            for (std::size_t k = 1; k < n; ++k, next = (next + 1) % n)
+                if (edges[next]->source() == edges[e]->target()) break;
+            if (edges[next]->source() != edges[e]->target()) break; // not closed: rounding left a gap
+            e = next;
         }
-    } while (++c != first);
-    while (r.size() > 1 && r.front() == r.back()) r.pop_back();
-    return r;
+        while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+        if (r.size() >= 3) loops.push_back(std::move(r));
+    }
+    return loops;
 }
 } // namespace
 
@@ -377,20 +400,35 @@ CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments
     for (auto f = arr.faces_begin(); f != arr.faces_end(); ++f) {
         if (f->is_unbounded() || !f->has_outer_ccb()) continue;
         PolygonWithHoles face;
-        face.outer = ring_without_antennas(f->outer_ccb());
-        if (face.outer.size() < 3) continue;
-        for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h) {
-            auto ring = ring_without_antennas(*h);
-            if (ring.size() >= 3) face.holes.push_back(std::move(ring));
-        }
+        // The outer walk's loop of largest area is the ring; its other loops are
+        // fracture cycles tied to it by an antenna: holes, as those of inner walks.
+        auto outer_loops = loops_without_antennas(f->outer_ccb());
+        if (outer_loops.empty()) continue;
+        const auto ring = std::max_element(outer_loops.begin(), outer_loops.end(), [](const auto& p, const auto& q) {
+            return std::abs(signed_area(p)) < std::abs(signed_area(q));
+        });
+        face.outer = std::move(*ring);
+        outer_loops.erase(ring);
+        for (auto& loop : outer_loops) face.holes.push_back(std::move(loop));
+        for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h)
+            for (auto& loop : loops_without_antennas(*h)) face.holes.push_back(std::move(loop));
         std::vector<Vec2> obstacles;
         for (const auto& h : face.holes) obstacles.insert(obstacles.end(), h.begin(), h.end());
         if (!detail::domain_contains(d, interior_point(face.outer, obstacles))) continue;
         inside.push_back(f);
-        // A face pinched at a vertex (in a dense fracture network two opposite
+        // A face pinched at a vertex: in a dense fracture network two opposite
         // corners of an X crossing can belong to one face that wraps around a small
-        // neighbour), or one that rounding made cross itself, is no polygon the
-        // pattern can fill: say where, rather than fail inside CGAL.
+        // neighbour block. Its walk splits there into one counter-clockwise loop,
+        // the ring, and clockwise loops around the neighbours: holes that touch the
+        // ring at a point, which the Boolean operations filling the face take.
+        if (auto loops = split_at_repeats(face.outer); loops.size() > 1) {
+            const auto ccw = std::count_if(loops.begin(), loops.end(), [](const auto& l) { return signed_area(l) > 0; });
+            if (ccw == 1 && std::all_of(loops.begin(), loops.end(), [](const auto& l) { return is_simple(l); }))
+                for (auto& l : loops) (signed_area(l) > 0 ? face.outer : face.holes.emplace_back()) = std::move(l);
+        }
+        // One that rounding made cross itself, or pinched otherwise, is no polygon
+        // the pattern can fill: say where, rather than fail inside CGAL (the
+        // caller's area check catches what slips through).
         if (const auto loops = split_at_repeats(face.outer); loops.size() > 1 || !is_simple(face.outer)) {
             Vec2 at = face.outer.front();
             for (std::size_t i = 1; i < face.outer.size(); ++i)
