@@ -111,7 +111,7 @@ int run_cli(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     sweep->add_option("--set", sweep_sets,
                       "KEY=V1,V2,...: a model-file key as error messages name it and its values, e.g. "
-                      "joint_property[0].tensile=2e6,3e6 or region[1].pattern.size=0.2,0.3 (repeatable)")
+                      "joint_property[0].tensile=2e6,3e6 or region[1].pattern.size=0.2,0.3 (repeatable); keys joined by '+' take the same values together")
         ->take_all();
     sweep->add_option("--seeds", sweep_options.seeds,
                       "Seeds per combination: the random patterns' seeds plus 0, 1, ... seeds-1")

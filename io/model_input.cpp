@@ -1023,6 +1023,19 @@ std::string edit_model_text(std::string_view text, const std::string& name,
                 const auto seed = (*pattern)["seed"].value_or(std::int64_t{1});
                 pattern->insert_or_assign("seed", seed + seed_offset);
             }
+        // Generated fracture sets (region.dfn, not those read from a file) too: a seed
+        // study of a jointed rock mass is over networks as well as patterns.
+        if (auto* regions = doc["region"].as_array())
+            for (auto& r : *regions) {
+                auto* sets = r.as_table() ? (*r.as_table())["dfn"].as_array() : nullptr;
+                if (!sets) continue;
+                for (auto& d : *sets) {
+                    auto* t = d.as_table();
+                    if (!t || (*t)["file"]) continue;
+                    const auto seed = (*t)["seed"].value_or(std::int64_t{1});
+                    t->insert_or_assign("seed", seed + seed_offset);
+                }
+            }
         // Heterogeneous joint strengths draw from strength_seed + offset.
         if (auto* properties = doc["joint_property"].as_array())
             for (auto& j : *properties) {

@@ -27,6 +27,8 @@ std::pair<std::string, std::vector<std::string>> parse_set(const std::string& te
         throw InputError("--set", 0, "", "expected KEY=V1,V2,... (e.g. joint_property[0].tensile=2e6,3e6), got '" +
                                               text + "'");
     std::pair<std::string, std::vector<std::string>> out{text.substr(0, eq), {}};
+    if (out.first.front() == '+' || out.first.back() == '+' || out.first.find("++") != std::string::npos)
+        throw InputError("--set", 0, out.first, "an empty key among those joined by '+'");
     // Split at commas outside brackets and quotes: region[0].outline.min=[0,0],[1,1].
     int depth = 0;
     bool quoted = false;
@@ -45,6 +47,19 @@ std::pair<std::string, std::vector<std::string>> parse_set(const std::string& te
     for (const auto& v : out.second)
         if (v.empty()) throw InputError("--set", 0, out.first, "an empty value in '" + text + "'");
     return out;
+}
+
+std::vector<std::pair<std::string, std::string>>
+split_joined_keys(const std::vector<std::pair<std::string, std::string>>& set) {
+    std::vector<std::pair<std::string, std::string>> edits;
+    for (const auto& [key, value] : set)
+        for (std::size_t at = 0;;) {
+            const auto plus = key.find('+', at);
+            edits.emplace_back(key.substr(at, plus == std::string::npos ? std::string::npos : plus - at), value);
+            if (plus == std::string::npos) break;
+            at = plus + 1;
+        }
+    return edits;
 }
 
 namespace {
@@ -120,7 +135,7 @@ int run_sweep(const SweepOptions& o) {
         char dir[32];
         std::snprintf(dir, sizeof dir, "run_%03zu", k + 1);
         r.dir = dir;
-        r.text = io::edit_model_text(base, o.model, r.set, r.seed_offset);
+        r.text = io::edit_model_text(base, o.model, split_joined_keys(r.set), r.seed_offset);
     }
     // Every edited model is read before anything runs: a wrong key or value is an
     // error now (exit 2, naming it), not a table of failed runs.

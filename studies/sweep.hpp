@@ -35,6 +35,11 @@ struct SweepOptions {
 /// "KEY=V1,V2,..." -> key and values; throws InputError naming --set.
 std::pair<std::string, std::vector<std::string>> parse_set(const std::string& text);
 
+/// The edits of one run: a key joined by '+' ("region[1].dfn[0].p21+region[1].dfn[1].p21")
+/// becomes one edit per key, each with the same value.
+std::vector<std::pair<std::string, std::string>>
+split_joined_keys(const std::vector<std::pair<std::string, std::string>>& set);
+
 /// Runs the sweep; returns 0 if every run finished, 1 if any failed (the table says which).
 int run_sweep(const SweepOptions& options);
 

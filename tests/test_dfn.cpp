@@ -3,9 +3,11 @@
 // Kolmogorov–Smirnov test at 5% against the asked laws, later sets end at earlier
 // ones, and the traces cut a bonded region into blocks along fracture joints with
 // rock bridges between them.
+#include "base/error.hpp"
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
 #include "meshing/dfn.hpp"
+#include "studies/sweep.hpp"
 
 #include <doctest/doctest.h>
 
@@ -278,7 +280,58 @@ property = "bond"
     CHECK(bridges > 100);
 }
 
-TEST_CASE("a network too large or too dense for the cutting is refused with the reason, before or instead of a crash") {
+TEST_CASE("bbm sweep moves generated fracture sets with the seeds and sets joined keys together") {
+    const std::string text = R"(
+[[material]]
+name = "rock"
+young = 20e9
+poisson = 0.25
+
+[[region]]
+name = "rock mass"
+outline = { type = "rectangle", min = [0.0, 0.0], max = [10.0, 10.0] }
+pattern = { type = "voronoi", size = 0.5, seed = 3 }
+material = "rock"
+
+[[region.dfn]]
+name = "J1"
+orientation = { distribution = "uniform" }
+length = { distribution = "fixed", value = 2.0 }
+p21 = 0.2
+seed = 4
+
+[[region.dfn]]
+name = "J2"
+orientation = { distribution = "uniform" }
+length = { distribution = "fixed", value = 2.0 }
+p21 = 0.1
+
+[[joint_property]]
+name = "bond"
+law = "elastic"
+kn = 1e12
+ks = 1e12
+
+[[joint_assignment]]
+property = "bond"
+)";
+    const auto edits = studies::split_joined_keys({{"region[0].dfn[0].p21+region[0].dfn[1].p21", "0.35"}});
+    REQUIRE(edits.size() == 2);
+    CHECK(edits[1].first == "region[0].dfn[1].p21");
+    const auto mf = io::parse_model(io::edit_model_text(text, "dfn.toml", edits, 2), "dfn.toml");
+    const auto& region = mf.geometry.regions[0];
+    REQUIRE(region.dfn.size() == 2);
+    CHECK(region.dfn[0].p21 == 0.35);
+    CHECK(region.dfn[1].p21 == 0.35);
+    // Seed offset 2: the pattern's 3 -> 5, the sets' 4 -> 6 and (default) 1 -> 3, so
+    // every realization of a sweep draws its own network.
+    CHECK(region.pattern.seed == 5);
+    CHECK(region.dfn[0].seed == 6);
+    CHECK(region.dfn[1].seed == 3);
+    CHECK_THROWS_AS(studies::parse_set("region[0].dfn[0].p21+=0.1"), InputError);
+}
+
+TEST_CASE("a network too large is refused before it is drawn; a dense one is cut into blocks that tile the region") {
     const auto model = [](const std::string& sets) {
         return std::string(R"(
 [model]
@@ -318,9 +371,29 @@ property = "bond"
     const std::string huge = error_of(model(set("J1", 20.0, 10'000'000, 4, "")));
     MESSAGE(huge);
     CHECK(huge.find("dfn[0]: fracture set 'J1' would draw about") == 0);
-    // 5,000 + 5,000 fractures: faces pinched at crossings, refused with where.
-    const std::string dense = error_of(model(set("J1", 20.0, 5000, 4, "") +
-                                             set("J2", 110.0, 5000, 5, "terminate = { at = [\"J1\"], probability = 0.5 }\n")));
-    MESSAGE(dense);
-    CHECK(dense.find("dfn: the real joints and fractures cut region 'rock mass' into") == 0);
+    // 1,000 + 1,000 fractures (P21 0.66 /m each, 0.5 m blocks): once refused, the
+    // blocks covering 1,599.87 of 1,600 m², because a face whose walk made an
+    // excursion along a fracture to a closed cycle of fractures lost the cycle's
+    // corner; and faces pinched at crossings (a hole touching the ring at a point).
+    // Now cut: the blocks tile the region, the traces became fracture joints.
+    auto mf = io::parse_model(model(set("J1", 20.0, 1000, 4, "") +
+                                    set("J2", 110.0, 1000, 5, "terminate = { at = [\"J1\"], probability = 0.5 }\n")),
+                              "dense.toml");
+    GenerationStats st;
+    const auto a = generate_blocks(mf.geometry, &st);
+    double area = 0.0, traces = 0.0, joints = 0.0;
+    for (int b = 0; b < a.block_count(); ++b) area += a.area[b];
+    for (const auto& t : a.fracture_traces) traces += norm(t.b - t.a);
+    for (const auto& j : a.joints)
+        if (j.tag == JointTag::fracture) joints += j.length();
+    MESSAGE(a.block_count() << " blocks over " << area << " m²; traces " << traces << " m, fracture joints " << joints
+                            << " m; " << st.unsplit_blocks << " blocks not split at a trace's tip");
+    CHECK(area == doctest::Approx(1600.0).epsilon(1e-9));
+    CHECK(a.block_count() > 15000);
+    // A trace whose tip lies in a block that is not a simple polygon stops short
+    // there (counted and warned by bbm mesh): a few of 2,000 traces. The fracture
+    // joints measure 2,080.6 m against 2,073.7 m of traces (+0.33%, where the
+    // small network above matches to 1e-6): not explained yet, bounded here.
+    CHECK(st.unsplit_blocks < 40);
+    CHECK(joints == doctest::Approx(traces).epsilon(0.01));
 }
