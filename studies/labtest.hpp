@@ -119,7 +119,12 @@ struct LabTestOptions {
     /// the property joint_set_joint (kn, ks: the bond's when 0).
     bool joint_set = false;
     double joint_set_angle = 60.0, joint_set_spacing = 0.0;
-    JointPropertySpec joint_set_joint{"joint_set", JointPropertySpec::Law::coulomb};
+    JointPropertySpec joint_set_joint = [] {
+        JointPropertySpec plane;
+        plane.name = "joint_set";
+        plane.law = JointPropertySpec::Law::coulomb;
+        return plane;
+    }();
 
     /// The paper's Voronoi calibration run (SPEC §8).
     static LabTestOptions paper_ucs();
