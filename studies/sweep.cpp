@@ -235,8 +235,9 @@ int run_sweep(const SweepOptions& o) {
             << num("steps") << ',' << num("cracks", "tensile") << ',' << num("cracks", "shear") << ','
             << num("wall_seconds") << ',' << (s.is_null() ? "" : s.value("state_hash", std::string{})) << ','
             << (std::isfinite(y) ? num(o.plot.c_str()) : "") << ',' << r.dir << '\n';
-        // The plot: the value against the first swept key, if it is a number.
-        if (!o.set.empty() && std::isfinite(y)) {
+        // The plot: the value against the first swept key, if it is a number, of
+        // finished runs only (a run stopped early has no answer to average).
+        if (!o.set.empty() && std::isfinite(y) && status == "done") {
             char* end = nullptr;
             const double x = std::strtod(r.set.front().second.c_str(), &end);
             if (end && *end == '\0') {
