@@ -7,11 +7,14 @@
 // number > 0, got nan". CLI11 prefixes the option name; main() exits with status 2.
 #pragma once
 
+#include "base/error.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace bbm::cli {
 
@@ -75,6 +78,21 @@ inline CLI::Validator whole_at_least(long long lo) {
             return {};
         },
         ">= " + std::to_string(lo));
+}
+
+/// Parses option strings (the Python module's keywords) with a command's option
+/// definitions; a parse error becomes an InputError naming the command and what
+/// CLI11 said (the flag). Returns whether an output folder was asked for.
+inline bool parse_args(CLI::App& app, const std::string& command, const std::vector<std::string>& args) {
+    std::vector<std::string> reversed(args.rbegin(), args.rend()); // CLI11 takes them last first
+    try {
+        app.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+        throw InputError(command, 0, "", e.what());
+    }
+    bool has_out = false;
+    for (const auto& a : args) has_out = has_out || a == "--out" || a == "-o";
+    return has_out;
 }
 
 } // namespace bbm::cli

@@ -872,21 +872,6 @@ void note_given_joint_values(const CLI::App& cmd, CalibrateCli& v) {
     v.given_cohesion = cmd.count("--cohesion") > 0;
 }
 
-namespace {
-
-/// Parses option strings with a command's option definitions; a parse error
-/// becomes an InputError naming the command and what CLI11 said (the flag).
-void parse_options(CLI::App& app, const std::string& command, const std::vector<std::string>& args) {
-    std::vector<std::string> reversed(args.rbegin(), args.rend()); // CLI11 takes them last first
-    try {
-        app.parse(reversed);
-    } catch (const CLI::ParseError& e) {
-        throw InputError(command, 0, "", e.what());
-    }
-}
-
-} // namespace
-
 LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,
                               const std::function<void(const Solver&, const StressStrainPoint&, int)>& on_frame) {
     const auto kind = labtest_kind(command);
@@ -899,7 +884,7 @@ LabTestStudy run_labtest_args(const std::string& command, const std::vector<std:
         app.add_option("--confinement", values.o.confinement, "Lateral stress (Pa, compression positive)")
             ->required()
             ->check(cli::non_negative());
-    parse_options(app, command, args);
+    cli::parse_args(app, command, args);
     values.write_files = app.count("--out") > 0;
     values.on_frame = on_frame;
     LabTestStudy study;
@@ -912,7 +897,7 @@ std::string run_calibrate_args(const std::vector<std::string>& args, bool quiet)
     CLI::App app{"calibrate", "calibrate"};
     bool quiet_flag = quiet;
     add_calibrate_options(&app, values, quiet_flag);
-    parse_options(app, "calibrate", args);
+    cli::parse_args(app, "calibrate", args);
     note_given_joint_values(app, values);
     values.lab.write_files = app.count("--out") > 0;
     std::string json;

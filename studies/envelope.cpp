@@ -509,15 +509,7 @@ EnvelopeStudy run_envelope_args(const std::vector<std::string>& args, bool quiet
     e.lab.write_files = false;
     bool q = quiet;
     add_envelope_options(&app, e, q);
-    bool has_out = false;
-    for (const auto& a : args) has_out = has_out || a == "--out" || a == "-o";
-    std::vector<std::string> reversed(args.rbegin(), args.rend());
-    try {
-        app.parse(reversed);
-    } catch (const CLI::ParseError& error) {
-        throw InputError("envelope", 0, "", error.what());
-    }
-    e.lab.write_files = has_out;
+    e.lab.write_files = cli::parse_args(app, "envelope", args);
     EnvelopeStudy study;
     run_envelope(e, q, false, &study);
     return study;

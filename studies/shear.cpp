@@ -576,15 +576,7 @@ ShearStudy run_shear_args(const std::vector<std::string>& args, bool quiet) {
     v.lab.write_files = false;
     bool q = quiet;
     add_shear_options(&app, v, q);
-    bool has_out = false;
-    for (const auto& a : args) has_out = has_out || a == "--out" || a == "-o";
-    std::vector<std::string> reversed(args.rbegin(), args.rend());
-    try {
-        app.parse(reversed);
-    } catch (const CLI::ParseError& error) {
-        throw InputError("shear", 0, "", error.what());
-    }
-    v.lab.write_files = has_out;
+    v.lab.write_files = cli::parse_args(app, "shear", args);
     ShearStudy study;
     run_shear(v, q, false, &study);
     return study;
