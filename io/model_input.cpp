@@ -326,7 +326,7 @@ RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
               });
     std::vector<std::string> sets;
     read_list(c, t, p, "dfn", "an array of fracture set tables ([[region.dfn]])",
-              [&](const toml::node& n, const Path& ep) { r.dfn.push_back(read_dfn_set(c, n, ep, sets)); });
+              [&](const toml::node& n, const Path& ep) { r.dfn.push_back(read_dfn_set(c, n, ep, sets, r.outline)); });
     if (const toml::node* m = find(c, t, p, "mesh")) r.mesh = read_mesh(c, *m, p.key("mesh"));
     return r;
 }

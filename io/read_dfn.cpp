@@ -1,6 +1,7 @@
 // bbm io: the [[region.dfn]] tables of a model file — fracture sets of a discrete
 // fracture network, generated (meshing/dfn.hpp) or read from a CSV file of traces
-// (docs/input.md "Fracture networks").
+// (docs/input.md "Fracture networks"), or from a DXF drawing (io/dxf.hpp).
+#include "io/dxf.hpp"
 #include "io/reader.hpp"
 
 #include <filesystem>
@@ -100,13 +101,11 @@ FractureOrientationSpec read_orientation(const Ctx& c, const toml::node& node, c
 
 /// Traces from a CSV file: x1, y1, x2, y2[, set] per line; blank lines, lines
 /// starting with '#' and a header line are skipped. With `only`, the rows whose
-/// fifth column is that set.
-std::vector<SegmentSpec> read_trace_file(const Ctx& c, const toml::node& n, const Path& p, const std::string& name,
-                                         const std::optional<std::string>& only) {
-    namespace fs = std::filesystem;
-    const fs::path path = fs::path(c.file).parent_path() / name;
+/// fifth column is that set. Coordinates times `scale` (metres per file unit).
+std::vector<SegmentSpec> read_trace_csv(const Ctx& c, const toml::node& n, const Path& p, const std::string& path,
+                                        const std::optional<std::string>& only, double scale) {
     std::ifstream in(path);
-    if (!in) c.fail(n, p, "cannot open the trace file " + path.string());
+    if (!in) c.fail(n, p, "cannot open the trace file " + path);
     std::vector<SegmentSpec> traces;
     std::string text;
     int line_no = 0;
@@ -139,32 +138,105 @@ std::vector<SegmentSpec> read_trace_file(const Ctx& c, const toml::node& n, cons
         }
         seen_data = true;
         if (!numeric || cells.size() > 5)
-            throw InputError(path.string(), line_no, p.full,
+            throw InputError(path, line_no, p.full,
                              "expected x1, y1, x2, y2[, set] (numbers, then an optional set name), got \"" + text +
                                  "\"");
         if (only && (cells.size() < 5 || cells[4] != *only)) continue;
-        const SegmentSpec s{{v[0], v[1]}, {v[2], v[3]}};
-        if (s.a == s.b)
-            throw InputError(path.string(), line_no, p.full, "the trace's two ends are the same point");
+        const SegmentSpec s{{scale * v[0], scale * v[1]}, {scale * v[2], scale * v[3]}};
+        if (s.a == s.b) throw InputError(path, line_no, p.full, "the trace's two ends are the same point");
         traces.push_back(s);
     }
-    if (traces.empty())
-        c.fail(n, p,
-               "the trace file " + path.string() + " has no traces" +
-                   (only ? " of set " + reader::quoted(*only) : std::string()));
     return traces;
 }
 
+/// Traces from an ASCII DXF drawing (io/dxf.hpp); with `only`, those on that layer.
+/// `note` says what was read and what was left out, for `bbm mesh`.
+std::vector<SegmentSpec> read_trace_dxf(const Ctx& c, const toml::node& n, const Path& p, const std::string& path,
+                                        const std::optional<std::string>& only, double scale, std::string& note) {
+    const DxfDrawing d = read_dxf(path, p.full, scale);
+    std::vector<SegmentSpec> traces;
+    std::vector<std::string> layers;
+    for (const DxfTrace& t : d.traces) {
+        if (std::ranges::find(layers, t.layer) == layers.end()) layers.push_back(t.layer);
+        if (!only || t.layer == *only) traces.push_back({t.a, t.b});
+    }
+    auto counts = [](const std::map<std::string, int>& kinds) {
+        std::string s;
+        for (const auto& [type, count] : kinds) s += (s.empty() ? "" : ", ") + std::to_string(count) + " " + type;
+        return s;
+    };
+    note = "DXF: " + (d.entities_read.empty() ? std::string("no LINE or polyline") : counts(d.entities_read)) +
+           " on layers " + join(std::vector<std::string_view>(layers.begin(), layers.end())) + "; units " +
+           (scale > 0.0 ? "given by 'units'" : dxf_unit_name(d.insunits)) + " (" + fmt6(d.metres_per_unit) + " m)";
+    if (!d.entities_skipped.empty()) note += "; left out: " + counts(d.entities_skipped);
+    if (traces.empty() && only && !layers.empty())
+        c.fail(n, p,
+               "the DXF file " + path + " has no traces on layer " + reader::quoted(*only) + "; its layers with traces are " +
+                   join(std::vector<std::string_view>(layers.begin(), layers.end())));
+    return traces;
+}
+
+/// The box an outline lies in (arcs and circles by their whole circle: an upper bound).
+Box2 outline_box(const meshing::OutlineSpec& o) {
+    using K = meshing::OutlineSpec::Kind;
+    Box2 b;
+    auto circle = [&](Vec2 centre, double r) {
+        b.add(centre - Vec2{r, r});
+        b.add(centre + Vec2{r, r});
+    };
+    switch (o.kind) {
+    case K::rectangle: b.add(o.min), b.add(o.max); break;
+    case K::polygon: for (Vec2 q : o.points) b.add(q); break;
+    case K::circle: circle(o.center, o.radius); break;
+    case K::path:
+        b.add(o.start);
+        for (const auto& s : o.steps) {
+            b.add(s.to);
+            if (s.arc) circle(s.center, norm(s.to - s.center));
+        }
+        break;
+    case K::opening:
+        circle(o.center, 0.5 * o.width);
+        b.add({o.center.x, o.floor_y});
+        break;
+    }
+    return b;
+}
+
+/// A trace file drawn in other coordinates (a mine grid, millimetres) would leave
+/// the region uncut without a word: refuse a set none of whose traces reaches the
+/// region's outline box.
+void check_reaches_region(const Ctx& c, const toml::node& n, const Path& p, const std::vector<SegmentSpec>& traces,
+                          const meshing::OutlineSpec& outline) {
+    const Box2 region = outline_box(outline);
+    Box2 all;
+    for (const SegmentSpec& t : traces) {
+        Box2 tb;
+        tb.add(t.a), tb.add(t.b);
+        all.add(t.a), all.add(t.b);
+        if (!(tb.hi.x < region.lo.x || tb.lo.x > region.hi.x || tb.hi.y < region.lo.y || tb.lo.y > region.hi.y)) return;
+    }
+    c.fail(n, p,
+           "none of its " + std::to_string(traces.size()) + " traces reaches the region: they span x " + fmt6(all.lo.x) +
+               " to " + fmt6(all.hi.x) + ", y " + fmt6(all.lo.y) + " to " + fmt6(all.hi.y) + " m, the region x " +
+               fmt6(region.lo.x) + " to " + fmt6(region.hi.x) + ", y " + fmt6(region.lo.y) + " to " + fmt6(region.hi.y) +
+               " m (other coordinates or units? see 'units')");
+}
+
+constexpr std::array<std::string_view, 5> unit_names{"m", "cm", "mm", "ft", "in"};
+constexpr std::array<double, 5> unit_metres{1.0, 0.01, 0.001, 0.3048, 0.0254};
+
 } // namespace
 
-meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier) {
+meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier,
+                                 const meshing::OutlineSpec& outline) {
     const toml::table& t = to_table(c, node, p, "a fracture set table ([[region.dfn]])");
-    static constexpr std::array<std::string_view, 12> all{"name",  "seed",      "centres",  "cluster",
+    static constexpr std::array<std::string_view, 13> all{"name",  "seed",      "centres",  "cluster",
                                                           "orientation", "length", "p21", "count",
-                                                          "terminate", "property", "file", "set"};
+                                                          "terminate", "property", "file", "set", "units"};
     static constexpr std::array<std::string_view, 10> generated_keys{
         "name", "seed", "centres", "cluster", "orientation", "length", "p21", "count", "terminate", "property"};
-    static constexpr std::array<std::string_view, 4> file_keys{"name", "file", "set", "property"};
+    static constexpr std::array<std::string_view, 5> file_keys{"name", "file", "set", "units", "property"};
     const bool from_file = t.contains("file");
     check_keys(c, t, p, from_file ? Keys(file_keys) : Keys(generated_keys), all,
                from_file ? "a fracture set read from a file" : "a generated fracture set");
@@ -182,10 +254,25 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
     }
     if (from_file) {
         const toml::node& f = *find(c, t, p, "file");
-        s.file = to_str(c, f, p.key("file"));
+        const Path fp = p.key("file");
+        s.file = to_str(c, f, fp);
         std::optional<std::string> only;
         if (const toml::node* n = find(c, t, p, "set")) only = to_str(c, *n, p.key("set"));
-        s.traces = read_trace_file(c, f, p.key("file"), s.file, only);
+        double scale = 0.0; // metres per file unit; 0 = the file's own (a DXF's header) or metres
+        if (const toml::node* n = find(c, t, p, "units"))
+            scale = unit_metres[to_choice(c, *n, p.key("units"), unit_names, "length unit")];
+        const std::string path = (std::filesystem::path(c.file).parent_path() / s.file).string();
+        std::string ext = std::filesystem::path(s.file).extension().string();
+        for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+        if (ext == ".dxf") {
+            if (!std::filesystem::exists(path)) c.fail(f, fp, "cannot open the trace file " + path);
+            s.traces = read_trace_dxf(c, f, fp, path, only, scale, s.import_note);
+        } else {
+            s.traces = read_trace_csv(c, f, fp, path, only, scale > 0.0 ? scale : 1.0);
+        }
+        if (s.traces.empty())
+            c.fail(f, fp, "the trace file " + path + " has no traces" + (only ? " of set " + reader::quoted(*only) : std::string()));
+        check_reaches_region(c, f, fp, s.traces, outline);
         earlier.push_back(s.name);
         return s;
     }

@@ -513,7 +513,8 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
                      const Names& regions, const Names& supports);
 /// One [[region.dfn]] table (io/read_dfn.cpp); `earlier` holds the names of the
 /// region's sets before it, and gets its name.
-meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier);
+meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier,
+                                 const meshing::OutlineSpec& outline);
 /// [[liner]] tables (io/read_liners.cpp).
 void read_liners(Ctx& c, const toml::table& doc, std::vector<LinerSpec>& liners, Names& names);
 

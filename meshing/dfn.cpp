@@ -163,6 +163,7 @@ FractureSetStats measure(const DfnSetSpec& spec, const std::vector<Fracture>& fr
                          double diagonal) {
     FractureSetStats st;
     st.name = spec.name;
+    st.source = spec.file.empty() ? "generated" : spec.file + (spec.import_note.empty() ? "" : " (" + spec.import_note + ")");
     st.area = area;
     const Box2 box = box_of(domain);
     double c2 = 0.0, s2 = 0.0, sum = 0.0, sum2 = 0.0;

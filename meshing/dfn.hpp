@@ -32,6 +32,7 @@ namespace bbm::meshing {
 /// What a set asked for and what was built, in the region it was cut into.
 struct FractureSetStats {
     std::string name;
+    std::string source;      ///< "generated", or the trace file (and, for DXF, what it held)
     int fractures = 0;       ///< generated fractures whose centre lies in the region
     int traces = 0;          ///< pieces of trace inside the region
     double area = 0.0;       ///< of the region, m²

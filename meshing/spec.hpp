@@ -123,7 +123,7 @@ struct FractureOrientationSpec {
 
 /// One set of a discrete fracture network ([[region.dfn]]): stochastic traces with
 /// random centres, orientations and lengths at a target intensity, or traces read
-/// from a file (CSV: x1, y1, x2, y2[, set]).
+/// from a file (CSV: x1, y1, x2, y2[, set]; or DXF lines and polylines).
 struct DfnSetSpec {
     std::string name;
     enum class Centres { poisson, clustered };
@@ -142,6 +142,7 @@ struct DfnSetSpec {
     std::uint64_t seed = 1;
     std::vector<SegmentSpec> traces; ///< given traces (from a file); non-empty = not generated
     std::string file;            ///< where `traces` came from (for the report)
+    std::string import_note;     ///< what the file held and what was left out (DXF), for the report
 };
 
 /// The triangle mesh of a region's deformable blocks (SPEC §6). A region with a mesh

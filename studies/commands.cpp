@@ -73,6 +73,7 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
     for (std::size_t k = 0; k < a.fracture_stats.size(); ++k) {
         const auto& f = a.fracture_stats[k];
         fracture_sets.push_back({{"name", f.name},
+                                 {"source", f.source},
                                  {"region", a.region_names[a.fracture_sets[k].region]},
                                  {"fractures", f.fractures},
                                  {"traces", f.traces},
@@ -162,6 +163,7 @@ int run_mesh(const MeshCommand& command, bool quiet, bool check_only) {
                         f["std_length"].get<double>());
             if (f["mean_length_target"].get<double>() > 0)
                 std::printf(" (asked mean %.3g)", f["mean_length_target"].get<double>());
+            if (f["source"] != "generated") std::printf("\n    from %s", f["source"].get<std::string>().c_str());
             std::printf("\n");
         }
         std::printf("  wrote %s/{blocks.vtu, joints.vtu%s, blocks.png, summary.json}\n", out.string().c_str(),

@@ -280,6 +280,30 @@ property = "bond"
     CHECK(bridges > 100);
 }
 
+TEST_CASE("mapped joints from a DXF drawing cut the tunnel's bonded region, the curved fault as its chords") {
+    const auto mf = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/dfn/tunnel_voronoi_mapped.toml");
+    const auto& sets = mf.geometry.regions[1].dfn;
+    REQUIRE(sets.size() == 3);
+    CHECK(sets[0].traces.size() == 25); // layer J1: 25 LINEs
+    CHECK(sets[1].traces.size() == 25);
+    CHECK(sets[2].traces.size() == 17); // two arcs of 45.2° and 34.1°: 10 + 7 chords of <= 5°
+    CHECK(sets[2].import_note.find("left out: 1 TEXT") != std::string::npos);
+    const auto a = generate_blocks(mf.geometry);
+    // The drawing is in mm: once in metres its traces cross the 8 m x 16 m region.
+    std::vector<double> trace_length(3, 0.0), joint_length(3, 0.0);
+    for (std::size_t i = 0; i < a.fracture_traces.size(); ++i)
+        trace_length[a.fracture_trace_set[i]] += norm(a.fracture_traces[i].b - a.fracture_traces[i].a);
+    for (const auto& j : a.joints)
+        if (j.tag == JointTag::fracture) joint_length[j.fracture_set] += j.length();
+    MESSAGE("mapped traces " << trace_length[0] << " / " << trace_length[1] << " / " << trace_length[2]
+                             << " m, fracture joints " << joint_length[0] << " / " << joint_length[1] << " / "
+                             << joint_length[2] << " m");
+    for (int k = 0; k < 3; ++k) {
+        CHECK(trace_length[k] > 1.0);
+        CHECK(joint_length[k] == doctest::Approx(trace_length[k]).epsilon(1e-6));
+    }
+}
+
 TEST_CASE("bbm sweep moves generated fracture sets with the seeds and sets joined keys together") {
     const std::string text = R"(
 [[material]]

@@ -1,11 +1,16 @@
 // Tests of the model-file reader (io/model_input): a complete file reads into the
 // right geometry description, and every kind of mistake is reported at the right
 // line and key.
+#include "io/dxf.hpp"
 #include "io/model_input.hpp"
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <map>
+#include <numbers>
+#include <vector>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -1356,4 +1361,141 @@ TEST_CASE("fracture sets: a generated set, a set read from a CSV file, and their
     std::remove(csv.c_str());
     check_error(with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + csv + "\"\n"), "file =", "region[0].dfn[0].file",
                 "cannot open the trace file");
+}
+
+namespace {
+
+/// An ASCII DXF drawing of `entities` (group code / value pairs), padded as CAD
+/// programs write it, with CRLF line ends and $INSUNITS `units`.
+std::string dxf_drawing(const std::vector<std::string>& entities, int units = 6) {
+    std::vector<std::string> g{"999", "a test drawing", "0", "SECTION", "2", "HEADER", "9", "$ACADVER", "1", "AC1015",
+                               "9", "$INSUNITS", "70", std::to_string(units), "0", "ENDSEC", "0", "SECTION", "2",
+                               "ENTITIES"};
+    g.insert(g.end(), entities.begin(), entities.end());
+    for (const char* s : {"0", "ENDSEC", "0", "EOF"}) g.emplace_back(s);
+    std::string text;
+    for (std::size_t i = 0; i < g.size(); ++i)
+        text += (i % 2 == 0 ? std::string(3 - std::min<std::size_t>(3, g[i].size()), ' ') : "") + g[i] + "\r\n";
+    return text;
+}
+
+std::vector<std::string> dxf_line(const std::string& layer, Vec2 a, Vec2 b) {
+    return {"0", "LINE", "5", "1F", "100", "AcDbEntity", "8", layer, "100", "AcDbLine", "10", std::to_string(a.x),
+            "20", std::to_string(a.y), "30", "0.0", "11", std::to_string(b.x), "21", std::to_string(b.y), "31", "0.0"};
+}
+
+void write_file(const std::string& path, const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+}
+
+} // namespace
+
+TEST_CASE("fracture traces from a DXF drawing: lines, polylines with arcs, layers, units, and the file's mistakes") {
+    using bbm::io::read_dxf;
+    const std::string path = "/tmp/bbm_test_traces.dxf";
+    auto cat = [](std::vector<std::vector<std::string>> parts) {
+        std::vector<std::string> all;
+        for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+        return all;
+    };
+    // A semicircle of bulge 1 from (0, 0) to (2, 0) (counter-clockwise: below the
+    // chord), a closed square, an old-style POLYLINE, one mirrored by its extrusion
+    // (0, 0, -1), a text to leave out; drawn in millimetres.
+    const std::vector<std::string> arc{"0", "LWPOLYLINE", "8", "fault", "90", "2", "70", "0", "10", "0", "20", "0",
+                                       "42", "1.0", "10", "2000", "20", "0"};
+    const std::vector<std::string> square{"0", "LWPOLYLINE", "8", "frame", "90", "4", "70", "1", "10", "0", "20",
+                                          "0", "10", "1000", "20", "0", "10", "1000", "20", "1000", "10", "0", "20", "1000"};
+    const std::vector<std::string> old{"0", "POLYLINE", "8", "J2", "66", "1", "70", "0", "0", "VERTEX", "8", "J2", "10",
+                                       "0", "20", "0", "0", "VERTEX", "8", "J2", "10", "500", "20", "500", "0",
+                                       "VERTEX", "8", "J2", "10", "500", "20", "500", "0", "VERTEX", "8", "J2", "10",
+                                       "1000", "20", "0", "0", "SEQEND"};
+    const std::vector<std::string> mirrored{"0", "LWPOLYLINE", "8", "J2", "90", "2", "70", "0", "10", "1000", "20",
+                                            "0", "10", "2000", "20", "0", "210", "0", "220", "0", "230", "-1"};
+    const std::vector<std::string> text{"0", "TEXT", "8", "frame", "10", "0", "20", "0", "1", "map 1"};
+    write_file(path, dxf_drawing(cat({dxf_line("J1", {-500, 250}, {1500, 250}), arc, square, old, mirrored, text}), 4));
+    const auto d = read_dxf(path, "k");
+    CHECK(d.insunits == 4);
+    CHECK(d.metres_per_unit == 1e-3);
+    CHECK(d.entities_read.at("LINE") == 1);
+    CHECK(d.entities_read.at("LWPOLYLINE") == 3);
+    CHECK(d.entities_read.at("POLYLINE") == 1);
+    CHECK(d.entities_skipped.at("TEXT") == 1);
+    std::map<std::string, std::vector<bbm::io::DxfTrace>> by_layer;
+    for (const auto& t : d.traces) by_layer[t.layer].push_back(t);
+    REQUIRE(by_layer["J1"].size() == 1);
+    CHECK(by_layer["J1"][0].a == Vec2{-0.5, 0.25});
+    CHECK(by_layer["J1"][0].b == Vec2{1.5, 0.25});
+    CHECK(by_layer["J1"][0].line == 21); // its "0 LINE": after 20 lines of header
+    // The arc: 180° in chords of 5°, on the circle about (1, 0) of radius 1, below.
+    const auto& fault = by_layer["fault"];
+    REQUIRE(fault.size() == 36);
+    CHECK(fault.front().a == Vec2{0, 0});
+    CHECK(fault.back().b == Vec2{2, 0});
+    double chords = 0.0;
+    for (const auto& t : fault) {
+        CHECK(norm(t.b - Vec2{1, 0}) == doctest::Approx(1.0).epsilon(1e-12));
+        CHECK(t.b.y <= 1e-15);
+        chords += norm(t.b - t.a);
+    }
+    CHECK(chords == doctest::Approx(72.0 * std::sin(std::numbers::pi / 72.0)).epsilon(1e-12));
+    CHECK(by_layer["frame"].size() == 4); // closed: back to the first vertex
+    // The repeated vertex of the POLYLINE leaves no zero-length trace.
+    REQUIRE(by_layer["J2"].size() == 3);
+    CHECK(by_layer["J2"][1].b == Vec2{1.0, 0.0});
+    CHECK(by_layer["J2"][2].a == Vec2{-1.0, 0.0}); // mirrored: world x = -object x
+    CHECK(by_layer["J2"][2].b == Vec2{-2.0, 0.0});
+    // `units` overrides the header.
+    CHECK(read_dxf(path, "k", 1.0).traces.front().b == Vec2{1500, 250});
+
+    // In a model: a layer per set, an unknown layer, traces off the region.
+    auto model = [&](const std::string& extra) {
+        return with("[[region.dfn]]\nname = \"mapped\"\nfile = \"" + path + "\"\n" + extra);
+    };
+    const auto mf = parse_model(model("set = \"J1\"\n"), "t.toml");
+    REQUIRE(mf.geometry.regions[0].dfn[0].traces.size() == 1);
+    CHECK(mf.geometry.regions[0].dfn[0].import_note.find("units mm") != std::string::npos);
+    CHECK(mf.geometry.regions[0].dfn[0].import_note.find("left out: 1 TEXT") != std::string::npos);
+    CHECK(parse_model(model(""), "t.toml").geometry.regions[0].dfn[0].traces.size() == 44);
+    check_error(model("set = \"J3\"\n"), "file =", "region[0].dfn[0].file",
+                "has no traces on layer 'J3'; its layers with traces are J1, fault, frame, J2");
+    check_error(model("set = \"J1\"\nunits = \"m\"\n"), "file =", "region[0].dfn[0].file",
+                "none of its 1 traces reaches the region: they span x -500 to 1500, y 250 to 250 m");
+    check_error(model("units = \"furlong\"\n"), "units =", "region[0].dfn[0].units", "furlong");
+    // `units` on a CSV file.
+    {
+        const std::string csv = "/tmp/bbm_test_traces_mm.csv";
+        write_file(csv, "-500,0,500,100\n");
+        const auto in_mm = parse_model(with("[[region.dfn]]\nname = \"m\"\nfile = \"" + csv + "\"\nunits = \"mm\"\n"), "t.toml");
+        CHECK(in_mm.geometry.regions[0].dfn[0].traces[0].b == Vec2{0.5, 0.1});
+        std::remove(csv.c_str());
+    }
+
+    // The file's mistakes, at their line in the DXF file.
+    auto dxf_error = [&](const std::string& contents, int line, const std::string& words) {
+        write_file(path, contents);
+        try {
+            read_dxf(path, "region[0].dfn[0].file");
+            FAIL("no error for: " << words);
+        } catch (const InputError& e) {
+            INFO(e.what());
+            CHECK(e.file() == path);
+            CHECK(e.line() == line);
+            CHECK(e.key() == "region[0].dfn[0].file");
+            CHECK(std::string(e.what()).find(words) != std::string::npos);
+        }
+    };
+    dxf_error(std::string("AutoCAD Binary DXF\r\n\x1a") + '\0', 1, "a binary DXF file");
+    dxf_error("x1,y1,x2,y2\n0,0,1,1\n", 1, "expected a DXF group code");
+    auto bad = dxf_line("J1", {0, 0}, {1, 1});
+    bad[13] = "1.0.0"; // the start's y (20)
+    dxf_error(dxf_drawing(bad), 34, "group code 20 of the LINE at line 21 must be a number, got \"1.0.0\"");
+    dxf_error(dxf_drawing(std::vector<std::string>(arc.begin(), arc.end() - 4)), 21,
+              "says it has 2 vertices (group code 90) but lists 1");
+    dxf_error(dxf_drawing(cat({{"0", "LWPOLYLINE", "90", "2", "210", "1", "230", "0"}, {"10", "0", "20", "0", "10", "1", "20", "0"}})),
+              21, "not drawn in the XY plane");
+    dxf_error(dxf_drawing({"0", "LINE", "8", "J1", "10", "0", "20", "0"}), 21, "a LINE without its end point");
+    dxf_error(dxf_drawing(dxf_line("J1", {0, 0}, {1, 1}), 9), 13, "$INSUNITS = 9 are not a length bbm converts");
+    dxf_error(dxf_drawing(old).substr(0, dxf_drawing(old).find("  0\r\nSEQEND")) + "  0\r\nENDSEC\r\n  0\r\nEOF\r\n", 21,
+              "the POLYLINE has no SEQEND");
+    std::remove(path.c_str());
 }
