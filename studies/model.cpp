@@ -190,7 +190,12 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
                                              {"depth_crown", zone.depth_crown},
                                              {"extent_springline_deg", zone.extent_springline_deg},
                                              {"extent_crown_deg", zone.extent_crown_deg},
-                                             {"area_m2", zone.area}};
+                                             {"area_m2", zone.area},
+                                             {"reaches_region_edge", zone.reaches_region_edge},
+                                             {"region_edge_cells", zone.edge_cells},
+                                             {"region_edge_cells_damaged", zone.edge_cells_damaged}};
+        if (zone.reaches_region_edge)
+            summary["opening"]["failed_zone"]["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
         // Hoop stress profiles from the wall outwards (compression positive, MPa).
         const auto stress = solver.block_stresses();
         const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);

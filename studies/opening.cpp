@@ -100,6 +100,21 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
         where[std::size_t(i)] = {ring * sectors + sector, is_broken};
     }
     all.assign(std::size_t(rings * sectors), 0.0), broken.assign(all.size(), 0.0);
+    // Cells that hold the edge of the opening's region (an interface with a
+    // deformable region: the elastic far field).
+    std::vector<std::uint8_t> edge(all.size(), 0);
+    for (int i = 0; i < c.size(); ++i) {
+        const int ba = c.vertex_block[i], bb = c.edge_block[i];
+        if (b.region[ba] == b.region[bb] || b.removed[ba] || b.removed[bb] || !(b.deformable[ba] || b.deformable[bb]))
+            continue;
+        const Vec2 r = initial(c.vertex_id[i], ba) - center;
+        const double d = norm(r);
+        if (d < z.radius) continue;
+        double angle = std::atan2(r.y, r.x);
+        if (angle < 0) angle += 2 * pi;
+        const int ring = int((d - z.radius) / cell), sector = std::min(sectors - 1, int(angle / (2 * pi) * sectors));
+        if (ring < rings) edge[std::size_t(ring * sectors + sector)] = 1;
+    }
     for (int i = 0; i < c.size(); ++i) {
         const auto [cell_index, is_broken] = where[std::size_t(i)];
         if (cell_index < 0) continue;
@@ -117,6 +132,18 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
                 wall[std::size_t(sector)] = ring;
                 break;
             }
+    // The band along that edge: its cells and their neighbours, inside it.
+    auto near_edge = [&](int k) {
+        const int ring = k / sectors, sector = k % sectors;
+        for (int dr = -1; dr <= 1; ++dr)
+            for (int ds = -1; ds <= 1; ++ds) {
+                const int rr = ring + dr, ss = (sector + ds + sectors) % sectors;
+                if (rr >= 0 && rr < rings && edge[std::size_t(rr * sectors + ss)]) return true;
+            }
+        return false;
+    };
+    for (int k = 0; k < int(all.size()); ++k)
+        if (all[std::size_t(k)] > 0 && near_edge(k)) ++z.edge_cells, z.edge_cells_damaged += damaged(k);
     std::vector<std::uint8_t> in_zone(all.size(), 0);
     std::vector<int> stack;
     for (int sector = 0; sector < sectors; ++sector) {
@@ -135,6 +162,11 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
     for (std::size_t k = 0; k < in_zone.size(); ++k) {
         if (!in_zone[k]) continue;
         const int ring = int(k) / sectors, sector = int(k) % sectors;
+        if (near_edge(int(k)) && (!z.reaches_region_edge || norm(z.region_edge_point - center) < z.radius + (ring + 0.5) * cell)) {
+            const double mid = (sector + 0.5) * 2 * pi / sectors;
+            z.reaches_region_edge = true;
+            z.region_edge_point = center + (z.radius + (ring + 0.5) * cell) * Vec2{std::cos(mid), std::sin(mid)};
+        }
         z.depth[std::size_t(sector)] = std::max(z.depth[std::size_t(sector)], (ring + 1 - wall[std::size_t(sector)]) * cell);
         const double r0 = z.radius + ring * cell, r1 = r0 + cell;
         z.area += pi * (r1 * r1 - r0 * r0) / sectors;

@@ -50,6 +50,16 @@ struct FailedZone {
     /// Angular width of the zone (sectors with a depth) within +/-45 deg of each direction.
     double extent_springline_deg = 0, extent_crown_deg = 0;
     double area = 0; ///< m^2, the cells of the zone
+    /// The zone reaches the edge of the opening's region: a cell of it holds, or
+    /// borders, a contact between blocks of two regions one of which is deformable
+    /// (the interface with an elastic far field). The failure is then the model's
+    /// boundary's as much as the rock's: the model is too small.
+    bool reaches_region_edge = false;
+    Vec2 region_edge_point{}; ///< where (the outermost such cell's centre)
+    /// Cells holding that edge, and those of them damaged (connected to the wall
+    /// or not: cracks along the interface mean the far field loads the rock there
+    /// unlike rock would).
+    int edge_cells = 0, edge_cells_damaged = 0;
     /// The zone's outer edge: per sector, its centre direction at radius + depth.
     std::vector<Vec2> outline() const;
 };

@@ -546,6 +546,21 @@ int run_model(const RunOptions& opt) {
                          1e3 * summary["opening"]["crown_convergence"].get<double>(),
                          summary["opening"]["cracks_springline_sector"].get<int>(),
                          summary["opening"]["cracks_crown_sector"].get<int>());
+        if (rep.opening) {
+            const auto& zone = summary["opening"]["failed_zone"];
+            if (zone.value("reaches_region_edge", false)) {
+                const auto& p = zone["region_edge_point"];
+                std::fprintf(stderr, "warning: the failed zone reaches the edge of the opening's region at (%.2f, %.2f) "
+                                     "m, its interface with the elastic far field: the failure there is the model "
+                                     "boundary's as much as the rock's; enlarge the bonded region\n",
+                             p[0].get<double>(), p[1].get<double>());
+            } else if (zone.value("region_edge_cells_damaged", 0) >= 2) {
+                std::fprintf(stderr, "warning: the rock is damaged along the edge of the opening's region (%d of its "
+                                     "%d cells there), where it meets the elastic far field: the boundary, not only "
+                                     "the opening, breaks rock; enlarge the bonded region\n",
+                             zone["region_edge_cells_damaged"].get<int>(), zone["region_edge_cells"].get<int>());
+            }
+        }
         if (summary.contains("bolts"))
             for (const auto& b : summary["bolts"])
                 std::fprintf(stderr, "bolts '%s': %d, largest load %.1f kN (bond %.1f kN/m), %d yielded, %d broken\n",
@@ -573,7 +588,7 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
            "cracks_springline_sector,cracks_crown_sector,failed_zone_depth_springline_m,failed_zone_depth_crown_m,"
            "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio,bolts,bolt_max_axial_kN,bolts_yielded,"
-           "bolts_broken,liner_max_thrust_kN_per_m,liner_max_moment_kNm_per_m\n";
+           "bolts_broken,liner_max_thrust_kN_per_m,liner_max_moment_kNm_per_m,damage_at_region_edge\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
           "crack depth (90%) springline m | crack depth (90%) crown m | sector cracks springline / crown | "
           "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio | "
@@ -624,6 +639,7 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         const int fragments = verdict.value("fragments", 0);
         const auto zone = op.contains("failed_zone") ? op["failed_zone"] : nlohmann::json::object();
         const double zone_springline = zone.value("depth_springline", 0.0), zone_crown = zone.value("depth_crown", 0.0);
+        const bool at_edge = zone.value("reaches_region_edge", false) || zone.value("region_edge_cells_damaged", 0) >= 2;
         // Support, over its sets: how many bolts, the largest load, how many yielded or broke.
         int bolts = 0, yielded = 0, broken = 0;
         double bolt_load = 0.0;
@@ -646,7 +662,7 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         char row[1024];
         std::snprintf(row, sizeof row,
                       "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d,%.1f,"
-                      "%.2f\n",
+                      "%.2f,%d\n",
                       name.c_str(),
                       j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
                       j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
@@ -654,18 +670,18 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
                       1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
                       get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
                       int(get("cracks_crown_sector")), zone_springline, zone_crown, kind.c_str(), crack_rate, fragments,
-                      rock_ratio, bolts, bolt_load, yielded, broken, liner_thrust, liner_moment);
+                      rock_ratio, bolts, bolt_load, yielded, broken, liner_thrust, liner_moment, int(at_edge));
         csv << row;
         const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
         std::snprintf(row, sizeof row,
-                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f | %s | %.2f | %d | "
+                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f%s | %s | %.2f | %d | "
                       "%.2e | %s | %s |\n",
                       shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
                       1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
                       int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), zone_springline, zone_crown,
-                      kind.c_str(), crack_rate, fragments, rock_ratio, bolt_cell, liner_cell);
+                      at_edge ? " (damage at the region's edge)" : "", kind.c_str(), crack_rate, fragments, rock_ratio, bolt_cell, liner_cell);
         md << row;
         // Cracks against step from the run's history (columns whose quantity is a crack count).
         Series ser{name, {}, {}};

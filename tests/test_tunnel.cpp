@@ -180,4 +180,34 @@ TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and ex
     // The deepest single crack (OpeningMeasures) sees the crown cluster.
     const auto m = measure_opening(s, {0, 0}, {4, 0}, {0, 4});
     CHECK(m.failed_depth_crown > 3.0);
+    // Neither reaches the bonded region's edge at x = 8 m (its interface with the
+    // elastic far field).
+    CHECK_FALSE(z.reaches_region_edge);
+    CHECK(z.edge_cells > 20);
+    CHECK(z.edge_cells_damaged == 0);
+
+    // A column of cracks along that edge, apart from the wall (x 7.3 to 8 m, y 2
+    // to 6 m): not the zone, but damage along the edge.
+    auto crack = [&](auto where) {
+        for (int i = 0; i < c.size(); ++i) {
+            const Vec2 x = b.centroid0[c.vertex_block[i]] + b.local[c.vertex_id[i]];
+            if (where(x) && c.history[i].bonded && b.region[c.vertex_block[i]] == b.region[c.edge_block[i]])
+                c.history[i].broken = contact::JointState::broken_tension, c.history[i].bonded = false;
+        }
+    };
+    crack([](Vec2 x) { return x.x > 7.3 && x.x < 8.0 && x.y > 2.0 && x.y < 6.0; });
+    const auto column = measure_failed_zone(s, {0, 0}, {4, 0}, {0, 4});
+    MESSAGE("column along the edge: " << column.edge_cells_damaged << " of " << column.edge_cells << " edge cells damaged");
+    CHECK_FALSE(column.reaches_region_edge);
+    CHECK(column.edge_cells_damaged >= 3);
+    CHECK(column.depth_springline == z.depth_springline);
+    // The wall's zone carried on to the edge along the springline: it reaches it,
+    // at x about 8 m (and, joined to the column there, takes the column in).
+    crack([](Vec2 x) { return x.x > 4.0 && x.x < 8.0 && std::abs(x.y) < 0.8; });
+    const auto through = measure_failed_zone(s, {0, 0}, {4, 0}, {0, 4});
+    MESSAGE("zone to the edge: depth " << through.depth_springline << " m, edge point (" << through.region_edge_point.x
+                                       << ", " << through.region_edge_point.y << ")");
+    CHECK(through.reaches_region_edge);
+    CHECK(through.region_edge_point.x > 8.0 - 2 * through.cell);
+    CHECK(std::abs(through.region_edge_point.y) < 6.0 + through.cell);
 }
