@@ -236,10 +236,51 @@ void insert_vertex_on_edge(std::vector<Vec2>& poly, Vec2 tip, double tol) {
     }
 }
 
+/// Removes the spikes of a polygon: a vertex where its boundary runs out along a
+/// line and straight back (an edge followed by its own reverse, zero area), left
+/// where a fracture ends inside a face and the face's pattern or a split met it.
+/// A spike is not rock: kept, its two sides would each make a joint with the
+/// blocks across the fracture, counting that stretch of fracture twice, and the
+/// polygon is not simple, so a trace ending in it could not split it.
+/// Returns whether anything was removed.
+bool remove_spikes(std::vector<Vec2>& poly, double tol) {
+    bool changed = false;
+    for (bool again = true; again && poly.size() >= 3;) {
+        again = false;
+        for (std::size_t i = 0; i < poly.size() && poly.size() >= 3; ++i) {
+            const std::size_t n = poly.size();
+            const Vec2 p = poly[(i + n - 1) % n], v = poly[i], q = poly[(i + 1) % n];
+            const Vec2 a = v - p, b = q - v;
+            const bool repeated = norm(a) <= tol;
+            const bool spike = !repeated && norm(b) > tol && dot(a, b) < 0.0 &&
+                               std::abs(cross(a, b)) <= tol * std::max(norm(a), norm(b));
+            if (!repeated && !spike) continue;
+            poly.erase(poly.begin() + long(i));
+            changed = again = true;
+            if (i > 0) --i;
+        }
+    }
+    return changed;
+}
+
 struct RegionBlocks {
     std::vector<std::vector<Vec2>> polygons;
     std::vector<int> parent;
 };
+
+/// The spikes of every block removed; a block that was nothing but a spike (no
+/// area left) is dropped.
+void remove_spikes(RegionBlocks& rb, double tol) {
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < rb.polygons.size(); ++k) {
+        remove_spikes(rb.polygons[k], tol);
+        if (rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol) continue;
+        if (kept != k) rb.polygons[kept] = std::move(rb.polygons[k]), rb.parent[kept] = rb.parent[k];
+        ++kept;
+    }
+    rb.polygons.resize(kept);
+    rb.parent.resize(kept);
+}
 
 /// Real joints that end inside a rock block split the inner blocks they cross,
 /// along their line; the part beyond the tip becomes an ordinary inner joint.
@@ -684,7 +725,9 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
                 rb.parent.push_back(offset + fill.parent[k]);
             }
         }
+        remove_spikes(rb, tol);
         st.unsplit_blocks += split_by_dangling(rb, cut.dangling, tol);
+        remove_spikes(rb, tol);
         order_along_curve(rb);
         const int parent_base = a.block_count();
         for (std::size_t k = 0; k < rb.polygons.size(); ++k)

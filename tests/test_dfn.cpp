@@ -414,10 +414,18 @@ property = "bond"
                             << " m; " << st.unsplit_blocks << " blocks not split at a trace's tip");
     CHECK(area == doctest::Approx(1600.0).epsilon(1e-9));
     CHECK(a.block_count() > 15000);
-    // A trace whose tip lies in a block that is not a simple polygon stops short
-    // there (counted and warned by bbm mesh): a few of 2,000 traces. The fracture
-    // joints measure 2,080.6 m against 2,073.7 m of traces (+0.33%, where the
-    // small network above matches to 1e-6): not explained yet, bounded here.
+    // A trace whose tip lies in a block that is not a simple polygon (a fracture-
+    // bounded block touching it at a point, inside it) stops short there (counted
+    // and warned by bbm mesh): a few of 2,000 traces. No stretch of fracture is a
+    // joint twice: blocks whose boundary ran out along a fracture and back (a
+    // spike) once gave two joints there, 2,080.6 m of fracture joints against
+    // 2,073.7 m of traces (+0.33%); without spikes, 2,070.97 m (-0.13%, the tips
+    // that stop short).
     CHECK(st.unsplit_blocks < 40);
-    CHECK(joints == doctest::Approx(traces).epsilon(0.01));
+    CHECK(joints <= traces * (1.0 + 1e-9));
+    CHECK(joints >= traces * 0.995);
+    double smallest = 1e300;
+    for (int b = 0; b < a.block_count(); ++b) smallest = std::min(smallest, a.area[b]);
+    MESSAGE("smallest block " << smallest << " m²");
+    CHECK(smallest > 0.0); // blocks that were nothing but a spike are gone
 }
