@@ -120,6 +120,9 @@ struct GenerationStats {
     /// Blocks a trace ending inside them should have split along its line but that
     /// were no simple polygon (dense fracture networks): the trace stops short there.
     int unsplit_blocks = 0;
+    /// Sliver blocks (under 1e-8 of a block's area: where fractures cross nearly at
+    /// one point) merged into the neighbour they share most boundary with.
+    int merged_slivers = 0;
     /// Deformable blocks: triangles made, and the time spent subdividing and meshing.
     int zones = 0;
     double seconds_meshing = 0;

@@ -151,6 +151,12 @@ Domain intersection(const Domain& a, const Domain& b) {
     return from_set(s);
 }
 
+Domain join(const Domain& a, const Domain& b) {
+    PolySet s = to_set(a);
+    s.join(to_set(b));
+    return from_set(s);
+}
+
 // ---------------------------------------------------------------------------
 // Clipper: boundary edges in a uniform grid decide cheaply whether a polygon is
 // wholly inside or outside; only polygons touching the boundary go to CGAL.

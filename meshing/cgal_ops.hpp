@@ -29,6 +29,7 @@ double area(const Domain& d);
 Domain make_domain(std::span<const Vec2> outer_ccw, const std::vector<std::vector<Vec2>>& holes_ccw);
 Domain difference(const Domain& a, const Domain& b);
 Domain intersection(const Domain& a, const Domain& b);
+Domain join(const Domain& a, const Domain& b);
 
 /// A domain prepared once for clipping many small polygons against it.
 class Clipper {

@@ -100,6 +100,7 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
             {"collapsed_edges", st.collapsed_edges},
             {"short_edges_left", st.short_edges_left},
             {"unsplit_blocks", st.unsplit_blocks},
+            {"merged_slivers", st.merged_slivers},
             {"regions", regions},
             {"fracture_sets", fracture_sets},
             {"seconds", {{"regions", st.seconds_regions},
