@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include <unistd.h>
@@ -344,6 +345,65 @@ int merge_slivers(RegionBlocks& rb, double min_area, double tol) {
     return merged;
 }
 
+/// A block whose ring passes a vertex twice to wrap around a smaller block that
+/// touches it there (a pinched hole: in a dense network, a fracture-bounded block
+/// inside it meeting its boundary at one point) as a ring with holes: one
+/// counter-clockwise loop and clockwise ones, all simple. Nothing when it is not.
+std::optional<cgal::PolygonWithHoles> as_pinched(const std::vector<Vec2>& ring) {
+    auto loops = cgal::split_at_repeats(ring);
+    if (loops.size() < 2) return std::nullopt;
+    cgal::PolygonWithHoles p;
+    for (auto& l : loops) {
+        if (!cgal::is_simple(l)) return std::nullopt;
+        if (signed_area(l) < 0) {
+            p.holes.push_back(std::move(l));
+        } else {
+            if (!p.outer.empty()) return std::nullopt;
+            p.outer = std::move(l);
+        }
+    }
+    if (p.outer.empty()) return std::nullopt;
+    return p;
+}
+
+/// The lobes of a block whose ring passes a vertex twice with every loop
+/// counter-clockwise (pieces touching at a point); empty when it is not that.
+std::vector<std::vector<Vec2>> lobes_of(const std::vector<Vec2>& ring) {
+    auto loops = cgal::split_at_repeats(ring);
+    const bool lobes = loops.size() > 1 && std::all_of(loops.begin(), loops.end(), [](const auto& l) {
+                           return signed_area(l) > 0;
+                       });
+    return lobes ? loops : std::vector<std::vector<Vec2>>{};
+}
+
+/// The inverse of as_pinched: each hole walked into the ring at the vertex where
+/// it touches it (clockwise, as a block's ring passes round a pinched hole).
+/// Empty when a hole touches the ring nowhere (it would be a true hole, which a
+/// block cannot have).
+std::vector<Vec2> pinched_ring(const cgal::PolygonWithHoles& p) {
+    std::vector<Vec2> ring = p.outer;
+    // A hole may touch the ring only through another hole: weave until none is left.
+    std::vector<const std::vector<Vec2>*> left;
+    for (const auto& h : p.holes) left.push_back(&h);
+    while (!left.empty()) {
+        const auto before = left.size();
+        std::erase_if(left, [&](const std::vector<Vec2>* h) {
+            for (std::size_t i = 0; i < ring.size(); ++i) {
+                const auto at = std::find(h->begin(), h->end(), ring[i]);
+                if (at == h->end()) continue;
+                std::vector<Vec2> walk;
+                const std::size_t j = std::size_t(at - h->begin());
+                for (std::size_t m = 1; m <= h->size(); ++m) walk.push_back((*h)[(j + m) % h->size()]);
+                ring.insert(ring.begin() + long(i) + 1, walk.begin(), walk.end());
+                return true;
+            }
+            return false;
+        });
+        if (left.size() == before) return {};
+    }
+    return ring;
+}
+
 /// Real joints that end inside a rock block split the inner blocks they cross,
 /// along their line; the part beyond the tip becomes an ordinary inner joint.
 /// Returns the number of blocks a trace should have split but could not (not
@@ -359,22 +419,44 @@ int split_by_dangling(RegionBlocks& rb, const std::vector<SegmentSpec>& dangling
             const Box2 b = bounding_box(rb.polygons[k]);
             if (b.hi.x < sb.lo.x || b.lo.x > sb.hi.x || b.hi.y < sb.lo.y || b.lo.y > sb.hi.y) continue;
             if (!segment_enters(rb.polygons[k], s.a, s.b)) continue;
-            // CGAL's Boolean operations need a simple polygon; a block that is not
-            // is reported by the caller's area check instead of crashing here.
-            if (!cgal::is_simple(rb.polygons[k])) {
+            // A block an earlier trace left as only a spike is dropped afterwards.
+            remove_spikes(rb.polygons[k], tol);
+            if (rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol) continue;
+            std::vector<std::vector<Vec2>> split;
+            const double whole = signed_area(rb.polygons[k]);
+            // CGAL's Boolean operations need simple polygons. A block with a
+            // pinched hole (a smaller fracture-bounded block inside it, touching it
+            // at one point) is split as a ring with holes, one of lobes lobe by
+            // lobe; one that rounding made cross itself is left whole and counted.
+            if (cgal::is_simple(rb.polygons[k])) {
+                split = cgal::split_by_line(rb.polygons[k], s.a, s.b);
+            } else if (const auto pinched = as_pinched(rb.polygons[k])) {
+                for (const auto& piece : cgal::split_by_line(*pinched, s.a, s.b)) split.push_back(pinched_ring(piece));
+            } else if (const auto lobes = lobes_of(rb.polygons[k]);
+                       !lobes.empty() && std::all_of(lobes.begin(), lobes.end(), cgal::is_simple)) {
+                // Two lobes touching at a vertex are two blocks; each is split.
+                for (const auto& lobe : lobes)
+                    for (auto& piece : cgal::split_by_line(lobe, s.a, s.b)) split.push_back(std::move(piece));
+            }
+            // The pieces of a block that is not simple must tile it: a walk whose
+            // loops are not what they seem (a clockwise loop outside the ring)
+            // would make rock from nothing. Rounding moves each vertex by < tol.
+            double pieces_area = 0.0, perimeter = 0.0;
+            for (const auto& r : split) {
+                pieces_area += r.empty() ? 1e300 : std::abs(signed_area(r));
+                for (std::size_t i = 0; i < r.size(); ++i) perimeter += norm(r[(i + 1) % r.size()] - r[i]);
+            }
+            if (std::abs(pieces_area - whole) > 1e-9 * whole + 4.0 * tol * perimeter) split.clear();
+            if (split.empty()) {
                 ++skipped;
                 continue;
             }
             std::vector<std::vector<Vec2>> pieces;
             // A line through a vertex of a concave block can leave a piece of two
             // lobes touching at that vertex: two blocks.
-            for (auto& piece : cgal::split_by_line(rb.polygons[k], s.a, s.b)) {
-                auto loops = cgal::split_at_repeats(piece);
-                const bool lobes = loops.size() > 1 && std::all_of(loops.begin(), loops.end(), [](const auto& l) {
-                                       return signed_area(l) > 0;
-                                   });
-                if (lobes)
-                    for (auto& l : loops) pieces.push_back(std::move(l));
+            for (auto& piece : split) {
+                if (auto lobes = lobes_of(piece); !lobes.empty())
+                    for (auto& l : lobes) pieces.push_back(std::move(l));
                 else
                     pieces.push_back(std::move(piece));
             }

@@ -289,6 +289,18 @@ std::vector<std::vector<Vec2>> split_by_line(std::span<const Vec2> poly, Vec2 a,
     return out;
 }
 
+std::vector<PolygonWithHoles> split_by_line(const PolygonWithHoles& poly, Vec2 a, Vec2 b) {
+    const Pwh p = to_exact_pwh(poly);
+    const double extent = extent_of(poly.outer) + norm(a) + norm(b);
+    std::vector<PolygonWithHoles> out;
+    for (bool left : {true, false}) {
+        std::vector<Pwh> res;
+        CGAL::intersection(p, half_plane(to_exact(a), to_exact(b), extent, left), std::back_inserter(res));
+        for (const auto& r : res) out.push_back(to_pwh(r));
+    }
+    return out;
+}
+
 // ---------------------------------------------------------------------------
 namespace {
 using Traits = CGAL::Arr_segment_traits_2<EK>;

@@ -56,6 +56,9 @@ std::vector<std::vector<Vec2>> split_holes(const PolygonWithHoles& p);
 
 /// Splits a simple polygon by the infinite line through a and b (exact line).
 std::vector<std::vector<Vec2>> split_by_line(std::span<const Vec2> poly, Vec2 a, Vec2 b);
+/// The same for a polygon whose holes may touch its ring at a vertex (exact line;
+/// the pieces may keep such holes).
+std::vector<PolygonWithHoles> split_by_line(const PolygonWithHoles& poly, Vec2 a, Vec2 b);
 
 /// Result of cutting a domain by real joint segments (CGAL arrangement).
 struct CutResult {
