@@ -269,18 +269,27 @@ struct RegionBlocks {
     std::vector<int> parent;
 };
 
-/// The spikes of every block removed; a block that was nothing but a spike (no
-/// area left) is dropped.
-void remove_spikes(RegionBlocks& rb, double tol) {
+/// The blocks marked gone removed, the others kept in order.
+void drop_blocks(RegionBlocks& rb, const std::vector<char>& gone) {
     std::size_t kept = 0;
     for (std::size_t k = 0; k < rb.polygons.size(); ++k) {
-        remove_spikes(rb.polygons[k], tol);
-        if (rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol) continue;
+        if (gone[k]) continue;
         if (kept != k) rb.polygons[kept] = std::move(rb.polygons[k]), rb.parent[kept] = rb.parent[k];
         ++kept;
     }
     rb.polygons.resize(kept);
     rb.parent.resize(kept);
+}
+
+/// The spikes of every block removed; a block that was nothing but a spike (no
+/// area left) is dropped.
+void remove_spikes(RegionBlocks& rb, double tol) {
+    std::vector<char> gone(rb.polygons.size(), 0);
+    for (std::size_t k = 0; k < rb.polygons.size(); ++k) {
+        remove_spikes(rb.polygons[k], tol);
+        gone[k] = rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol;
+    }
+    drop_blocks(rb, gone);
 }
 
 /// Length of boundary two polygons share: their edges that lie on one line and
@@ -334,14 +343,7 @@ int merge_slivers(RegionBlocks& rb, double min_area, double tol) {
         gone[k] = 1;
         ++merged;
     }
-    std::size_t kept = 0;
-    for (std::size_t k = 0; k < rb.polygons.size(); ++k) {
-        if (gone[k]) continue;
-        if (kept != k) rb.polygons[kept] = std::move(rb.polygons[k]), rb.parent[kept] = rb.parent[k];
-        ++kept;
-    }
-    rb.polygons.resize(kept);
-    rb.parent.resize(kept);
+    drop_blocks(rb, gone);
     return merged;
 }
 
