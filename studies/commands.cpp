@@ -328,7 +328,7 @@ nlohmann::json labtest_json(const LabTestResult& r) {
             {"crack_initiation_stress", r.crack_initiation_stress}, {"crack_damage_stress", r.crack_damage_stress},
             {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
             {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
-            {"post_peak_locking", r.post_peak_locking},
+            {"post_peak_locking", r.post_peak_locking}, {"preload_skipped", r.preload_skipped},
             {"joint_slip_stress", r.joint_slip_stress}, {"joint_slip_stress_half", r.joint_slip_stress_half},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
@@ -358,7 +358,7 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.crack_initiation_stress = j["crack_initiation_stress"], r.crack_damage_stress = j["crack_damage_stress"];
     r.tensile_strength = j["tensile_strength"], r.blocks = j["blocks"], r.contacts = j["contacts"];
     r.steps = j["steps"], r.wall_seconds = j["wall_seconds"], r.peak_passed = j["peak_passed"];
-    r.post_peak_locking = j["post_peak_locking"];
+    r.post_peak_locking = j["post_peak_locking"], r.preload_skipped = j["preload_skipped"];
     r.joint_slip_stress = j["joint_slip_stress"], r.joint_slip_stress_half = j["joint_slip_stress_half"];
     r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
     const auto& o = j["crack_orientation"];
@@ -589,6 +589,10 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                              static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.E50 / 1e9, r.nu, r.peak_stress / 1e6,
                              r.strain_at_peak, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6,
                              r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
+                if (r.preload_skipped)
+                    std::fprintf(stderr, "  seed %llu: the confinement left blocks the implicit preload cannot solve "
+                                         "(held at one point, or loose): loaded explicitly from the start\n",
+                                 static_cast<unsigned long long>(ok.seed));
                 if (r.post_peak_locking)
                     std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",

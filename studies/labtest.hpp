@@ -166,6 +166,10 @@ struct LabTestResult {
     /// After failure the stress climbed back above the peak (a jammed rubble core):
     /// the run stopped there and peak_stress is the peak before failure.
     bool post_peak_locking = false;
+    /// The implicit elastic preload could not be solved (the confinement left a
+    /// block held at one point, or a loose group): the loading was explicit from
+    /// the start, and E comes from the explicit curve.
+    bool preload_skipped = false;
     std::vector<StressStrainPoint> curve;
 };
 
