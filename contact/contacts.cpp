@@ -128,6 +128,72 @@ void update_normals(Contacts& c, const BlockView& b, double corner_radius) {
     for (int i = 0; i < c.size(); ++i) contact_kinematics(c, i, b, corner_radius);
 }
 
+void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::uint8_t>& face_shear) {
+    c.face_group.clear();
+    c.face_first.assign(1, 0);
+    c.face_entry.clear();
+    c.face_du_s.clear();
+    const int n = c.size();
+    auto grouped = [&](int i) {
+        const int p = c.property[i];
+        return p < int(face_shear.size()) && face_shear[p] && b.deformable[c.vertex_block[i]] != b.deformable[c.edge_block[i]];
+    };
+    bool any = false;
+    for (int i = 0; i < n && !any; ++i) any = grouped(i);
+    if (!any) return;
+    // A face is named by the global id of its first vertex (unique over blocks).
+    std::vector<std::pair<int, int>> face_of; // (face, contact)
+    for (int i = 0; i < n; ++i) {
+        if (!grouped(i)) continue;
+        int face = c.edge_id[i];
+        if (b.deformable[c.edge_block[i]]) {
+            // The rigid block's vertex: of its two edges, the one most nearly
+            // opposite to the deformable edge (faces in contact run opposite ways).
+            const int A = c.vertex_block[i], v = c.vertex_id[i];
+            const int prev = v == int(b.first[A]) ? int(b.first[A + 1]) - 1 : v - 1, next = next_vertex(b.first, A, v);
+            const Vec2 t = b.vertex[c.edge_end[i]] - b.vertex[c.edge_id[i]];
+            const Vec2 in = b.vertex[v] - b.vertex[prev], out = b.vertex[next] - b.vertex[v];
+            face = dot(in, t) / norm(in) < dot(out, t) / norm(out) ? prev : v;
+        }
+        face_of.emplace_back(face, i);
+    }
+    std::sort(face_of.begin(), face_of.end());
+    c.face_group.assign(n, -1);
+    for (std::size_t k = 0; k < face_of.size(); ++k) {
+        if (k > 0 && face_of[k].first != face_of[k - 1].first) c.face_first.push_back(int(k));
+        c.face_group[face_of[k].second] = int(c.face_first.size()) - 1;
+        c.face_entry.push_back(face_of[k].second);
+    }
+    c.face_first.push_back(int(face_of.size()));
+    c.face_du_s.assign(c.face_first.size() - 1, 0.0);
+}
+
+void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_radius) {
+    const int faces = int(c.face_du_s.size());
+#pragma omp for schedule(static) nowait
+    for (int f = 0; f < faces; ++f) {
+        double sum = 0.0, length = 0.0;
+        for (int e = c.face_first[f]; e < c.face_first[f + 1]; ++e) {
+            const int i = c.face_entry[e];
+            const int A = c.vertex_block[i], B = c.edge_block[i];
+            const Vec2 x = b.vertex[c.vertex_id[i]], p = b.vertex[c.edge_id[i]], q = b.vertex[c.edge_end[i]];
+            const double inv_len = b.inv_edge_length[c.edge_id[i]];
+            const Vec2 t = inv_len * (q - p);
+            const double s = dot(x - p, t) * inv_len;
+            Vec2 tangent = t;
+            if (!c.history[i].bonded && (s < 0.0 || s > 1.0)) {
+                const Vec2 nrm{t.y, -t.x};
+                const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * nrm);
+                if (const double rl = norm(r); rl > 0.0) tangent = tangent_of(r / rl);
+            }
+            const Vec2 vr = vertex_velocity(b, A, c.vertex_id[i], x) - edge_velocity(b, B, c.edge_id[i], c.edge_end[i], s, x);
+            sum += c.length[i] * dot(vr, tangent) * dt;
+            length += c.length[i];
+        }
+        c.face_du_s[f] = length > 0.0 ? sum / length : 0.0;
+    }
+}
+
 namespace {
 // The first pass reads everything through local restrict pointers: through the
 // Contacts members the compiler must assume the stores alias them and would
@@ -149,6 +215,8 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
     const Vec2* __restrict vertex = b.vertex;
     const BodyState* __restrict body = b.body;
     const double* __restrict inv_edge = b.inv_edge_length;
+    const int* __restrict face = c.face_group.empty() ? nullptr : c.face_group.data();
+    const double* __restrict face_du_s = c.face_du_s.data();
     double sum = 0.0;
     const std::size_t count = ids.size();
     for (std::size_t k = 0; k < count; ++k) {
@@ -183,7 +251,10 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
             vr = vertex_velocity(b, A, vid[i], x) - edge_velocity(b, B, e0[i], e1[i], s, x);
         else
             vr = (bA.velocity + bA.omega * perp(ra)) - (bB.velocity + bB.omega * perp(rb));
-        const double du_n = dot(vr, n) * dt, du_s = dot(vr, t) * dt;
+        const double du_n = dot(vr, n) * dt;
+        double du_s = dot(vr, t) * dt;
+        if constexpr (Mixed)
+            if (face && face[i] >= 0) du_s = face_du_s[face[i]];
         law.update(h, du_n, du_s);
         const Vec2 f = len[i] * (h.sn * n - h.tau * t);
         double moment_b = -cross(rb, f);

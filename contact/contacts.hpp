@@ -121,6 +121,12 @@ struct Contacts {
     /// Per FE node likewise: entry 4·contact + role, role 0 = A's vertex node
     /// (+F), 1 = first node of B's edge (−(1−w)F), 2 = second node (−wF).
     std::vector<int> node_first, node_entry;
+    /// Faces of rigid blocks against deformable blocks, for property sets with
+    /// `face_shear` (assign_face_groups): per contact its face or −1; per face its
+    /// contacts, in contact order (CSR); and each step the face's mean shear-slip
+    /// increment, which every contact of the face takes (face_slip_pass).
+    std::vector<int> face_group, face_first{0}, face_entry;
+    std::vector<double> face_du_s;
     // Per-step scratch of step_contacts (sized by rebuild_index, never in a step).
     std::vector<ContactForce> force;
     std::vector<double> partial_sum; ///< per work item
@@ -171,6 +177,23 @@ inline void contact_kinematics(Contacts& c, int i, const BlockView& b, double co
 
 /// Normals of every contact from the current geometry.
 void update_normals(Contacts& c, const BlockView& b, double corner_radius);
+
+/// Groups the contacts between a rigid block and a deformable one whose property
+/// set has `face_shear[property]` by the rigid block's face: the rigid block's
+/// edge when it is the edge block, else the edge at its vertex that runs most
+/// nearly against the deformable edge (current geometry). Clears the groups when
+/// no set asks for them.
+void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::uint8_t>& face_shear);
+
+/// Per face, the length-weighted mean of its contacts' shear-slip increments this
+/// step, into `c.face_du_s` (the same kinematics as contact_pass). Between a rigid
+/// face and a deformable body the pointwise slip grows along the face with the
+/// body's strain, and pointwise shear springs would load the rigid block with a
+/// couple of forces a joint between two rigid blocks never carries; on the mean
+/// slip the face's shear traction is uniform, as on such a joint (docs/theory.md
+/// §11.1). An OpenMP work-sharing loop with `nowait` like contact_pass: the team
+/// must meet at a barrier before contact_pass reads the result.
+void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_radius);
 
 /// Contact force on the vertex block (A); B gets the opposite.
 inline Vec2 contact_force(const Contacts& c, int i) {

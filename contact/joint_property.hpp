@@ -17,6 +17,10 @@ struct JointPropertySpec {
     Law law = Law::softening;
     double kn = 0.0;              ///< normal stiffness, Pa/m (> 0)
     double ks = 0.0;              ///< shear stiffness, Pa/m (> 0)
+    /// Between a rigid block and a deformable one: the contacts of the rigid
+    /// block's face share the face's mean shear slip (contact/contacts.hpp,
+    /// face_slip_pass) — the interface of a bonded region with an elastic far field.
+    bool face_shear = false;
     double friction = 30.0;       ///< friction angle φ, degrees
     double residual_friction = -1; ///< φr after failure, degrees; < 0 = friction
     double cohesion = 0.0;        ///< c, Pa (coulomb: brittle bond; softening: peak cohesion)

@@ -73,7 +73,7 @@ std::uint64_t Solver::compute_model_fingerprint() const {
     };
     auto vec = [&](const auto& v) { mix(v.data(), v.size() * sizeof(v[0])); };
     vec(b_.local), vec(b_.centroid0), vec(b_.real_mass), vec(b_.fixed), vec(b_.fixed_velocity), vec(b_.applied);
-    vec(n_.position0), vec(n_.real_mass), vec(n_.fixed), vec(n_.applied), vec(z_.elasticity);
+    vec(n_.position0), vec(n_.real_mass), vec(n_.fixed), vec(n_.applied), vec(z_.elasticity), vec(face_shear_);
     for (const auto& set : bolts_.sets) {
         const double p[9] = {set.ea, set.yield_force, set.rupture_strain, set.bond_stiffness, set.bond_strength,
                              set.normal_stiffness, set.line_mass, set.spacing, double(set.cable)};
@@ -167,9 +167,9 @@ void Solver::load_state(std::istream& i) {
     liners_.reaction_moment.assign(liners_.position.size(), 0.0);
     index_bolt_hosts();
     normals_stale_ = true;
+    update_vertices(); // the faces of assign_face_groups are read off the current geometry
     rebuild_contact_index();
     detector_.invalidate();
-    update_vertices();
     if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
 }
 

@@ -268,6 +268,8 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
         laws_.push_back(contact::make_law(unbonded));
         property_names_.push_back(unbonded.name);
     }
+    face_shear_.assign(laws_.size(), 0);
+    for (std::size_t k = 0; k < specs.size(); ++k) face_shear_[k] = specs[k].face_shear;
     // Mean size of the rigid blocks (the few large deformable ones would swamp it).
     double mean_area = 0.0;
     int counted = 0;
@@ -628,6 +630,7 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
 
 void Solver::rebuild_contact_index() {
     c_.rebuild_index(int(laws_.size()), b_.count(), b_.deformable.data(), n_.count(), b_.vertex_node.data());
+    contact::assign_face_groups(c_, view(), face_shear_);
 }
 
 void Solver::refresh_normals() const {
@@ -642,6 +645,10 @@ void Solver::compute_forces() {
     // forces in a fixed order, plus gravity, boundary loads and relaxing supports.
     // Support (bolts, liners): one thread, while the others start on the contacts
     // (dynamic batches).
+    if (!c_.face_du_s.empty()) {
+        contact::face_slip_pass(c_, view(), dt_, corner_radius_);
+#pragma omp barrier
+    }
     const int bolt_ties = bolts_.node_count();
     const bool bolts = bolt_ties + liners_.node_count() > 0;
     if (bolts) {

@@ -277,6 +277,7 @@ private:
     std::vector<std::pair<int, double>> bolt_node_tie_;
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
+    std::vector<std::uint8_t> face_shear_; ///< per property set: JointPropertySpec::face_shear
     std::vector<std::string> region_names_;
     SolverSpec settings_;
     std::vector<std::pair<std::string, std::vector<int>>> boundary_blocks_;

@@ -532,10 +532,11 @@ void read_heterogeneity(const Ctx& c, const toml::table& t, const Path& p, Joint
 }
 
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 13> all_keys{"name",
+    static constexpr std::array<std::string_view, 14> all_keys{"name",
                                                                "law",
                                                                "kn",
                                                                "ks",
+                                                               "face_shear",
                                                                "friction",
                                                                "residual_friction",
                                                                "cohesion",
@@ -550,13 +551,14 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
     using Law = JointPropertySpec::Law;
     j.name = read_name(c, t, p, names);
     j.law = static_cast<Law>(choice(c, t, p, "law", laws, "joint law"));
-    const Keys keys = j.law == Law::elastic   ? Keys(all_keys).first(4)
-                      : j.law == Law::coulomb ? Keys(all_keys).first(11)
+    const Keys keys = j.law == Law::elastic   ? Keys(all_keys).first(5)
+                      : j.law == Law::coulomb ? Keys(all_keys).first(12)
                                               : Keys(all_keys);
     check_keys(c, t, p, keys, all_keys,
                article(laws[static_cast<std::size_t>(j.law)]) + " joint property");
     j.kn = required_number(c, t, p, "kn", above(0, pascals_per_metre));
     j.ks = required_number(c, t, p, "ks", above(0, pascals_per_metre));
+    j.face_shear = boolean(c, t, p, "face_shear").value_or(false);
     if (j.law == Law::elastic) return j;
     j.friction = number(c, t, p, "friction", below(0, 90, degrees)).value_or(j.friction);
     j.residual_friction = number(c, t, p, "residual_friction", below(0, 90, degrees)).value_or(-1);

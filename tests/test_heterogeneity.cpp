@@ -94,6 +94,9 @@ TEST_CASE("heterogeneous strengths: model-file keys") {
         return "";
     };
     const std::string bond = "name = \"b\"\nlaw = \"coulomb\"\nkn = 1e10\nks = 1e10\n";
+    // face_shear (the interface with a far field) is a key of every law.
+    CHECK(error_of("name = \"e\"\nlaw = \"elastic\"\nkn = 1e10\nks = 1e10\nface_shear = true\n") == "");
+    CHECK(error_of(bond + "face_shear = 1\n").find("joint_property[0].face_shear") == 0);
     CHECK(error_of(bond + "cohesion = 1e6\nweibull_modulus = 3\nstrength_classes = 8\nstrength_seed = 4\n") == "");
     CHECK(error_of(bond + "weibull_modulus = 3\n").find("joint_property[0].weibull_modulus: heterogeneous strengths need a bond") == 0);
     CHECK(error_of(bond + "cohesion = 1e6\nstrength_classes = 8\n").find("joint_property[0].strength_classes: goes with weibull_modulus") == 0);
