@@ -643,8 +643,7 @@ void Solver::compute_forces() {
     // First passes (contacts, then zones: independent of each other, no barrier
     // between them), then one gather per block and node: its contacts' and zones'
     // forces in a fixed order, plus gravity, boundary loads and relaxing supports.
-    // Support (bolts, liners): one thread, while the others start on the contacts
-    // (dynamic batches).
+    // Support (bolts, liners): one thread, before its share of the contacts.
     if (!c_.face_du_s.empty()) {
         contact::face_slip_pass(c_, view(), dt_, corner_radius_);
 #pragma omp barrier
@@ -754,7 +753,7 @@ void Solver::integrate() {
     // over the chunks in order: the same bits on any thread count.
     const int nb = b_.count(), nn = n_.count();
     const int block_chunks = (nb + sum_chunk - 1) / sum_chunk, chunks = block_chunks + (nn + sum_chunk - 1) / sum_chunk;
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static)
     for (int chunk = 0; chunk < chunks; ++chunk) {
         double w = 0.0, unbalanced = 0.0;
         if (chunk < block_chunks) {

@@ -73,7 +73,7 @@ inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double 
 
 void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip) {
     const int count = z.size(), items = int(z.partial_sum.size());
-#pragma omp for schedule(dynamic, 1) nowait
+#pragma omp for schedule(static) nowait
     for (int w = 0; w < items; ++w) {
         double sum = 0.0;
         for (int k = w * Zones::work_item_size; k < std::min(count, (w + 1) * Zones::work_item_size); ++k) {

@@ -134,7 +134,10 @@ void write_grid(vtkUnstructuredGrid* grid, const fs::path& file) {
     writer->SetInputData(grid);
     writer->SetDataModeToAppended();
     writer->EncodeAppendedDataOff(); // raw binary, not base64
-    writer->SetCompressorTypeToZLib();
+    // LZ4, not zlib: a snapshot of the trigon tunnel takes a quarter of the time
+    // (0.8 -> 0.2 s of its 8 s run, serial), for files 30% larger; ParaView and
+    // VTK's readers take either.
+    writer->SetCompressorTypeToLZ4();
     writer->SetHeaderTypeToUInt64(); // no 4 GiB limit on one array, whatever the model size
     const int ok = writer->Write();
     const unsigned long code = writer->GetErrorCode();

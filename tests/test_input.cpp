@@ -905,7 +905,7 @@ TEST_CASE("joint property mistakes") {
                      "tension_softening = [[2, 0]]\n"),
                 "tension_softening", "joint_property[0].tension_softening",
                 "key 'tension_softening' does not apply to a coulomb joint property; its keys "
-                "are: name, law, kn, ks, friction, residual_friction, cohesion, tensile");
+                "are: name, law, kn, ks, face_shear, friction, residual_friction, cohesion, tensile");
     check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"elastic\"\nkn = 1\nks = 1\n"
                      "friction = 30\n"),
                 "friction", "joint_property[0].friction",
