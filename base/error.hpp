@@ -53,6 +53,14 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// The implicit elastic system has no unique solution: a block, node or group can
+/// move without resistance (no joints or broken ones, no support). A caller that
+/// has another way on (a lab test loading explicitly) catches this type alone.
+class SingularSystemError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 /// A geometric defect in one region's description (self-intersection, hole outside,
 /// overlap). `region` indexes the region list; `key` is the key inside that region.
 class GeometryError : public std::runtime_error {

@@ -139,9 +139,6 @@ void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::
         const int p = c.property[i];
         return p < int(face_shear.size()) && face_shear[p] && b.deformable[c.vertex_block[i]] != b.deformable[c.edge_block[i]];
     };
-    bool any = false;
-    for (int i = 0; i < n && !any; ++i) any = grouped(i);
-    if (!any) return;
     // A face is named by the global id of its first vertex (unique over blocks).
     std::vector<std::pair<int, int>> face_of; // (face, contact)
     for (int i = 0; i < n; ++i) {
@@ -158,6 +155,7 @@ void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::
         }
         face_of.emplace_back(face, i);
     }
+    if (face_of.empty()) return;
     std::sort(face_of.begin(), face_of.end());
     c.face_group.assign(n, -1);
     for (std::size_t k = 0; k < face_of.size(); ++k) {
@@ -177,18 +175,11 @@ void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_ra
         for (int e = c.face_first[f]; e < c.face_first[f + 1]; ++e) {
             const int i = c.face_entry[e];
             const int A = c.vertex_block[i], B = c.edge_block[i];
-            const Vec2 x = b.vertex[c.vertex_id[i]], p = b.vertex[c.edge_id[i]], q = b.vertex[c.edge_end[i]];
-            const double inv_len = b.inv_edge_length[c.edge_id[i]];
-            const Vec2 t = inv_len * (q - p);
-            const double s = dot(x - p, t) * inv_len;
-            Vec2 tangent = t;
-            if (!c.history[i].bonded && (s < 0.0 || s > 1.0)) {
-                const Vec2 nrm{t.y, -t.x};
-                const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * nrm);
-                if (const double rl = norm(r); rl > 0.0) tangent = tangent_of(r / rl);
-            }
-            const Vec2 vr = vertex_velocity(b, A, c.vertex_id[i], x) - edge_velocity(b, B, c.edge_id[i], c.edge_end[i], s, x);
-            sum += c.length[i] * dot(vr, tangent) * dt;
+            const Vec2 x = b.vertex[c.vertex_id[i]];
+            const ContactFrame fr = contact_frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]],
+                                                  b.inv_edge_length[c.edge_id[i]], c.history[i].bonded, corner_radius);
+            const Vec2 vr = vertex_velocity(b, A, c.vertex_id[i], x) - edge_velocity(b, B, c.edge_id[i], c.edge_end[i], fr.s, x);
+            sum += c.length[i] * dot(vr, fr.t) * dt;
             length += c.length[i];
         }
         c.face_du_s[f] = length > 0.0 ? sum / length : 0.0;
@@ -233,17 +224,9 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
             __builtin_prefetch(&body[eb[j]]);
         }
         const int A = va[i], B = eb[i];
-        const Vec2 x = vertex[vid[i]], p = vertex[e0[i]], q = vertex[e1[i]];
-        const double inv_len = inv_edge[e0[i]];
-        Vec2 t = inv_len * (q - p);
-        Vec2 n{t.y, -t.x};
+        const Vec2 x = vertex[vid[i]];
         JointHistory& h = hist[i];
-        const double s = dot(x - p, t) * inv_len;
-        if (!h.bonded && (s < 0.0 || s > 1.0)) [[unlikely]] {
-            const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * n);
-            const double rl = norm(r);
-            if (rl > 0.0) n = r / rl, t = Vec2{-n.y, n.x};
-        }
+        const auto [n, t, s] = contact_frame(x, vertex[e0[i]], vertex[e1[i]], inv_edge[e0[i]], h.bonded, corner_radius);
         const BodyState& bA = body[A];
         const BodyState& bB = body[B];
         const Vec2 ra = x - bA.centroid, rb = x - bB.centroid;

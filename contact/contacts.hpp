@@ -154,25 +154,33 @@ inline int next_vertex(const std::uint32_t* first, int block, int v) {
 
 inline Vec2 tangent_of(Vec2 n) { return {-n.y, n.x}; }
 
-/// Normal of contact i from the current geometry (used outside the step loop,
-/// which inlines the same computation).
-inline void contact_kinematics(Contacts& c, int i, const BlockView& b, double corner_radius) {
-    const Vec2 x = b.vertex[c.vertex_id[i]];
-    const Vec2 p = b.vertex[c.edge_id[i]], q = b.vertex[c.edge_end[i]];
-    const double inv_len = b.inv_edge_length[c.edge_id[i]];
-    Vec2 t = inv_len * (q - p);
-    Vec2 nrm{t.y, -t.x}; // outward normal of a counter-clockwise polygon's edge
-    // An unbonded contact beyond an end of its edge: normal of the rounded corner.
-    const double s = dot(x - p, t) * inv_len;
-    if (!c.history[i].bonded && (s < 0.0 || s > 1.0)) [[unlikely]] {
-        const Vec2 r = x - ((s < 0.0 ? p : q) - corner_radius * nrm);
+/// The frame of a contact whose vertex x lies against the edge p → q (1/|q − p| =
+/// inv_len): normal n (the edge's outward normal), tangent t, and the vertex's
+/// parameter s along the edge. An unbonded contact beyond an end of its edge takes
+/// the normal of the rounded corner. The step loop, the face pass and
+/// contact_kinematics all read the frame from here.
+struct ContactFrame {
+    Vec2 n, t;
+    double s;
+};
+inline ContactFrame contact_frame(Vec2 x, Vec2 p, Vec2 q, double inv_len, bool bonded, double corner_radius) {
+    ContactFrame f;
+    f.t = inv_len * (q - p);
+    f.n = Vec2{f.t.y, -f.t.x}; // outward normal of a counter-clockwise polygon's edge
+    f.s = dot(x - p, f.t) * inv_len;
+    if (!bonded && (f.s < 0.0 || f.s > 1.0)) [[unlikely]] {
+        const Vec2 r = x - ((f.s < 0.0 ? p : q) - corner_radius * f.n);
         const double rl = norm(r);
-        if (rl > 0.0) {
-            nrm = r / rl;
-            t = Vec2{-nrm.y, nrm.x};
-        }
+        if (rl > 0.0) f.n = r / rl, f.t = Vec2{-f.n.y, f.n.x};
     }
-    c.normal[i] = nrm;
+    return f;
+}
+
+/// Normal of contact i from the current geometry (used outside the step loop).
+inline void contact_kinematics(Contacts& c, int i, const BlockView& b, double corner_radius) {
+    c.normal[i] = contact_frame(b.vertex[c.vertex_id[i]], b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]],
+                                b.inv_edge_length[c.edge_id[i]], c.history[i].bonded, corner_radius)
+                      .n;
 }
 
 /// Normals of every contact from the current geometry.

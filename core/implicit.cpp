@@ -160,7 +160,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
         for (int i = 0; i < nb; ++i)
             for (int c = 0; c < 3; ++c)
                 if (block_dof[i][c] >= 0 && !(diagonal[block_dof[i][c]] > 0.0))
-                    throw std::runtime_error("elastic solve: block " + std::to_string(i) + " of region '" +
+                    throw SingularSystemError("elastic solve: block " + std::to_string(i) + " of region '" +
                                              region_names_[b_.region[i]] + "' at " + where(b_.centroid[i]) +
                                              " has no stiffness in " + component[c] +
                                              ": it floats (no joints and no support). Remove it, join it to the "
@@ -168,7 +168,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
         for (int k = 0; k < nn; ++k)
             for (int c = 0; c < 2; ++c)
                 if (node_dof[k][c] >= 0 && !(diagonal[node_dof[k][c]] > 0.0))
-                    throw std::runtime_error("elastic solve: node " + std::to_string(k) + " at " + where(n_.position[k]) +
+                    throw SingularSystemError("elastic solve: node " + std::to_string(k) + " at " + where(n_.position[k]) +
                                              " has no stiffness in " + component[c] + " (a zone-less node)");
 
         // Loads beyond what the stiffnesses carry (a stress of 1e300 Pa, a load in the
@@ -203,7 +203,7 @@ Solver::ElasticSolveReport Solver::solve_elastic() {
             report.method = sr.method;
             report.relative_residual = sr.relative_residual;
         } catch (const std::runtime_error& e) {
-            throw std::runtime_error(std::string("elastic solve: ") + e.what() +
+            throw SingularSystemError(std::string("elastic solve: ") + e.what() +
                                      ". The model (or part of it) can move without resistance: check that the "
                                      "boundaries hold it in x, y and rotation, and that no group of blocks is "
                                      "joined to the rest only by broken joints.");

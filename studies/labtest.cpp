@@ -1,5 +1,6 @@
 #include "studies/labtest.hpp"
 
+#include "base/error.hpp"
 #include "core/solver.hpp"
 
 #include <algorithm>
@@ -482,7 +483,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         bool solvable = true;
         try {
             s.solve_elastic();
-        } catch (const std::runtime_error&) {
+        } catch (const SingularSystemError&) {
             solvable = false;
             r.preload_skipped = true;
         }
@@ -504,7 +505,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             strain = reach * trial;
             try {
                 s.solve_elastic(); // the geometric correction: without it the linear state stands
-            } catch (const std::runtime_error&) {
+            } catch (const SingularSystemError&) {
             }
         }
         // The straight line between them, exact for the linear response (none when
