@@ -140,7 +140,8 @@ void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::
         return p < int(face_shear.size()) && face_shear[p] && b.deformable[c.vertex_block[i]] != b.deformable[c.edge_block[i]];
     };
     // A face is named by the global id of its first vertex (unique over blocks).
-    std::vector<std::pair<int, int>> face_of; // (face, contact)
+    auto& face_of = c.face_scratch; // (face, contact)
+    face_of.clear();
     for (int i = 0; i < n; ++i) {
         if (!grouped(i)) continue;
         int face = c.edge_id[i];

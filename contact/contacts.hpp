@@ -127,6 +127,9 @@ struct Contacts {
     /// increment, which every contact of the face takes (face_slip_pass).
     std::vector<int> face_group, face_first{0}, face_entry;
     std::vector<double> face_du_s;
+    /// assign_face_groups' (face, contact) pairs, kept between rebuilds so that a
+    /// rebuild allocates only when the model has grown.
+    std::vector<std::pair<int, int>> face_scratch;
     // Per-step scratch of step_contacts (sized by rebuild_index, never in a step).
     std::vector<ContactForce> force;
     std::vector<double> partial_sum; ///< per work item

@@ -92,12 +92,12 @@ TEST_CASE("every shipped example ends in the same state on 1, 2 and 3 threads") 
     CHECK(compared >= 20);
 }
 
-TEST_CASE("the trigon tunnel, past its first 1,000 cracks, is the same on 1, 2, 3 and 4 threads") {
+TEST_CASE("the trigon tunnel, past its first 900 cracks, is the same on 1, 2, 3 and 4 threads") {
     const auto model = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/tunnel_trigon.toml");
     const auto blocks = meshing::generate_blocks(model.geometry);
     const Outcome one = run_model(model, blocks, 1);
     INFO("1 thread: " << outcome_text(one));
-    REQUIRE(one.tensile + one.shear > 1000);
+    REQUIRE(one.tensile + one.shear > 900); // 952 (461 / 491) with face shear on the far field's interface
     for (int threads : {2, 3, 4}) {
         const Outcome other = run_model(model, blocks, threads);
         INFO(threads << " threads: " << outcome_text(other));

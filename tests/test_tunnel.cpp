@@ -133,15 +133,14 @@ TEST_CASE("tunnel: Voronoi blocks with joints calibrated in bbm (macro friction 
     CHECK(m.cracks_springline_sector >= 20);
     CHECK(m.cracks_springline_sector >= 3 * m.cracks_crown_sector);
     CHECK(m.failed_depth_springline > 0.5);
-    // Its failure stops (issue 24): the rock mass comes to rest while a block that
-    // came off the wall falls in the opening and keeps the model's ratio up; the
-    // stage stops at rest (until = "rest") long before its 30,000-step limit.
+    // With the far field straining along the rigid faces (face_shear, docs/theory.md
+    // §11.1) the wall keeps spalling in bursts to its 30,000-step limit (501 cracks
+    // there; 726 and still moving at 120,000): the verdict says it is still failing,
+    // from cracks made over the run's last part — not equilibrium.
     MESSAGE(describe(r.verdict) << "; " << r.steps << " steps");
-    CHECK(r.verdict.kind == Verdict::Kind::equilibrium_with_fragments);
-    CHECK(r.verdict.fragments >= 1);
-    CHECK(r.verdict.ratio > 1e-5);
-    CHECK(r.verdict.rock_ratio <= 1e-5);
-    CHECK(r.steps < 20000);
+    CHECK(r.verdict.kind == Verdict::Kind::failing);
+    CHECK(r.verdict.crack_rate > 0.0);
+    CHECK(m.cracks_springline_sector >= 100);
 }
 
 TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and extent, and a deep crack cluster apart is not in it") {
