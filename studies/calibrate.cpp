@@ -107,7 +107,7 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
         } else {
             lo.kind = LabTestOptions::Kind::biaxial;
             lo.confinement = confinements[std::size_t(k / n - 2)];
-            lo.post_peak_strain = 1e-3; // as bbm envelope: a confined peak is final once the specimen has failed
+            lo.post_peak_strain = envelope_post_peak_strain; // as bbm envelope: a confined peak is final once failed
         }
         const LabTestResult r = run_labtest(lo);
         char text[128];

@@ -291,7 +291,7 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--max-strain", o.max_strain, "Stop at this axial strain")->check(cli::positive())->capture_default_str();
     sub->add_option("--post-peak-strain", o.post_peak_strain,
                     "Confined tests: stop this much axial strain past the peak once the specimen has failed (0: go on "
-                    "to --max-strain or --stop-fraction; bbm envelope uses 1e-3)")
+                    "to --max-strain or --stop-fraction; bbm envelope and calibrate use 2e-4)")
         ->check(cli::non_negative());
     sub->add_option_function<double>(
            "--joint-set-angle", [&o](const double& a) { o.joint_set = true, o.joint_set_angle = a; },

@@ -44,6 +44,11 @@
 
 namespace bbm {
 
+/// Strain past a failed confined peak at which the envelope's and the
+/// calibration's biaxial tests stop: the peak is final by then, and the tail shows
+/// the drop (the stall rule looks back 2e-4 of strain).
+inline constexpr double envelope_post_peak_strain = 2e-4;
+
 struct LabTestOptions {
     enum class Kind { ucs, tension, biaxial, brazilian };
     Kind kind = Kind::ucs;
@@ -98,7 +103,8 @@ struct LabTestOptions {
     /// Confined tests (biaxial): stop this much axial strain past the peak once the
     /// specimen has failed (0: go on to max_strain or stop_fraction). Exact for the
     /// peak: under confinement a failed specimen's peak is final (a climb back
-    /// above it is the locking rule's stop). The envelope sets 1e-3.
+    /// above it is the locking rule's stop). The envelope and calibration set
+    /// envelope_post_peak_strain.
     double post_peak_strain = 0.0;
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
