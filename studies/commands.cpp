@@ -802,7 +802,13 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     toml += "[[joint_property]]\nname = \"calibrated\"\nlaw = \"softening\"\nkn = " + fmt_number(j.kn) +
             "\nks = " + fmt_number(j.ks) + "\ntensile = " + fmt_number(j.tensile) + "\ncohesion = " +
             fmt_number(j.cohesion) + "\nfriction = " + fmt_number(j.friction) +
+            (j.residual_friction >= 0.0 ? "\nresidual_friction = " + fmt_number(j.residual_friction) : std::string()) +
             "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
+    // The set's heterogeneity is part of it: without these lines the file would
+    // describe a uniform rock the calibration never measured.
+    if (j.weibull_modulus > 0.0)
+        toml += "weibull_modulus = " + fmt_number(j.weibull_modulus) +
+                "\nstrength_classes = " + std::to_string(j.strength_classes) + "\n";
     const nlohmann::json calibration{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
                                                           {"tensile", targets.tensile}, {"envelope", targets.envelope},
                                                           {"ci_ratio", targets.ci_ratio}}},
