@@ -194,6 +194,10 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
                                              {"reaches_region_edge", zone.reaches_region_edge},
                                              {"region_edge_cells", zone.edge_cells},
                                              {"region_edge_cells_damaged", zone.edge_cells_damaged}};
+        nlohmann::json lobes = nlohmann::json::array();
+        for (const auto& l : zone.lobes())
+            lobes.push_back({{"centre_deg", l.centre_deg}, {"depth_m", l.depth}, {"width_deg", l.width_deg}, {"area_m2", l.area}});
+        summary["opening"]["failed_zone"]["lobes"] = lobes;
         if (zone.reaches_region_edge)
             summary["opening"]["failed_zone"]["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
         // Hoop stress profiles from the wall outwards (compression positive, MPa).

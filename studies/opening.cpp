@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 namespace bbm {
 
@@ -207,6 +208,42 @@ std::vector<Vec2> FailedZone::outline() const {
                                       Vec2{std::cos(mid), std::sin(mid)});
     }
     return points;
+}
+
+std::vector<FailedZone::Lobe> FailedZone::lobes() const {
+    const int sectors = int(depth.size());
+    const double pi = std::numbers::pi, width = 2 * pi / std::max(1, sectors);
+    std::vector<Lobe> out;
+    // Start the walk after an empty sector, so a lobe across 0 degrees is one lobe.
+    int start = -1;
+    for (int k = 0; k < sectors; ++k)
+        if (depth[std::size_t(k)] <= 0) start = k;
+    if (start < 0) start = 0; // the zone goes all round: one lobe
+    double sx = 0, sy = 0;
+    Lobe lobe;
+    auto close = [&] {
+        if (lobe.width_deg <= 0) return;
+        double c = std::atan2(sy, sx) * 180 / pi;
+        lobe.centre_deg = c < 0 ? c + 360 : c;
+        out.push_back(lobe);
+        lobe = {}, sx = sy = 0;
+    };
+    for (int n = 1; n <= sectors; ++n) {
+        const int k = (start + n) % sectors;
+        const double d = depth[std::size_t(k)];
+        if (d <= 0) {
+            close();
+            continue;
+        }
+        const double mid = (k + 0.5) * width, r = radius + (wall_offset.empty() ? 0.0 : wall_offset[std::size_t(k)]);
+        sx += d * std::cos(mid), sy += d * std::sin(mid);
+        lobe.depth = std::max(lobe.depth, d);
+        lobe.width_deg += 360.0 / sectors;
+        lobe.area += 0.5 * width * ((r + d) * (r + d) - r * r);
+    }
+    close();
+    std::stable_sort(out.begin(), out.end(), [](const Lobe& a, const Lobe& b) { return a.area > b.area; });
+    return out;
 }
 
 double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,

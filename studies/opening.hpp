@@ -62,6 +62,15 @@ struct FailedZone {
     int edge_cells = 0, edge_cells_damaged = 0;
     /// The zone's outer edge: per sector, its centre direction at radius + depth.
     std::vector<Vec2> outline() const;
+    /// The zone's lobes — notches or breakouts — as an engineer maps them: each
+    /// run of neighbouring sectors with a depth, largest area first.
+    struct Lobe {
+        double centre_deg = 0; ///< depth-weighted mean direction, counter-clockwise from +x, [0, 360)
+        double depth = 0;      ///< deepest sector, m from the wall
+        double width_deg = 0;  ///< angular width (sectors times their width)
+        double area = 0;       ///< m^2 between the wall and the lobe's outer edge
+    };
+    std::vector<Lobe> lobes() const;
 };
 FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
                                double threshold = 0.2, int sectors = 36);

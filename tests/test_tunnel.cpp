@@ -143,6 +143,37 @@ TEST_CASE("tunnel: Voronoi blocks with joints calibrated in bbm (macro friction 
     CHECK(m.cracks_springline_sector >= 100);
 }
 
+TEST_CASE("failed zone lobes: each run of sectors with a depth, its depth-weighted direction, width and area") {
+    // 36 sectors of 10 degrees round a 2 m opening: a notch over 80-120 degrees
+    // (depths 0.2, 0.4, 0.4, 0.2: symmetric about 100), a lobe across 0 degrees
+    // (350-10: 0.3, 0.3) and a one-sector lobe at 200-210 (0.1).
+    FailedZone z;
+    z.radius = 2.0;
+    z.depth.assign(36, 0.0);
+    z.wall_offset.assign(36, 0.0);
+    z.depth[8] = 0.2, z.depth[9] = 0.4, z.depth[10] = 0.4, z.depth[11] = 0.2;
+    z.depth[35] = 0.3, z.depth[0] = 0.3;
+    z.depth[20] = 0.1;
+    const auto lobes = z.lobes();
+    REQUIRE(lobes.size() == 3);
+    const double sector = std::numbers::pi / 18;
+    auto ring = [&](double d) { return 0.5 * sector * ((2 + d) * (2 + d) - 4); };
+    CHECK(lobes[0].centre_deg == doctest::Approx(100.0));
+    CHECK(lobes[0].depth == doctest::Approx(0.4));
+    CHECK(lobes[0].width_deg == doctest::Approx(40.0));
+    CHECK(lobes[0].area == doctest::Approx(2 * ring(0.2) + 2 * ring(0.4)));
+    // Across 0 degrees: one lobe, centred on 0 (reported in [0, 360)).
+    CHECK(lobes[1].width_deg == doctest::Approx(20.0));
+    CHECK(std::min(lobes[1].centre_deg, 360.0 - lobes[1].centre_deg) == doctest::Approx(0.0).epsilon(1e-9));
+    CHECK(lobes[2].centre_deg == doctest::Approx(205.0));
+    CHECK(lobes[2].area == doctest::Approx(ring(0.1)));
+    // A zone all round is one lobe; no zone, none.
+    z.depth.assign(36, 0.5);
+    CHECK(z.lobes().size() == 1);
+    z.depth.assign(36, 0.0);
+    CHECK(z.lobes().empty());
+}
+
 TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and extent, and a deep crack cluster apart is not in it") {
     // Issue 24: cracks written into the joints of the Voronoi tunnel at known
     // places: every joint within 1.2 m of the wall and 20 degrees of the
