@@ -1,15 +1,19 @@
 // The long validation runs (minutes each; CTest label `long`, so `ctest -LE long`
 // leaves them out): the paper's trigon specimen, the calibration of issue 5 and
 // the post-peak targets of issue 12 over three seeds, exact restart of the
-// deformable tunnel (issue 27).
+// deformable tunnel (issue 27), the Mine-by notches (issue 24).
+#include "core/solver.hpp"
+#include "core/stages.hpp"
 #include "io/model_input.hpp"
 #include "studies/calibrate.hpp"
 #include "studies/labtest.hpp"
+#include "studies/opening.hpp"
 #include "tests/restart.hpp"
 #include "tests/specimens.hpp"
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <string>
 #include <thread>
 #include <vector>
@@ -99,6 +103,40 @@ TEST_CASE("calibrate, paper specimen: targets E 20 GPa, nu 0.2, UCS 20 MPa, tens
                               << ", UCS " << fresh.ucs / 1e6 << " MPa, tensile " << fresh.tensile / 1e6 << " MPa");
     CHECK(fresh.E == doctest::Approx(t.E).epsilon(0.05));
     CHECK(fresh.nu == doctest::Approx(t.nu).epsilon(0.10));
+    CHECK(fresh.ucs == doctest::Approx(t.ucs).epsilon(0.05));
+    CHECK(fresh.tensile == doctest::Approx(t.tensile).epsilon(0.10));
+}
+
+TEST_CASE("calibrate, Lac du Bonnet on crack initiation: E, nu, sigma_ci and tension hold on fresh seeds") {
+    // examples/lab/lac_du_bonnet_in_situ.toml (issue 23 item 4, issue 24): the
+    // record's E 69 GPa, nu 0.26, tension 9.3 MPa and sigma_ci = 0.35 x 213 MPa in
+    // the UCS's place; 0.12 m Voronoi blocks in a 2.4 m x 4.8 m specimen, bonds of
+    // 5 degrees' friction (35 once broken), started from the peak calibration's
+    // stiffnesses. Issue 23's targets on fresh seeds: E, nu and the strength within
+    // 5%, tension within 10%.
+    CalibrationOptions o;
+    o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
+    o.base.density = 2650;
+    o.base.joint.kn = 992e9, o.base.joint.ks = 339e9;
+    o.base.joint.tensile = 17.2e6, o.base.joint.cohesion = 36e6;
+    o.base.joint.friction = 5, o.base.joint.residual_friction = 35;
+    o.start_kn = o.start_ks = o.start_tensile = o.start_cohesion = true;
+    o.realizations = 3;
+    o.threads = 2;
+    o.max_iterations = 5;
+    CalibrationTargets t;
+    t.E = 69e9, t.nu = 0.26, t.ucs = 74.6e6, t.tensile = 9.3e6; // sigma_ci = 0.35 x 213 MPa, as the example file
+    const auto iterations = calibrate(t, o);
+    const auto& last = iterations.back();
+    MESSAGE(iterations.size() << " iterations: kn " << last.joint.kn / 1e9 << " GPa/m, ks " << last.joint.ks / 1e9
+                              << " GPa/m, tensile " << last.joint.tensile / 1e6 << " MPa, cohesion "
+                              << last.joint.cohesion / 1e6 << " MPa");
+    REQUIRE(last.converged);
+    const auto fresh = measure_macro_properties(last.joint, o, 1001);
+    MESSAGE("fresh seeds: E " << fresh.E / 1e9 << " GPa, nu " << fresh.nu << ", strength " << fresh.ucs / 1e6
+                              << " MPa, tensile " << fresh.tensile / 1e6 << " MPa, sigma_ci/peak " << fresh.ci_ratio);
+    CHECK(fresh.E == doctest::Approx(t.E).epsilon(0.05));
+    CHECK(fresh.nu == doctest::Approx(t.nu).epsilon(0.05));
     CHECK(fresh.ucs == doctest::Approx(t.ucs).epsilon(0.05));
     CHECK(fresh.tensile == doctest::Approx(t.tensile).epsilon(0.10));
 }
@@ -206,4 +244,50 @@ TEST_CASE("restart: the deformable tunnel (f = 0.95) stopped in its excavation a
     // The whole run on 2 threads (33,000 steps), resumed on 1 (issue 27).
     auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/compare_rigid_deformable/deformable_f095.toml");
     test::check_exact_restart({meshing::generate_blocks(file.geometry), file.analysis}, {2000, 9000}, {1}, 2);
+}
+
+TEST_CASE("field: the Mine-by tunnel in rock calibrated on crack initiation notches its roof and floor, across the largest stress") {
+    // examples/field/mineby_in_situ.toml (issue 24, docs/field.md): Lac du Bonnet
+    // bonds calibrated on laboratory data only (E, nu, tension and the crack-
+    // initiation stress), the field's stresses (60 MPa plunging 14 degrees, 11 MPa),
+    // seed as shipped. The field: V-shaped notches at the roof and floor across the
+    // largest stress (104 and 284 degrees), nothing comparable at the side walls
+    // (14 and 194 degrees), the notch tip at rf/a about 1.45 (docs/field.md).
+    auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/field/mineby_in_situ.toml");
+    file.analysis.solver.threads = 2;
+    const auto blocks = meshing::generate_blocks(file.geometry);
+    Solver s(blocks, file.analysis);
+    struct Quiet : StageObserver {} q;
+    const auto reports = run_stages(s, file.analysis.stages, q);
+    const auto& rep = file.analysis.report;
+    const auto zone = measure_failed_zone(s, rep.center, rep.springline, rep.crown);
+    const auto lobes = zone.lobes();
+    auto off = [](double deg, double target) { return std::abs(std::remainder(deg - target, 360.0)); };
+    // The notches: the largest lobe near each notch direction; the side walls':
+    // the largest near each side wall, if any.
+    auto largest_near = [&](double direction) {
+        FailedZone::Lobe best;
+        for (const auto& l : lobes)
+            if (off(l.centre_deg, direction) <= 45.0 && l.area > best.area) best = l;
+        return best;
+    };
+    const double a = 1.75;
+    for (double notch : {104.0, 284.0}) {
+        const auto l = largest_near(notch);
+        MESSAGE("notch at " << notch << " deg: centre " << l.centre_deg << " deg, depth " << l.depth << " m (rf/a "
+                            << (a + l.depth) / a << ", field 1.45), width " << l.width_deg << " deg, area " << l.area << " m2");
+        CHECK(l.area > 0.0);
+        CHECK(off(l.centre_deg, notch) <= 10.0);
+        // At least three block rows: a notch, not a skin of cracks. (Its depth
+        // against the field's is measured over seeds in docs/field.md: 0.43-0.72 m
+        // against about 0.79 m.)
+        CHECK(l.depth >= 3 * 0.12);
+        for (double side : {14.0, 194.0}) {
+            const auto w = largest_near(side);
+            MESSAGE("side wall at " << side << " deg: depth " << w.depth << " m, area " << w.area << " m2");
+            CHECK(w.area < 0.5 * l.area);
+        }
+    }
+    CHECK_FALSE(zone.reaches_region_edge);
+    CHECK(reports.back().verdict.kind == Verdict::Kind::equilibrium);
 }

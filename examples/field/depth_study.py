@@ -5,12 +5,16 @@ The in-situ stress of examples/field/mineby.toml (60 and 11 MPa, 14 degrees) is
 scaled by each factor, every component in the boundaries and the initial state
 together, and each model is run over seeds with `bbm sweep`. For every run the
 largest elastic hoop stress sigma_max = 3 sigma1 - sigma3 is set against the
-model rock's laboratory UCS, and the failed zone's depth across the largest
+rock's laboratory UCS (--ucs: the model rock's own for the peak-calibrated
+mineby.toml; the record's 213 MPa for mineby_in_situ.toml, whose bonds are
+calibrated on crack initiation), and the failed zone's depth across the largest
 stress (the notch, roof and floor, +/-15 degrees) gives r_f / a. The field's
 trend (Martin, Kaiser & McCreath 1999, Can. Geotech. J. 36: failure starts near
 sigma_max / UCS = 0.4, r_f / a = 1.25 sigma_max / UCS + 0.51) is drawn beside it.
 
     python3 examples/field/depth_study.py --bbm build/apps/bbm --out out/depth_study
+    python3 examples/field/depth_study.py --bbm build/apps/bbm --model examples/field/mineby_in_situ.toml \
+        --ucs 213e6 --out out/depth_study_in_situ
 """
 import argparse
 import csv
@@ -22,7 +26,7 @@ import subprocess
 
 RADIUS = 1.75          # m, the Mine-by tunnel
 SIGMA1, SIGMA3 = 60e6, 11e6
-UCS_MODEL = 229.7e6    # the calibrated bonds' UCS (docs/calibration.md, Lac du Bonnet, iteration 2)
+UCS_PEAK_MODEL = 229.7e6  # the peak-calibrated bonds' UCS (docs/calibration.md, Lac du Bonnet, iteration 2)
 NOTCH_DEG = (104.0, 284.0)  # across the largest stress: roof and floor
 SIDEWALL_DEG = (14.0, 194.0)  # along it: the side walls, where the hoop stress is least (tension)
 
@@ -47,6 +51,17 @@ def zone_depth(summary, directions):
     return best
 
 
+def notch_centre(summary, direction):
+    """The centre (degrees) of the failed zone's largest lobe within 45 degrees of
+    a direction, or None: where the notch is, whatever its depth."""
+    best = None
+    for lobe in summary["opening"]["failed_zone"].get("lobes", []):
+        if abs((lobe["centre_deg"] - direction + 180.0) % 360.0 - 180.0) <= 45.0:
+            if best is None or lobe["area_m2"] > best["area_m2"]:
+                best = lobe
+    return None if best is None else best["centre_deg"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bbm", default="bbm")
@@ -55,6 +70,8 @@ def main():
     ap.add_argument("--factors", default="0.3,0.6,1.0,1.4,1.7,2.0")
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--ucs", type=float, default=UCS_PEAK_MODEL,
+                    help="the laboratory UCS that sigma_max is divided by, Pa")
     args = ap.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -74,9 +91,12 @@ def main():
             side = max(zone_depth(summary, SIDEWALL_DEG))
             smax = (3 * SIGMA1 - SIGMA3) * f
             rows.append({"factor": f, "run": run.name, "sigma_max_MPa": smax / 1e6,
-                         "sigma_max_over_ucs": smax / UCS_MODEL, "roof_depth_m": roof, "floor_depth_m": floor,
+                         "sigma_max_over_ucs": smax / args.ucs, "roof_depth_m": roof, "floor_depth_m": floor,
                          "sidewall_depth_m": side,
+                         "roof_notch_deg": notch_centre(summary, NOTCH_DEG[0]),
+                         "floor_notch_deg": notch_centre(summary, NOTCH_DEG[1]),
                          "rf_over_a": (RADIUS + max(roof, floor)) / RADIUS,
+                         "reaches_region_edge": summary["opening"]["failed_zone"]["reaches_region_edge"],
                          "cracks": summary["cracks"]["tensile"] + summary["cracks"]["shear"],
                          "verdict": summary["verdict"]["kind"],
                          "steps": summary["steps"]})
@@ -96,7 +116,13 @@ def main():
         return
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     x = [r["sigma_max_over_ucs"] for r in rows]
-    ax.plot(x, [r["rf_over_a"] for r in rows], "o", color="C3", label="bbm: roof and floor (each seed)")
+    inside = [r for r in rows if not r["reaches_region_edge"]]
+    edge = [r for r in rows if r["reaches_region_edge"]]
+    ax.plot([r["sigma_max_over_ucs"] for r in inside], [r["rf_over_a"] for r in inside], "o", color="C3",
+            label="bbm: roof and floor (each seed)")
+    if edge:
+        ax.plot([r["sigma_max_over_ucs"] for r in edge], [r["rf_over_a"] for r in edge], "x", color="C3",
+                label="bbm: zone reaches the bonded region's edge")
     ax.plot(x, [(RADIUS + r["sidewall_depth_m"]) / RADIUS for r in rows], "^", mfc="none", color="C0",
             label="bbm: side walls, in tension (each seed)")
     xs = [0.4 + 0.01 * i for i in range(111)]
@@ -107,7 +133,7 @@ def main():
     ax.set_xlabel("largest elastic hoop stress / laboratory UCS")
     ax.set_ylabel("failed radius / tunnel radius, r_f / a")
     ax.set_xlim(0, 1.6)
-    ax.set_ylim(0.95, 2.6)
+    ax.set_ylim(0.95, max(2.6, 0.1 + max(r["rf_over_a"] for r in rows)))
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "depth_study.png", dpi=120)
