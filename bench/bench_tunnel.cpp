@@ -4,6 +4,10 @@
 //      kernel alone (fem::zone_pass) — 1 and 2 threads of the contact loop;
 //   2. examples/tunnel_voronoi.toml end to end (mesh, in-situ, implicit elastic
 //      stage, excavation, failure stage): wall time per stage, on 2 threads.
+//   3. The contact loop's cost per contact in the paper's tunnel, the trigon
+//      tunnel and the Mine-by model (issue 24): each run to its end, then the
+//      contact pass alone timed on its final, cracked contacts, 1 and 2 threads —
+//      nanoseconds per contact-update and the ratio to the paper's tunnel.
 // Prints a table and writes JSON. Usage: bench_tunnel [out.json] (run from the
 // repository root, or set BBM_SOURCE_DIR).
 #include "io/model_input.hpp"
@@ -105,6 +109,42 @@ int main(int argc, char** argv) {
     result["tunnel_voronoi"] = {{"threads", 2}, {"setup_seconds", setup}, {"total_seconds", total},
                                 {"steps", s.steps()}, {"contacts", s.contacts().size()}, {"zones", s.zones().size()},
                                 {"stages", stages}};
+
+    // 3. The contact loop's cost per contact, model against model.
+    struct CostModel {
+        const char* name;
+        const char* file;
+    };
+    const CostModel cost_models[] = {{"paper's tunnel", "examples/tunnel_voronoi.toml"},
+                                     {"trigon tunnel", "examples/tunnel_trigon.toml"},
+                                     {"Mine-by", "examples/field/mineby_in_situ.toml"}};
+    nlohmann::json costs = nlohmann::json::array();
+    std::printf("\ncontact loop per contact, on each model's final contacts (best of 3)\n");
+    std::printf("%-16s %8s %9s %8s %7s %10s %9s\n", "model", "blocks", "contacts", "broken", "threads", "ns/c-upd",
+                "vs paper");
+    double paper_ns[3] = {0, 0, 0};
+    for (const auto& m : cost_models) {
+        auto model = io::read_model(root + "/" + m.file);
+        model.analysis.solver.threads = 2;
+        const auto mb = meshing::generate_blocks(model.geometry);
+        Solver run(mb, model.analysis);
+        run_stages(run, model.analysis.stages, q);
+        const int nc = run.contacts().size();
+        const long broken = run.cracks(contact::JointState::broken_tension) + run.cracks(contact::JointState::broken_shear);
+        const long passes = std::max(50L, long(3e7 / std::max(1, nc)));
+        for (int threads : {1, 2}) {
+            double best = 1e30;
+            for (int rep = 0; rep < 3; ++rep) best = std::min(best, run.time_contact_passes(passes, threads));
+            const double ns = best / (double(passes) * nc) * 1e9;
+            if (&m == &cost_models[0]) paper_ns[threads] = ns;
+            std::printf("%-16s %8d %9d %8ld %7d %10.2f %9.3f\n", m.name, run.blocks().count(), nc, broken, threads, ns,
+                        ns / paper_ns[threads]);
+            costs.push_back({{"model", m.name}, {"file", m.file}, {"blocks", run.blocks().count()}, {"contacts", nc},
+                             {"broken_joints", broken}, {"threads", threads}, {"passes", passes},
+                             {"ns_per_contact_update", ns}, {"relative_to_paper_tunnel", ns / paper_ns[threads]}});
+        }
+    }
+    result["contact_cost_by_model"] = costs;
     result["peak_memory_mb"] = peak_mb();
     std::ofstream(out) << result.dump(2) << "\n";
     std::printf("wrote %s\n", out);

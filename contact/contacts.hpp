@@ -36,6 +36,7 @@
 #include "base/vec2.hpp"
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace bbm::contact {
@@ -114,6 +115,16 @@ struct Contacts {
     };
     static constexpr int work_item_size = 512;
     std::vector<WorkItem> work;
+    /// Per work item, the estimated cost of the items before it (one more entry:
+    /// the total): a team splits the items into contiguous runs of equal cost
+    /// rather than of equal count — items are cut per batch, so their sizes differ
+    /// (the trigon tunnel: 21 items, 4 of them partial; an 11/10 split gave one
+    /// thread 30% more contacts than the other). Who computes an item does not
+    /// change its result.
+    std::vector<double> work_cost_before;
+    /// A contact with a deformable side costs this much more than a rigid pair
+    /// (node-interpolated velocities; measured 1.1-1.5x on the shipped tunnels).
+    static constexpr double mixed_contact_cost = 1.25;
     /// Per block, the contacts it takes part in, in contact order (CSR): entry
     /// 2·contact + side, side 0 = the block is A, 1 = it is B. Rigid blocks gather
     /// their forces from it; detection finds a block's contacts in it.
@@ -221,6 +232,11 @@ inline Vec2 contact_force(const Contacts& c, int i) {
 /// barrier before the gathers below; called outside a team it runs serially.
 void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
                   double corner_radius);
+
+/// The work items [first, last) of `thread` in a team of `team`: contiguous runs
+/// of about equal cost (`cost_before`: Contacts::work_cost_before); every item goes
+/// to exactly one thread, in order.
+std::pair<int, int> team_share(const std::vector<double>& cost_before, int thread, int team);
 
 /// Second pass, per block: the force and moment of its contacts, summed in
 /// contact order — so the sum does not depend on which thread computed what.

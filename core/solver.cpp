@@ -3,6 +3,7 @@
 #include "base/error.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -987,6 +988,18 @@ int Solver::block_at(Vec2 p) const {
         if (d < dmin) dmin = d, best = i;
     }
     return best;
+}
+
+double Solver::time_contact_passes(long passes, int threads) const {
+    contact::Contacts copy = c_;
+    const auto view_now = view();
+    const auto t0 = std::chrono::steady_clock::now();
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    for (long k = 0; k < passes; ++k) {
+        contact::contact_pass(copy, laws_, view_now, dt_, corner_radius_);
+#pragma omp barrier
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 Solver::Memory Solver::memory() const {

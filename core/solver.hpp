@@ -208,6 +208,10 @@ public:
         std::size_t total() const { return blocks + vertices + nodes + zones + contacts + other; }
     };
     Memory memory() const;
+    /// For the benchmarks: wall seconds of `passes` contact passes alone (the
+    /// contact loop: kinematics, laws, forces) on `threads` threads, over a copy of
+    /// the contacts in their present state; the model is not changed.
+    double time_contact_passes(long passes, int threads) const;
     /// Contacts created, removed and transferred by detection so far.
     const contact::DetectionResult& detection_totals() const { return detection_totals_; }
     double detection_tolerance() const { return tolerance_; }

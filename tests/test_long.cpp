@@ -275,6 +275,7 @@ TEST_CASE("field: the Mine-by tunnel in rock calibrated on crack initiation notc
         return best;
     };
     const double a = 1.75;
+    double smaller_notch = 1e300;
     for (double notch : {104.0, 284.0}) {
         const auto l = largest_near(notch);
         MESSAGE("notch at " << notch << " deg: centre " << l.centre_deg << " deg, depth " << l.depth << " m (rf/a "
@@ -285,11 +286,12 @@ TEST_CASE("field: the Mine-by tunnel in rock calibrated on crack initiation notc
         // against the field's is measured over seeds in docs/field.md: 0.43-0.72 m
         // against about 0.79 m.)
         CHECK(l.depth >= 3 * 0.12);
-        for (double side : {14.0, 194.0}) {
-            const auto w = largest_near(side);
-            MESSAGE("side wall at " << side << " deg: depth " << w.depth << " m, area " << w.area << " m2");
-            CHECK(w.area < 0.5 * l.area);
-        }
+        smaller_notch = std::min(smaller_notch, l.area);
+    }
+    for (double side : {14.0, 194.0}) {
+        const auto w = largest_near(side);
+        MESSAGE("side wall at " << side << " deg: depth " << w.depth << " m, area " << w.area << " m2");
+        CHECK(w.area < 0.5 * smaller_notch);
     }
     CHECK_FALSE(zone.reaches_region_edge);
     CHECK(reports.back().verdict.kind == Verdict::Kind::equilibrium);
