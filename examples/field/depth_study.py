@@ -72,9 +72,15 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--ucs", type=float, default=UCS_PEAK_MODEL,
                     help="the laboratory UCS that sigma_max is divided by, Pa")
+    ap.add_argument("--replot", nargs="+", metavar="CSV",
+                    help="run nothing: draw OUT/depth_study.png from these studies' depth_study.csv files "
+                         "(e.g. low stresses in one region size, high ones in a larger)")
     args = ap.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.replot:
+        plot(read_rows(args.replot), out / "depth_study.png")
+        return
     text = pathlib.Path(args.model).read_text()
     rows = []
     for f in [float(v) for v in args.factors.split(",")]:
@@ -108,11 +114,29 @@ def main():
         w = csv.DictWriter(fh, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
+    plot(rows, out / "depth_study.png")
+
+
+def read_rows(paths):
+    """Rows of earlier studies' depth_study.csv files (--replot)."""
+    rows = []
+    for path in paths:
+        with open(path, newline="") as fh:
+            for r in csv.DictReader(fh):
+                for key in ("sigma_max_over_ucs", "rf_over_a", "sidewall_depth_m"):
+                    r[key] = float(r[key])
+                r["reaches_region_edge"] = r["reaches_region_edge"] == "True"
+                rows.append(r)
+    return rows
+
+
+def plot(rows, path):
     try:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
+        print(f"matplotlib is not installed: {path} not drawn (the CSV has every figure)")
         return
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     x = [r["sigma_max_over_ucs"] for r in rows]
@@ -136,7 +160,7 @@ def main():
     ax.set_ylim(0.95, max(2.6, 0.1 + max(r["rf_over_a"] for r in rows)))
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "depth_study.png", dpi=120)
+    fig.savefig(path, dpi=120)
 
 
 if __name__ == "__main__":
