@@ -119,11 +119,12 @@ struct Contacts {
     /// the total): a team splits the items into contiguous runs of equal cost
     /// rather than of equal count — items are cut per batch, so their sizes differ
     /// (the trigon tunnel: 21 items, 4 of them partial; an 11/10 split gave one
-    /// thread 30% more contacts than the other). Who computes an item does not
+    /// thread 41% more contacts than the other). Who computes an item does not
     /// change its result.
     std::vector<double> work_cost_before;
-    /// A contact with a deformable side costs this much more than a rigid pair
-    /// (node-interpolated velocities; measured 1.1-1.5x on the shipped tunnels).
+    /// A contact with a deformable side costs about this much more than a rigid
+    /// pair (node-interpolated velocities; 1.1x measured in the trigon tunnel). A
+    /// rough weight: it moves the balance between threads, never a result.
     static constexpr double mixed_contact_cost = 1.25;
     /// Per block, the contacts it takes part in, in contact order (CSR): entry
     /// 2·contact + side, side 0 = the block is A, 1 = it is B. Rigid blocks gather
