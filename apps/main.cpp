@@ -20,6 +20,7 @@
 #include "studies/cli_checks.hpp"
 #include "studies/commands.hpp"
 #include "studies/envelope.hpp"
+#include "studies/model_rock.hpp"
 #include "studies/ranks.hpp"
 #include "studies/run_model.hpp"
 #include "studies/shear.hpp"
@@ -27,6 +28,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -141,6 +143,25 @@ int run_cli(int argc, char** argv) {
     compare->add_option("--threads", compare_threads, "Threads of each run's contact loop")
         ->check(cli::positive())
         ->capture_default_str();
+    studies::CompareEnvelopeOptions compare_envelope;
+    compare->add_flag("--envelope", compare_envelope.enabled,
+                      "Also measure each model's rock as a laboratory does (bbm envelope on specimens of the model's "
+                      "block pattern, joints and blocks): DIR/<name>/envelope/, DIR/envelopes.csv and a table in "
+                      "comparison.md (UCS, T/UCS, Hoek-Brown mi, Mohr-Coulomb c and phi, sigma_ci / peak)");
+    compare->add_option("--envelope-width", compare_envelope.width, "--envelope: specimen width (m)")
+        ->check(cli::positive())
+        ->capture_default_str();
+    compare->add_option("--envelope-height", compare_envelope.height, "--envelope: specimen height (m)")
+        ->check(cli::positive())
+        ->capture_default_str();
+    compare->add_option("--envelope-realizations", compare_envelope.realizations,
+                        "--envelope: seeds of each test (from the model's pattern seed)")
+        ->check(cli::positive())
+        ->capture_default_str();
+    compare->add_option("--envelope-confinements", compare_envelope.confinements,
+                        "--envelope: lateral stresses of the biaxial tests, Pa, comma-separated (default: 0.1 to 0.5 "
+                        "times each rock's UCS)")
+        ->delimiter(',');
     compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
 
     studies::CalibrateCli calibrate_values;
@@ -231,11 +252,17 @@ int run_cli(int argc, char** argv) {
             return studies::run_sweep(sweep_options);
         }
         if (*compare) {
+            for (double s3 : compare_envelope.confinements)
+                if (!(s3 > 0.0) || !std::isfinite(s3))
+                    throw InputError("--envelope-confinements", 0, "", "each confinement must be a positive stress in Pa");
             if (check_only) {
-                for (const auto& m : compare_models) (void)io::read_model(m);
+                for (const auto& m : compare_models) {
+                    const auto model = io::read_model(m);
+                    if (compare_envelope.enabled) (void)studies::labtest_of_model(model, m);
+                }
                 return 0;
             }
-            return studies::compare_models(compare_models, compare_out, compare_threads, quiet);
+            return studies::compare_models(compare_models, compare_out, compare_threads, quiet, &compare_envelope);
         }
         for (auto& [command, values] : labtest_commands)
             if (*command) return studies::run_labtest_command(values, values.o.kind, quiet, check_only);

@@ -443,7 +443,8 @@ void apply_pattern_flags(LabTestCli& c) {
 }
 
 /// --tension-softening / --shear-softening b1,a1,a2 -> the points (a1, b1), (a2, 0)
-/// of the joint's curves, checked.
+/// of the joint's curves, checked. Empty values keep the joint's own curves (a
+/// model file's, which may have any number of points: labtest_of_model).
 void apply_softening_flags(LabTestCli& c) {
     auto curve = [](const std::vector<double>& v, const char* flag) {
         const double b1 = v[0], a1 = v[1], a2 = v[2];
@@ -451,8 +452,8 @@ void apply_softening_flags(LabTestCli& c) {
             throw InputError(flag, 0, "", "needs 0 < b1 < 1, 1 < a1 < a2 (points (a1, b1), (a2, 0) after the peak)");
         return std::vector<std::pair<double, double>>{{a1, b1}, {a2, 0.0}};
     };
-    c.o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
-    c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
+    if (!c.tension_softening.empty()) c.o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
+    if (!c.shear_softening.empty()) c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
 }
 
 std::string fmt_number(double v) {

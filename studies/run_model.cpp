@@ -6,6 +6,7 @@
 #include "io/vtk_output.hpp"
 #include "core/stages.hpp"
 #include "studies/model.hpp"
+#include "studies/model_rock.hpp"
 #include "studies/opening.hpp"
 #include "studies/ranks.hpp"
 #include "base/error.hpp"
@@ -581,7 +582,8 @@ int run_model(const RunOptions& opt) {
     return stop_signal != 0 ? 130 : 0;
 }
 
-int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet) {
+int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet,
+                   const CompareEnvelopeOptions* envelope) {
     make_output_directory(out);
     std::ostringstream csv, md;
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
@@ -617,6 +619,10 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         stopped = stopped || rc == 130 || interrupted.load() != 0;
         return std::to_string(rc);
     });
+    // The rocks' envelopes after the models (each spreads its own runs over the ranks).
+    std::string envelope_table;
+    if (envelope && envelope->enabled && !stopped && interrupted.load() == 0)
+        envelope_table = compare_envelopes(models, out, threads, quiet, *envelope);
     if (!Ranks::root()) return 0;
     for (std::size_t m = 0; m < models.size(); ++m) {
         const auto& model = models[m];
@@ -708,11 +714,12 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
         }
         if (!crack_columns.empty()) curves.push_back(std::move(ser));
     }
+    md << envelope_table;
     write_text_atomically(out / "comparison.csv", csv.str());
     write_text_atomically(out / "comparison.md", md.str());
     if (!curves.empty()) draw_curves(curves, "step", "broken contacts", out / "comparison.png", "cracks by model");
-    if (!quiet) std::fprintf(stderr, "%swrote %s/{comparison.csv, comparison.md, comparison.png}\n", md.str().c_str(),
-                             out.string().c_str());
+    if (!quiet) std::fprintf(stderr, "%swrote %s/{comparison.csv, comparison.md, comparison.png%s}\n", md.str().c_str(),
+                             out.string().c_str(), envelope_table.empty() ? "" : ", envelopes.csv");
     return status;
 }
 

@@ -63,8 +63,12 @@ bool stop_signal_received();
 /// writes DIR/comparison.csv and comparison.md (opening displacements, cracks by
 /// mode, failed-zone depths, counts and run time per model) and comparison.png
 /// (broken contacts against step, one curve per model). Models with a [report]
-/// give the opening columns. Returns the first non-zero exit status of a run, or 0.
+/// give the opening columns. With `envelope` (enabled), the strength envelope of
+/// each model's rock too (model_rock.hpp): DIR/<name>/envelope/, DIR/envelopes.csv
+/// and a second table in comparison.md. Returns the first non-zero exit status of
+/// a run, or 0.
+struct CompareEnvelopeOptions;
 int compare_models(const std::vector<std::string>& models, const std::filesystem::path& out, int threads,
-                   bool quiet);
+                   bool quiet, const CompareEnvelopeOptions* envelope = nullptr);
 
 } // namespace bbm::studies

@@ -1,13 +1,17 @@
 // The strength envelope (issue 23): the Hoek–Brown and Mohr–Coulomb fits checked
 // exactly on synthetic points and as least squares on scattered ones, the record
-// reader's errors, and a small envelope end to end.
+// reader's errors, and a small envelope end to end; the rock of a model file as a
+// specimen (bbm compare --envelope).
 #include "studies/envelope.hpp"
+#include "studies/model_rock.hpp"
 
 #include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <vector>
 
@@ -132,4 +136,80 @@ TEST_CASE("envelope of a small Voronoi specimen: strength rises with confinement
     CHECK(b5 > b2);
     CHECK(study.summary_json.find("\"hoek_brown\"") != std::string::npos);
     CHECK(study.summary_json.find("\"mohr_coulomb\"") != std::string::npos);
+}
+
+// ---- The rock of a model file as a specimen (bbm compare --envelope) ----
+
+namespace {
+
+std::string read_text(const std::string& file) {
+    std::ifstream in(file);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+} // namespace
+
+TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks become the specimen's") {
+    const std::string dir = std::string(BBM_SOURCE_DIR) + "/examples/";
+    const auto rigid = labtest_of_model(io::read_model(dir + "compare_rigid_deformable/rigid.toml"), "rigid.toml");
+    CHECK(rigid.pattern == "voronoi");
+    CHECK(rigid.o.size == 0.3);
+    CHECK(rigid.o.seed == 7);
+    CHECK(rigid.o.deformable_fraction == 0.0);
+    CHECK(rigid.o.joint.kn == 96.6e9);
+    CHECK(rigid.o.joint.ks == 40.3e9);
+    CHECK(rigid.o.joint.tensile == 3.0e6);
+    CHECK(rigid.o.joint.cohesion == 9.5e6);
+    CHECK(rigid.o.joint.friction == 25.0);
+    CHECK(rigid.o.joint.tension_softening == std::vector<std::pair<double, double>>{{1.7, 0.5}, {4.0, 0.0}});
+    CHECK(rigid.o.joint.shear_softening == std::vector<std::pair<double, double>>{{1.3, 0.5}, {2.1, 0.0}});
+    CHECK(rigid.tension_softening.empty()); // the model's curves are kept as they are
+
+    const auto f095 =
+        labtest_of_model(io::read_model(dir + "compare_rigid_deformable/deformable_f095.toml"), "deformable_f095.toml");
+    CHECK(f095.o.deformable_fraction == 0.95);
+    CHECK(f095.o.young == 22.4e9);
+    CHECK(f095.o.poisson == 0.2);
+    CHECK(f095.o.mesh_size == 0.15);
+    CHECK(f095.o.joint.kn == 96.6e9); // the split (kn / (1 - f)) is the lab test's, as the model's
+
+    const auto trigon = labtest_of_model(io::read_model(dir + "tunnel_trigon.toml"), "tunnel_trigon.toml");
+    CHECK(trigon.pattern == "trigon");
+    CHECK(trigon.o.joint.name == "bond");
+
+    // A specimen has one bond: trigon radial and peripheral joints of different properties are refused.
+    const std::string text = read_text(dir + "tunnel_trigon.toml") +
+                             "\n[[joint_assignment]]\nproperty = \"unbonded\"\ntags = [\"radial\"]\n";
+    const auto two_bonds = io::parse_model(text, "two_bonds.toml");
+    try {
+        (void)labtest_of_model(two_bonds, "two_bonds.toml");
+        FAIL("expected an InputError");
+    } catch (const InputError& e) {
+        CHECK(std::string(e.what()).find("two_bonds.toml") != std::string::npos);
+        CHECK(std::string(e.what()).find("radial and peripheral") != std::string::npos);
+    }
+}
+
+TEST_CASE("compare --envelope measures each model's rock exactly as bbm envelope does on the same specimen") {
+    const std::string model = std::string(BBM_SOURCE_DIR) + "/examples/compare_rigid_deformable/rigid.toml";
+    const auto out = std::filesystem::temp_directory_path() / "bbm_test_compare_envelope";
+    std::filesystem::remove_all(out);
+    CompareEnvelopeOptions options;
+    options.enabled = true;
+    options.width = 1.5, options.height = 3.0;
+    options.confinements = {2e6};
+    const std::string table = compare_envelopes({model}, out, 1, true, options);
+    // The same rock by hand: the paper's joints on Voronoi blocks of 0.3 m, the model's seed 7.
+    const EnvelopeStudy direct = run_envelope_args(
+        {"--width", "1.5", "--height", "3", "--seed", "7", "--confinements", "2e6", "--threads", "1", "--realizations", "1"},
+        true);
+    const auto by_hand = nlohmann::json::parse(direct.summary_json);
+    const auto measured = nlohmann::json::parse(read_text((out / "rigid" / "envelope" / "envelope.json").string()));
+    CHECK(measured["ucs"]["mean"].get<double>() == by_hand["ucs"]["mean"].get<double>());
+    CHECK(measured["levels"].back()["peak"]["mean"].get<double>() == by_hand["levels"].back()["peak"]["mean"].get<double>());
+    CHECK(measured["ucs"]["mean"].get<double>() > 10e6);
+    CHECK(table.find("| rigid | voronoi 0.3 m, rigid |") != std::string::npos);
+    const std::string csv = read_text((out / "envelopes.csv").string());
+    CHECK(csv.find("\nrigid,voronoi,0.3,0,1.5,3,1,") != std::string::npos);
+    std::filesystem::remove_all(out);
 }
