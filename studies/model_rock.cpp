@@ -64,19 +64,22 @@ LabTestCli labtest_of_model(const io::ModelFile& model, const std::string& file,
     const std::vector<JointTag> tags = pattern.kind == PatternSpec::Kind::trigon
                                            ? std::vector<JointTag>{JointTag::radial, JointTag::peripheral}
                                            : std::vector<JointTag>{JointTag::inner};
-    int property = -1;
+    int property = -1, property_rule = -1;
     for (JointTag tag : tags) {
         const auto [p, rule] = assigned_property(an, rock->name, tag);
         if (p < 0)
             throw InputError(file, src.line_of("joint_assignment"), "joint_assignment",
                              std::string("no joint property is assigned to the ") + meshing::to_string(tag) +
                                  " joints of region '" + rock->name + "'");
-        if (property >= 0 && p != property)
-            throw InputError(file, src.line_of("joint_assignment[" + std::to_string(rule) + "]"),
-                             "joint_assignment[" + std::to_string(rule) + "]",
-                             "the radial and peripheral joints of region '" + rock->name +
-                                 "' get different properties: a lab specimen has one bond");
-        property = p;
+        if (property >= 0 && p != property) {
+            // Name the later of the two rules: the one that set a kind of joint apart.
+            const std::string key = "joint_assignment[" + std::to_string(std::max(rule, property_rule)) + "]";
+            throw InputError(file, src.line_of(key), key,
+                             "the radial and peripheral joints of region '" + rock->name + "' get different properties ('" +
+                                 an.joint_properties[std::size_t(property)].name + "', '" +
+                                 an.joint_properties[std::size_t(p)].name + "'): a lab specimen has one bond");
+        }
+        property = p, property_rule = rule;
     }
     c.o.joint = an.joint_properties[std::size_t(property)];
     // The model's curves as they are (any number of points; not the flags' b1, a1, a2).

@@ -584,6 +584,9 @@ int run_model(const RunOptions& opt) {
 
 int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet,
                    const CompareEnvelopeOptions* envelope) {
+    // A rock a specimen cannot carry is refused before any model runs.
+    if (envelope && envelope->enabled)
+        for (const auto& m : models) (void)labtest_of_model(io::read_model(m), m);
     make_output_directory(out);
     std::ostringstream csv, md;
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"

@@ -40,3 +40,21 @@ file(READ ${DIR}/out/summary.json kept)
 if(NOT kept STREQUAL "earlier good output\n")
   message(FATAL_ERROR "bbm shear changed earlier output")
 endif()
+# bbm compare --envelope: a model whose rock a specimen cannot carry (trigon radial
+# and peripheral joints of different properties) is refused before anything runs,
+# naming the file and the rule; earlier output stays.
+file(WRITE ${DIR}/two_bonds.toml "[[region]]\nname = \"rock\"\noutline = { type = \"rectangle\", min = [0.0, 0.0], max = [2.0, 2.0] }\npattern = { type = \"trigon\", size = 0.5 }\n[[joint_property]]\nname = \"bond\"\nlaw = \"softening\"\nkn = 1e10\nks = 1e10\ntensile = 1e6\ncohesion = 2e6\n[[joint_property]]\nname = \"weak\"\nlaw = \"softening\"\nkn = 1e10\nks = 1e10\ntensile = 1e5\ncohesion = 2e5\n[[joint_assignment]]\nproperty = \"bond\"\n[[joint_assignment]]\nproperty = \"weak\"\ntags = [\"radial\"]\n[[stage]]\nname = \"s\"\ntype = \"solve\"\nmax_steps = 10\n")
+execute_process(COMMAND ${BBM} compare ${DIR}/two_bonds.toml --envelope --quiet --out ${DIR}/out
+                RESULT_VARIABLE status ERROR_VARIABLE err)
+if(NOT status EQUAL 2 OR NOT err MATCHES "two_bonds.toml:[0-9]+: joint_assignment\\[1\\]: .*radial and peripheral")
+  message(FATAL_ERROR "bbm compare --envelope should refuse two bonds naming file, line and rule (${status}): ${err}")
+endif()
+execute_process(COMMAND ${BBM} compare ${DIR}/two_bonds.toml --envelope --envelope-confinements 2e6,-1e6 --quiet --out ${DIR}/out
+                RESULT_VARIABLE status ERROR_VARIABLE err)
+if(NOT status EQUAL 2 OR NOT err MATCHES "--envelope-confinements")
+  message(FATAL_ERROR "a negative --envelope-confinements should name the flag (${status}): ${err}")
+endif()
+file(READ ${DIR}/out/summary.json kept)
+if(NOT kept STREQUAL "earlier good output\n")
+  message(FATAL_ERROR "bbm compare --envelope changed earlier output")
+endif()
