@@ -4,6 +4,7 @@
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"
 #include "studies/cli_checks.hpp"
+#include "studies/model_rock.hpp"
 #include "studies/ranks.hpp"
 
 #include <CLI/CLI.hpp>
@@ -321,6 +322,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     for (double s3 : e.confinements)
         if (!(s3 > 0.0) || !std::isfinite(s3))
             throw InputError("--confinements", 0, "", "each confinement must be a positive stress in Pa");
+    if (!e.model.empty()) c = labtest_of_model(io::read_model(e.model), e.model, c);
     std::vector<std::pair<double, double>> record;
     if (!e.target_record.empty()) record = read_strength_record(e.target_record);
     if ((e.target_sigma_ci > 0.0) != (e.target_mi > 0.0))
@@ -455,6 +457,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         {"confinements", confinements},
         {"levels", levels},
         {"runs", per_run}};
+    if (!e.model.empty()) summary["specimen"]["model"] = e.model;
     add_fits(summary);
     if (e.target_sigma_ci > 0.0) summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
     if (!record.empty()) {
@@ -500,6 +503,11 @@ void add_envelope_options(CLI::App* cmd, EnvelopeOptions& e, bool& quiet) {
     cmd->add_option("--target-sigma-ci", e.target_sigma_ci, "A Hoek-Brown record to draw: sigma_ci (Pa)")
         ->check(cli::positive());
     cmd->add_option("--target-mi", e.target_mi, "A Hoek-Brown record to draw: mi")->check(cli::positive());
+    cmd->add_option("--model", e.model,
+                    "Test the rock of this model file: its first region with a block pattern (pattern, size, seed, the "
+                    "joint property of its inner joints, deformable fraction and mesh of its blocks) replaces those "
+                    "flags; the specimen's size, loading and the envelope's flags still apply")
+        ->check(CLI::ExistingFile);
     cmd->add_flag("--replot", e.replot,
                   "Draw envelope.png again from --out's envelope.json (with --target-record or --target-sigma-ci/"
                   "--target-mi to compare), running no test");

@@ -140,7 +140,7 @@ std::string compare_envelopes(const std::vector<std::string>& models, const std:
         if (stop_signal_received()) break;
         const std::string name = fs::path(models[m]).stem().string();
         if (!quiet && Ranks::root()) std::fprintf(stderr, "== %s: the rock's envelope\n", name.c_str());
-        EnvelopeOptions e;
+        EnvelopeOptions e; // as `bbm envelope --model` (the rock read above)
         e.lab = rocks[m];
         e.confinements = options.confinements;
         EnvelopeStudy study;

@@ -190,7 +190,7 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
     }
 }
 
-TEST_CASE("compare --envelope measures each model's rock exactly as bbm envelope does on the same specimen") {
+TEST_CASE("compare --envelope and envelope --model measure a model's rock exactly as bbm envelope does on the same specimen") {
     const std::string model = std::string(BBM_SOURCE_DIR) + "/examples/compare_rigid_deformable/rigid.toml";
     const auto out = std::filesystem::temp_directory_path() / "bbm_test_compare_envelope";
     std::filesystem::remove_all(out);
@@ -208,6 +208,12 @@ TEST_CASE("compare --envelope measures each model's rock exactly as bbm envelope
     CHECK(measured["ucs"]["mean"].get<double>() == by_hand["ucs"]["mean"].get<double>());
     CHECK(measured["levels"].back()["peak"]["mean"].get<double>() == by_hand["levels"].back()["peak"]["mean"].get<double>());
     CHECK(measured["ucs"]["mean"].get<double>() > 10e6);
+    // bbm envelope --model: the same rock from the model file.
+    const auto from_model = nlohmann::json::parse(
+        run_envelope_args({"--model", model, "--width", "1.5", "--height", "3", "--confinements", "2e6", "--threads", "1"}, true)
+            .summary_json);
+    CHECK(from_model["ucs"]["mean"].get<double>() == by_hand["ucs"]["mean"].get<double>());
+    CHECK(from_model["specimen"]["model"].get<std::string>() == model);
     CHECK(table.find("| rigid | voronoi 0.3 m, rigid |") != std::string::npos);
     const std::string csv = read_text((out / "envelopes.csv").string());
     CHECK(csv.find("\nrigid,voronoi,0.3,0,1.5,3,1,") != std::string::npos);

@@ -186,7 +186,10 @@ def envelope(quiet=True, **options):
     """The strength envelope of a block model, as ``bbm envelope``: uniaxial
     compression, a tension test and biaxial tests at ``confinements`` (Pa; default
     0.1-0.5 x the UCS), ``realizations`` seeds each, with the lab-test options
-    (``size=0.3, pattern="trigon"``...). Returns the dict of envelope.json:
+    (``size=0.3, pattern="trigon"``...), or the rock of a model file
+    (``model="examples/tunnel_trigon.toml"``: its block pattern, joints and
+    blocks; the specimen's size and loading still from the options). Returns the
+    dict of envelope.json:
     ``ucs``, ``tension``, ``levels`` (peak, sigma_ci, sigma_cd per confinement),
     ``hoek_brown`` (sigma_ci, mi, rms), ``mohr_coulomb`` (cohesion, friction_deg),
     the crack-initiation and crack-damage lines and every run. Files are written

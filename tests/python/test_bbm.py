@@ -224,6 +224,16 @@ def test_envelope_small_specimen():
     assert 0 < e["tension"]["over_ucs"] < 0.3
 
 
+def test_envelope_of_a_model_files_rock():
+    """bbm.envelope(model=...): the rock of a model file (here the trigon tunnel's
+    trigon blocks and joints) on a small specimen."""
+    model = str(SOURCE / "examples/tunnel_trigon.toml")
+    e = bbm.envelope(model=model, width=1.5, height=3.0, confinements=[2e6], realizations=1, threads=1)
+    assert e["specimen"]["pattern"] == "trigon" and e["specimen"]["model"] == model
+    assert e["specimen"]["seed"] == 7  # the model's pattern seed
+    assert e["levels"][0]["peak"]["mean"] < e["levels"][1]["peak"]["mean"]
+
+
 def test_shear_coulomb_joint():
     """bbm.shear(): a planar 30-degree joint between rigid halves, two normal
     stresses: peaks sigma_n tan 30, a Coulomb fit through the origin, curves as arrays."""
