@@ -31,8 +31,14 @@
 // The means are over realizations, so the result carries their scatter: a new
 // set of seeds reproduces the targets only to within the realization scatter
 // (reported as the standard deviation). The record's σci/UCS, when given, is
-// reported beside the model's and not calibrated (it needs heterogeneity the
-// joints do not have: docs/calibration.md).
+// reported beside the model's; with fit_ci it is calibrated too, by the
+// heterogeneity of the bond strengths (docs/calibration.md, "Heterogeneous
+// bonds": the weakest bonds break first, so σci/UCS falls as the strengths
+// scatter): the unknown is h = 1/m, m the Weibull modulus of σt and c (h = 0:
+// every joint the same), moved by next_heterogeneity() — a fixed step of 0.2
+// toward the target until two iterations show the slope, then the secant — with
+// σt and c scaled by the mean strength loss measured on the paper's rock
+// (UCS / (1 + 0.7 h), tension / (1 + 2 h)) so that the strengths do not lag a step.
 #pragma once
 
 #include "studies/labtest.hpp"
@@ -68,7 +74,17 @@ struct CalibrationOptions {
     /// Starting values the user gave (kn, ks, tensile, cohesion of base.joint);
     /// the others start from the lattice inversion.
     bool start_kn = false, start_ks = false, start_tensile = false, start_cohesion = false;
+    /// Calibrate σci/UCS (CalibrationTargets::ci_ratio) by the bonds' strength
+    /// heterogeneity, within tolerance_ci (absolute, on the ratio).
+    bool fit_ci = false;
+    double tolerance_ci = 0.05;
 };
+
+/// The next heterogeneity h = 1/m of the σci/UCS calibration from the last two
+/// iterations (h_prev < 0: none before): the secant when the two show σci/UCS
+/// falling with h, else a step of 0.2 toward the target; steps within ±0.3 and h
+/// within [0, 1].
+double next_heterogeneity(double h_prev, double ci_prev, double h, double ci, double target);
 
 struct CalibrationIteration {
     JointPropertySpec joint;
@@ -110,7 +126,8 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
                                               std::uint64_t first_seed,
                                               const std::vector<double>& confinements = {});
 
-/// The misfit of measured properties against the targets (CalibrationIteration::misfit).
-double calibration_misfit(const CalibrationIteration& it, const CalibrationTargets& t);
+/// The misfit of measured properties against the targets (CalibrationIteration::misfit);
+/// with `with_ci`, |σci/UCS / target − 1| too.
+double calibration_misfit(const CalibrationIteration& it, const CalibrationTargets& t, bool with_ci = false);
 
 } // namespace bbm

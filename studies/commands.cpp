@@ -702,6 +702,9 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     o.realizations = c.realizations;
     o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     o.max_iterations = iterations;
+    o.fit_ci = values.fit_ci;
+    if (o.fit_ci && !(targets.ci_ratio > 0))
+        throw InputError("--fit-ci", 0, "", "needs the record's sigma_ci / UCS (--target-ci-ratio)");
     check_specimen_size(c);
     if (check_only) return 0;
     // SPEC §8's first estimates, kn = E/d and ks = G/d, for reference; the iteration
@@ -724,8 +727,13 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
             for (const auto& [s3, s1] : targets.envelope) std::fprintf(stderr, " %.4g at %.4g,", s1 / 1e6, s3 / 1e6);
             std::fprintf(stderr, " the friction angle calibrated too (phi and the sigma1 at the end of each row)\n");
         }
-        if (targets.ci_ratio > 0)
-            std::fprintf(stderr, "the record's sigma_ci/UCS %.3g is reported beside the model's, not calibrated\n",
+        if (targets.ci_ratio > 0 && o.fit_ci)
+            std::fprintf(stderr, "and sigma_ci/UCS %.3g (within %.2g), by the bonds' strength heterogeneity (Weibull "
+                                 "modulus m, at the end of each row)\n",
+                         targets.ci_ratio, o.tolerance_ci);
+        else if (targets.ci_ratio > 0)
+            std::fprintf(stderr, "the record's sigma_ci/UCS %.3g is reported beside the model's, not calibrated "
+                                 "(--fit-ci calibrates it)\n",
                          targets.ci_ratio);
         std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start kn %.2f, ks %.2f GPa/m (%s)\n",
                      first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9,
@@ -742,6 +750,7 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                          it.joint.kn / 1e9, it.joint.ks / 1e9, it.joint.tensile / 1e6, it.joint.cohesion / 1e6,
                          it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds);
             std::fprintf(stderr, " ci/UCS %.2f", it.ci_ratio);
+            if (o.fit_ci) std::fprintf(stderr, " (m %s)", it.joint.weibull_modulus > 0 ? fmt_number(it.joint.weibull_modulus).c_str() : "uniform");
             if (with_phi) {
                 std::fprintf(stderr, "   phi %5.2f  sigma1", it.joint.friction);
                 for (double s1 : it.confined) std::fprintf(stderr, " %7.2f", s1 / 1e6);
@@ -754,7 +763,8 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                          {"tensile_strength_std", it.tensile_std}, {"friction", it.joint.friction},
                          {"confined_strength", confined_json(it.confined)},
                          {"confined_strength_std", confined_json(it.confined_std)}, {"ci_ratio", it.ci_ratio},
-                         {"ci_ratio_std", it.ci_ratio_std}, {"misfit", it.misfit}, {"seconds", it.seconds},
+                         {"ci_ratio_std", it.ci_ratio_std}, {"weibull_modulus", it.joint.weibull_modulus},
+                         {"misfit", it.misfit}, {"seconds", it.seconds},
                          {"converged", it.converged}});
     });
     // The converged set, or else the best one (the smallest misfit).
@@ -762,7 +772,7 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     const auto& j = last.joint;
     // The calibrated set on seeds it has not seen: what a new model will get.
     auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, sigma3);
-    fresh.misfit = calibration_misfit(fresh, targets);
+    fresh.misfit = calibration_misfit(fresh, targets, o.fit_ci);
     if (!quiet) {
         std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "
                              "(std %.3f)",
@@ -812,7 +822,7 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                 "\nstrength_classes = " + std::to_string(j.strength_classes) + "\n";
     const nlohmann::json calibration{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
                                                           {"tensile", targets.tensile}, {"envelope", targets.envelope},
-                                                          {"ci_ratio", targets.ci_ratio}}},
+                                                          {"ci_ratio", targets.ci_ratio}, {"fit_ci", o.fit_ci}}},
                                              {"pattern", c.pattern},
                                              {"size", o.base.size},
                                              {"size_measure", c.size_measure},
@@ -873,9 +883,12 @@ void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
         ->delimiter(',')
         ->check(cli::positive());
     cmd->add_option("--target-ci-ratio", t.ci_ratio,
-                    "Optional: the record's crack-initiation stress over its UCS (reported beside the model's, not "
-                    "calibrated)")
+                    "Optional: the record's crack-initiation stress over its UCS (reported beside the model's; "
+                    "calibrated with --fit-ci)")
         ->check(cli::in_range(0.01, 1.0));
+    cmd->add_flag("--fit-ci", v.fit_ci,
+                  "Calibrate sigma_ci/UCS (--target-ci-ratio) too, within 0.05, by the heterogeneity of the bond "
+                  "strengths (their Weibull modulus m; --weibull-m is the start)");
     cmd->add_option("--iterations", v.iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
 }
 
