@@ -115,6 +115,33 @@ TEST_CASE("calibrate, paper specimen: targets E 20 GPa, nu 0.2, UCS 20 MPa, tens
     CHECK(fresh.tensile == doctest::Approx(t.tensile).epsilon(0.10));
 }
 
+TEST_CASE("calibrate --fit-ci, paper specimen: the paper's rock with sigma_ci/UCS 0.35 holds on fresh seeds") {
+    // Issue 23's targets for a record with a crack-initiation stress: E, nu and UCS
+    // within 5%, tension within 10%, sigma_ci/UCS within 0.05, on seeds the
+    // calibration never saw. Uniform bonds give this rock 0.34-0.48 (T/UCS 0.095);
+    // heterogeneous ones bring it to the target. Measured 2026-11-26 (1 thread, 5 min
+    // 56 s): converged at iteration 7 with m 1.89; fresh seeds 1001-1003 E 20.09 GPa,
+    // nu 0.206, UCS 20.85 MPa, T 2.067 MPa, sigma_ci/UCS 0.337.
+    CalibrationOptions o;
+    o.realizations = 3;
+    o.threads = 2;
+    o.max_iterations = 8;
+    o.fit_ci = true;
+    CalibrationTargets t;
+    t.E = 20e9, t.nu = 0.2, t.ucs = 20.7e6, t.tensile = 1.97e6, t.ci_ratio = 0.35;
+    const auto last = converged_set(t, o);
+    CHECK(last.joint.weibull_modulus > 0.0);
+    CHECK(std::abs(last.ci_ratio - t.ci_ratio) <= o.tolerance_ci);
+    const auto fresh = measure_macro_properties(last.joint, o, 1001);
+    MESSAGE("m " << last.joint.weibull_modulus << "; fresh seeds: E " << fresh.E / 1e9 << " GPa, nu " << fresh.nu << ", UCS "
+                 << fresh.ucs / 1e6 << " MPa, tensile " << fresh.tensile / 1e6 << " MPa, sigma_ci/UCS " << fresh.ci_ratio);
+    CHECK(fresh.E == doctest::Approx(t.E).epsilon(0.05));
+    CHECK(fresh.nu == doctest::Approx(t.nu).epsilon(0.05));
+    CHECK(fresh.ucs == doctest::Approx(t.ucs).epsilon(0.05));
+    CHECK(fresh.tensile == doctest::Approx(t.tensile).epsilon(0.10));
+    CHECK(std::abs(fresh.ci_ratio - t.ci_ratio) <= 0.05);
+}
+
 TEST_CASE("calibrate, Lac du Bonnet on crack initiation: E, nu, sigma_ci and tension hold on fresh seeds") {
     // examples/lab/lac_du_bonnet_in_situ.toml (issue 23 item 4, issue 24): the
     // record's E 69 GPa, nu 0.26, tension 9.3 MPa and sigma_ci = 0.35 x 213 MPa in
