@@ -786,6 +786,9 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
         if (!last.converged)
             std::fprintf(stderr, "not converged: the best set is iteration %d (misfit %.3f)\n",
                          int(&last - iterations_done.data()) + 1, last.misfit);
+        if (o.fit_ci && !(last.joint.weibull_modulus > 0.0) && last.ci_ratio < targets.ci_ratio - o.tolerance_ci)
+            std::fprintf(stderr, "sigma_ci/UCS is below the record's with uniform bonds: heterogeneous bonds only lower "
+                                 "it (docs/calibration.md, \"Calibrating sigma_ci/UCS\")\n");
     }
     // The set holds for this pattern only: say which, as a model file writes it.
     const std::string pattern_line = "pattern = { type = \"" + c.pattern + "\", size = " + fmt_number(o.base.size) +
