@@ -258,7 +258,7 @@ void draw_envelope(const nlohmann::json& e, const fs::path& file) {
         }
         return c;
     };
-    char label[160];
+    char label[256];
     if (e["hoek_brown"]["valid"].get<bool>()) {
         const HoekBrownFit hb{e["hoek_brown"]["sigma_ci"], e["hoek_brown"]["mi"], 0.0, true};
         std::snprintf(label, sizeof label, "Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", hb.sigma_ci / 1e6, hb.mi);
@@ -282,12 +282,16 @@ void draw_envelope(const nlohmann::json& e, const fs::path& file) {
         series.push_back(curve(label, [&](double x) { return target.sigma1(x); }));
     }
     const auto& sp = e["specimen"];
-    std::snprintf(label, sizeof label, "strength envelope, %s blocks of %.2g m%s, %d realization%s",
+    // Heterogeneous bonds are part of the rock drawn (older envelope.json files have no modulus).
+    const double weibull = sp.value("weibull_modulus", 0.0);
+    char bonds[48] = "";
+    if (weibull > 0) std::snprintf(bonds, sizeof bonds, ", bond strengths Weibull m = %.3g", weibull);
+    std::snprintf(label, sizeof label, "strength envelope, %s blocks of %.2g m%s%s, %d realization%s",
                   sp["pattern"].get<std::string>().c_str(), sp["size"].get<double>(),
                   sp["deformable_fraction"].get<double>() > 0
                       ? (", deformable f = " + std::to_string(sp["deformable_fraction"].get<double>()).substr(0, 4)).c_str()
                       : "",
-                  sp["realizations"].get<int>(), sp["realizations"].get<int>() > 1 ? "s" : "");
+                  bonds, sp["realizations"].get<int>(), sp["realizations"].get<int>() > 1 ? "s" : "");
     io::draw_curves(series, "sigma3 (MPa; tension at -T)", "sigma1 (MPa)", file, label, false, true);
 }
 
@@ -451,7 +455,8 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                                 ? t_stats["mean"].get<double>() / ucs_stats["mean"].get<double>() : 0.0;
     nlohmann::json summary{
         {"specimen", {{"pattern", c.pattern}, {"size", c.o.size}, {"width", c.o.width}, {"height", c.o.height},
-                      {"deformable_fraction", c.o.deformable_fraction}, {"seed", c.o.seed}, {"realizations", n}}},
+                      {"deformable_fraction", c.o.deformable_fraction}, {"weibull_modulus", c.o.joint.weibull_modulus},
+                      {"seed", c.o.seed}, {"realizations", n}}},
         {"ucs", ucs_stats},
         {"tension", {{"test", brazilian ? "brazilian" : "direct"}, {"strength", t_stats}, {"over_ucs", t_over_c}}},
         {"confinements", confinements},
