@@ -130,7 +130,10 @@ def _option_args(options):
             continue
         flag = "--" + key.replace("_", "-")
         if isinstance(value, bool):
-            value = "true" if value else "false"
+            # "--flag=true": a flag (--fit-ci, --replot) takes no separate value,
+            # a boolean option (--servo) takes this form as well.
+            args.append(flag + ("=true" if value else "=false"))
+            continue
         elif isinstance(value, (list, tuple)) or hasattr(value, "tolist"):
             value = ",".join(repr(float(x)) if isinstance(x, float) else str(x) for x in list(value))
         elif isinstance(value, float):

@@ -234,6 +234,17 @@ def test_envelope_of_a_model_files_rock():
     assert e["levels"][0]["peak"]["mean"] < e["levels"][1]["peak"]["mean"]
 
 
+def test_boolean_keywords_reach_flags_and_options():
+    """A True keyword is a flag (calibrate's fit_ci) or a boolean option (servo):
+    both must reach the program."""
+    c = bbm.calibrate(width=1.5, height=3.0, realizations=1, iterations=1, threads=1, target_ci_ratio=0.3,
+                      fit_ci=True, servo=True)
+    assert c["targets"]["fit_ci"] is True
+    assert "weibull_modulus" in c["iterations"][0]
+    c = bbm.calibrate(width=1.5, height=3.0, realizations=1, iterations=1, threads=1, fit_ci=False)
+    assert c["targets"]["fit_ci"] is False
+
+
 def test_shear_coulomb_joint():
     """bbm.shear(): a planar 30-degree joint between rigid halves, two normal
     stresses: peaks sigma_n tan 30, a Coulomb fit through the origin, curves as arrays."""
