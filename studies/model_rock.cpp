@@ -49,10 +49,18 @@ LabTestCli labtest_of_model(const io::ModelFile& model, const std::string& file,
     const int r = int(rock - regions.begin());
     const auto& src = model.source;
     const auto& pattern = rock->pattern;
-    if (pattern.kind == PatternSpec::Kind::brick || pattern.kind == PatternSpec::Kind::hexagonal)
-        if (pattern.angle != 0.0)
-            throw InputError(file, src.line_of(r, "pattern.angle"), "region[" + std::to_string(r) + "].pattern.angle",
-                             "a rotated lattice: the lab specimens are generated unrotated");
+    // What a specimen's pattern does not carry (labtest_geometry): refused, not dropped.
+    auto refuse = [&](const std::string& key, const std::string& why) {
+        throw InputError(file, src.line_of(r, "pattern." + key), "region[" + std::to_string(r) + "].pattern." + key,
+                         why + ": a lab specimen cannot test this rock");
+    };
+    const bool lattice = pattern.kind == PatternSpec::Kind::brick || pattern.kind == PatternSpec::Kind::hexagonal;
+    if (lattice && pattern.angle != 0.0) refuse("angle", "a rotated lattice (specimens are generated unrotated)");
+    if (pattern.kind == PatternSpec::Kind::brick && pattern.aspect != PatternSpec{}.aspect)
+        refuse("aspect", "bricks of another aspect than the specimens' 2");
+    if (pattern.kind == PatternSpec::Kind::brick && !pattern.running_bond)
+        refuse("bond", "stack-bonded bricks (specimens are running bond)");
+    if (pattern.min_edge >= 0.0) refuse("min_edge", "a given shortest edge (specimens use the default, 0.1 x size)");
     c.pattern = pattern_name(pattern.kind);
     c.size_measure = pattern.size_measure == PatternSpec::SizeMeasure::area ? "area" : "feret";
     c.o.size = pattern.size;

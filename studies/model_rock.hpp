@@ -9,7 +9,8 @@
 // earlier one, as the solver applies them). What a specimen cannot carry is
 // refused with an InputError naming the model file and the key: trigon regions
 // whose radial and peripheral joints get different properties, meshed blocks
-// whose material has no deformable fraction.
+// whose material has no deformable fraction, a rotated lattice, bricks of another
+// aspect or bond, a given shortest edge.
 #pragma once
 
 #include "io/model_input.hpp"

@@ -177,6 +177,18 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
     CHECK(trigon.pattern == "trigon");
     CHECK(trigon.o.joint.name == "bond");
 
+    // What a specimen's pattern cannot carry is refused, naming the key: a given shortest edge.
+    std::string edited = read_text(dir + "compare_rigid_deformable/rigid.toml");
+    const std::string voronoi = "pattern = { type = \"voronoi\", size = 0.3, seed = 7 }";
+    REQUIRE(edited.find(voronoi) != std::string::npos);
+    edited.replace(edited.find(voronoi), voronoi.size(), "pattern = { type = \"voronoi\", size = 0.3, seed = 7, min_edge = 0.01 }");
+    try {
+        (void)labtest_of_model(io::parse_model(edited, "min_edge.toml"), "min_edge.toml");
+        FAIL("expected an InputError");
+    } catch (const InputError& e) {
+        CHECK(std::string(e.what()).find("region[1].pattern.min_edge") != std::string::npos);
+    }
+
     // A specimen has one bond: trigon radial and peripheral joints of different properties are refused.
     const std::string text = read_text(dir + "tunnel_trigon.toml") +
                              "\n[[joint_assignment]]\nproperty = \"unbonded\"\ntags = [\"radial\"]\n";
