@@ -261,15 +261,17 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
 }
 } // namespace
 
-std::pair<int, int> team_share(const std::vector<double>& cost_before, int thread, int team) {
+std::pair<int, int> team_share(const std::vector<double>& cost_before, int thread, int team,
+                               const std::vector<double>* split) {
     // Item w belongs to the thread whose share of the total cost holds its middle.
     const int items = int(cost_before.size()) - 1;
     if (items <= 0) return {0, 0};
     const double total = cost_before[items];
+    const bool given = split && int(split->size()) == team + 1;
     auto first_of = [&](int t) {
         if (t <= 0) return 0;
         if (t >= team) return items;
-        const double from = total * double(t) / double(team);
+        const double from = total * (given ? (*split)[t] : double(t) / double(team));
         int lo = 0, hi = items; // first item whose middle is at or past `from`
         while (lo < hi) {
             const int mid = (lo + hi) / 2;
@@ -289,7 +291,7 @@ void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockVie
     // (dynamic handing-out moved them between cores every step; paired runs of the
     // trigon tunnel on 2 threads: 8% less wall time, median of 8). No barrier at
     // the end, like an `omp for nowait`; outside a team one thread takes all.
-    const auto [first, last] = team_share(c.work_cost_before, omp_get_thread_num(), omp_get_num_threads());
+    const auto [first, last] = team_share(c.work_cost_before, omp_get_thread_num(), omp_get_num_threads(), &c.team_split);
     for (int w = first; w < last; ++w) {
         const auto& item = c.work[w];
         const std::span<const int> ids(c.batches[item.batch].data() + item.begin, item.end - item.begin);

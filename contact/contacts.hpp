@@ -126,6 +126,13 @@ struct Contacts {
     /// pair (node-interpolated velocities; 1.1x measured in the trigon tunnel). A
     /// rough weight: it moves the balance between threads, never a result.
     static constexpr double mixed_contact_cost = 1.25;
+    /// Where each thread's run starts, as a fraction of the total cost (team + 1
+    /// entries, 0 … 1), moved by the solver toward equal measured times: the
+    /// estimate above misses what the laws cost (a softening or sliding contact
+    /// costs more than an elastic one; the trigon tunnel's second thread took 18%
+    /// longer on its equal share). Empty, or sized for another team: equal shares.
+    /// Like the estimate, it decides who computes an item, never a result.
+    std::vector<double> team_split;
     /// Per block, the contacts it takes part in, in contact order (CSR): entry
     /// 2·contact + side, side 0 = the block is A, 1 = it is B. Rigid blocks gather
     /// their forces from it; detection finds a block's contacts in it.
@@ -235,9 +242,11 @@ void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockVie
                   double corner_radius);
 
 /// The work items [first, last) of `thread` in a team of `team`: contiguous runs
-/// of about equal cost (`cost_before`: Contacts::work_cost_before); every item goes
-/// to exactly one thread, in order.
-std::pair<int, int> team_share(const std::vector<double>& cost_before, int thread, int team);
+/// of about equal cost (`cost_before`: Contacts::work_cost_before), or of the
+/// fractions of the cost in `split` (team + 1 entries from 0 to 1; ignored unless
+/// so); every item goes to exactly one thread, in order.
+std::pair<int, int> team_share(const std::vector<double>& cost_before, int thread, int team,
+                               const std::vector<double>* split = nullptr);
 
 /// Second pass, per block: the force and moment of its contacts, summed in
 /// contact order — so the sum does not depend on which thread computed what.

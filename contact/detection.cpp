@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <omp.h>
 #include <unordered_map>
 
 namespace bbm::contact {
@@ -169,7 +170,8 @@ void Detector::build_grid(const DetectionInput& in) {
     ++grid_builds_;
 }
 
-void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in) {
+void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in,
+                              std::vector<Candidate>& out) const {
     // Vertices of P against edges of Q.
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
@@ -249,7 +251,7 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
             if (rl > 0.0) gap = rl - in.corner_radius, n = r / rl;
         }
         const double un = gap - dot(vr, n) * in.dt;
-        candidates_.push_back({block_pair_key(A, B), A, int(v), B, best, e1, l, un});
+        out.push_back({block_pair_key(A, B), A, int(v), B, best, e1, l, un});
     }
 }
 
@@ -257,16 +259,30 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
     const int nb = in.block_count;
-    DetectionResult res;
     auto is_active = [&](int k) { return (!in.active || in.active[k]) && !(in.removed && in.removed[k]); };
-    drop_.resize(c.size(), 0);
-    dropped_.clear();
+#pragma omp single
+    {
+        drop_.resize(c.size(), 0);
+        active_blocks_.clear();
+        for (int k = 0; k < nb; ++k)
+            if (is_active(k)) active_blocks_.push_back(k);
+        team_.resize(std::max(1, omp_get_num_threads()));
+        for (auto& t : team_) {
+            t.candidates.clear();
+            t.dropped = t.dropped_tensile = t.dropped_shear = t.transferred = 0;
+        }
+        stale_ = !grid_valid_;
+        left_box_ = false;
+    }
+    ThreadScratch& mine = team_[omp_get_thread_num()];
+    const int na = int(active_blocks_.size());
 
     // 1–2. Transfer along the edge block's boundary, and removal of separated
     // unbonded contacts: the contacts of active blocks, each once (from its
     // vertex block if that is active).
-    for (int k = 0; k < nb; ++k) {
-        if (!is_active(k)) continue;
+#pragma omp for schedule(static)
+    for (int a = 0; a < na; ++a) {
+        const int k = active_blocks_[a];
         for (int e = c.block_first[k]; e < c.block_first[k + 1]; ++e) {
             const int i = c.block_entry[e] >> 1;
             const int A = c.vertex_block[i], B = c.edge_block[i];
@@ -284,37 +300,54 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
                     c.edge_id[i] = e0;
                     c.edge_end[i] = e1;
                     f = g;
-                    ++res.transferred;
+                    ++mine.transferred;
                 }
             }
             const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
-            if (f.gap > tol || beyond > 2.0 * tol) drop_[i] = 1, dropped_.push_back(i);
+            if (f.gap > tol || beyond > 2.0 * tol) {
+                drop_[i] = 1;
+                ++mine.dropped;
+                mine.dropped_tensile += c.history[i].broken == JointState::broken_tension;
+                mine.dropped_shear += c.history[i].broken == JointState::broken_shear;
+            }
         }
     }
 
     // 3. Broad phase from the active pieces; the grid is rebuilt first if one of
     // them has left its stored box (with a quarter tolerance to spare: a block is
     // checked again before it has moved that far).
-    bool stale = !grid_valid_;
-    for (int k = 0; k < nb && !stale; ++k) {
-        if (!is_active(k) || block_piece_.empty()) continue;
-        for (int p = block_piece_[k]; p < block_piece_[k + 1] && !stale; ++p) {
-            const Box2 box = current_box(pieces_[p], b, 1.25 * tol);
-            const Box2& s = stored_[p];
-            stale = box.lo.x < s.lo.x || box.lo.y < s.lo.y || box.hi.x > s.hi.x || box.hi.y > s.hi.y;
+    // (stale_ is read by every thread here and not written before the single
+    // below: a thread's piece that left its box raises left_box_ instead.)
+    if (!stale_) {
+        bool left = false;
+#pragma omp for schedule(static) nowait
+        for (int a = 0; a < na; ++a) {
+            const int k = active_blocks_[a];
+            for (int p = block_piece_[k]; p < block_piece_[k + 1] && !left; ++p) {
+                const Box2 box = current_box(pieces_[p], b, 1.25 * tol);
+                const Box2& s = stored_[p];
+                left = box.lo.x < s.lo.x || box.lo.y < s.lo.y || box.hi.x > s.hi.x || box.hi.y > s.hi.y;
+            }
         }
+        if (left) {
+#pragma omp atomic write
+            left_box_ = true;
+        }
+#pragma omp barrier
     }
-    if (stale) build_grid(in);
-    candidates_.clear();
-    for (int k = 0; k < nb; ++k) {
-        if (!is_active(k)) continue;
+#pragma omp single
+    if (stale_ || left_box_) build_grid(in);
+#pragma omp for schedule(static)
+    for (int a = 0; a < na; ++a) {
+        const int k = active_blocks_[a];
         for (int p = block_piece_[k]; p < block_piece_[k + 1]; ++p) {
             const Box2 box = current_box(pieces_[p], b, tol);
             const int i0 = std::clamp(int((box.lo.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
             const int i1 = std::clamp(int((box.hi.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
             const int j0 = std::clamp(int((box.lo.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
             const int j1 = std::clamp(int((box.hi.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
-            near_.clear();
+            auto& near = mine.near;
+            near.clear();
             for (int j = j0; j <= j1; ++j)
                 for (int i = i0; i <= i1; ++i) {
                     const std::size_t cell = std::size_t(j) * nx_ + i;
@@ -322,65 +355,75 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
                         const int q = cell_piece_[e];
                         const int other = pieces_[q].block;
                         // A pair of active pieces is handled from its lower piece.
-                        if (other != k && !(is_active(other) && q < p)) near_.push_back(q);
+                        if (other != k && !(is_active(other) && q < p)) near.push_back(q);
                     }
                 }
-            std::sort(near_.begin(), near_.end());
-            near_.erase(std::unique(near_.begin(), near_.end()), near_.end());
-            for (int q : near_) {
+            std::sort(near.begin(), near.end());
+            near.erase(std::unique(near.begin(), near.end()), near.end());
+            for (int q : near) {
                 const Box2 q_box = current_box(pieces_[q], b, tol);
                 if (box.hi.x < q_box.lo.x || q_box.hi.x < box.lo.x || box.hi.y < q_box.lo.y || q_box.hi.y < box.lo.y)
                     continue;
                 const Piece &P = pieces_[p], &Q = pieces_[q];
                 if (P.block < Q.block) {
-                    add_candidates(P, Q, q_box, in);
-                    add_candidates(Q, P, box, in);
+                    add_candidates(P, Q, q_box, in, mine.candidates);
+                    add_candidates(Q, P, box, in, mine.candidates);
                 } else {
-                    add_candidates(Q, P, box, in);
-                    add_candidates(P, Q, q_box, in);
+                    add_candidates(Q, P, box, in, mine.candidates);
+                    add_candidates(P, Q, q_box, in, mine.candidates);
                 }
             }
         }
     }
 
-    // 4. Acceptance, pair by pair in the order the candidates came.
-    order_.resize(candidates_.size());
-    std::iota(order_.begin(), order_.end(), 0);
-    // By pair, then in the order they came (a total order: std::sort gives the same
-    // result as a stable sort, without the buffer std::stable_sort allocates).
-    std::sort(order_.begin(), order_.end(), [&](int x, int y) {
-        return candidates_[x].pair < candidates_[y].pair || (candidates_[x].pair == candidates_[y].pair && x < y);
-    });
-    accepted_.clear();
-    for (std::size_t k = 0; k < order_.size(); ++k) {
-        const Candidate& cand = candidates_[order_[k]];
-        if (k == 0 || candidates_[order_[k - 1]].pair != cand.pair) accepted_.clear();
-        if (known(c, cand.vertex_block, cand.vertex, cand.edge_block, in)) continue;
-        const Vec2 x = b.vertex[cand.vertex];
-        bool duplicate = false;
-        for (int a : accepted_) duplicate = duplicate || norm(b.vertex[candidates_[a].vertex] - x) <= tol;
-        if (duplicate) continue;
-        accepted_.push_back(order_[k]);
-        JointHistory h;
-        h.bonded = false;
-        h.un = cand.un;
-        c.add(cand.vertex_block, cand.vertex, cand.edge_block, cand.edge, cand.edge_end, cand.length,
-              in.new_contact_property, h);
-        drop_.push_back(0);
-        ++res.created;
-    }
+#pragma omp single
+    {
+        DetectionResult res;
+        // The threads' runs of active blocks follow each other in block order.
+        candidates_.clear();
+        for (auto& t : team_) {
+            candidates_.insert(candidates_.end(), t.candidates.begin(), t.candidates.end());
+            res.transferred += t.transferred;
+            res.removed += t.dropped;
+            res.removed_tensile += t.dropped_tensile;
+            res.removed_shear += t.dropped_shear;
+        }
 
-    for (int i : dropped_) {
-        ++res.removed;
-        res.removed_tensile += c.history[i].broken == JointState::broken_tension;
-        res.removed_shear += c.history[i].broken == JointState::broken_shear;
-    }
-    if (res.removed > 0) {
-        c.remove_if_flagged(drop_);
-        drop_.resize(c.size());
-        std::fill(drop_.begin(), drop_.end(), 0);
-    }
-    return res;
+        // 4. Acceptance, pair by pair in the order the candidates came.
+        order_.resize(candidates_.size());
+        std::iota(order_.begin(), order_.end(), 0);
+        // By pair, then in the order they came (a total order: std::sort gives the same
+        // result as a stable sort, without the buffer std::stable_sort allocates).
+        std::sort(order_.begin(), order_.end(), [&](int x, int y) {
+            return candidates_[x].pair < candidates_[y].pair || (candidates_[x].pair == candidates_[y].pair && x < y);
+        });
+        accepted_.clear();
+        for (std::size_t k = 0; k < order_.size(); ++k) {
+            const Candidate& cand = candidates_[order_[k]];
+            if (k == 0 || candidates_[order_[k - 1]].pair != cand.pair) accepted_.clear();
+            if (known(c, cand.vertex_block, cand.vertex, cand.edge_block, in)) continue;
+            const Vec2 x = b.vertex[cand.vertex];
+            bool duplicate = false;
+            for (int a : accepted_) duplicate = duplicate || norm(b.vertex[candidates_[a].vertex] - x) <= tol;
+            if (duplicate) continue;
+            accepted_.push_back(order_[k]);
+            JointHistory h;
+            h.bonded = false;
+            h.un = cand.un;
+            c.add(cand.vertex_block, cand.vertex, cand.edge_block, cand.edge, cand.edge_end, cand.length,
+                  in.new_contact_property, h);
+            drop_.push_back(0);
+            ++res.created;
+        }
+
+        if (res.removed > 0) {
+            c.remove_if_flagged(drop_);
+            drop_.resize(c.size());
+            std::fill(drop_.begin(), drop_.end(), 0);
+        }
+        result_ = res;
+    } // omp single (its barrier: every thread reads the result)
+    return result_;
 }
 
 } // namespace bbm::contact

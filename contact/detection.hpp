@@ -28,6 +28,10 @@
 // accepted in an order fixed by block and vertex numbers, so a pass gives the same
 // contacts in the same order every time. The Detector keeps its scratch arrays
 // between passes: once their sizes have settled, a pass allocates nothing.
+// A team of threads may run a pass together: steps 1–3 share the active blocks
+// (contiguous runs in block order, each thread with its own candidate list; the
+// lists joined in thread order are the serial order), step 4 and the grid's
+// rebuild run on one thread.
 #pragma once
 
 #include "contact/contacts.hpp"
@@ -100,7 +104,9 @@ class Detector {
 public:
     /// One pass (steps 1–4 above). Needs `c`'s index (Contacts::rebuild_index) to
     /// be current; leaves it stale if contacts were created or removed (the
-    /// result says so), for the caller to rebuild once.
+    /// result says so), for the caller to rebuild once. Called by every thread of
+    /// an OpenMP team (all get the result), or outside one: the same contacts in
+    /// the same order on any number of threads.
     DetectionResult update(Contacts& c, const DetectionInput& in);
     /// Blocks were removed (or the state replaced): the grid is rebuilt next pass.
     void invalidate() { grid_valid_ = false; }
@@ -115,7 +121,13 @@ private:
     };
     Box2 current_box(const Piece& pc, const BlockView& b, double inflate) const;
     void build_grid(const DetectionInput& in);
-    void add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in);
+    struct Candidate {
+        std::uint64_t pair;
+        int vertex_block, vertex, edge_block, edge, edge_end;
+        double length, un;
+    };
+    void add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in,
+                        std::vector<Candidate>& out) const;
     bool known(const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) const;
 
     // Broad phase. Pieces enter the grid with their box at the build inflated by
@@ -135,14 +147,19 @@ private:
 
     // Scratch kept between passes.
     std::vector<std::uint8_t> drop_; ///< per contact; all zero between passes
-    std::vector<int> dropped_, near_;
-    struct Candidate {
-        std::uint64_t pair;
-        int vertex_block, vertex, edge_block, edge, edge_end;
-        double length, un;
+    std::vector<int> active_blocks_; ///< this pass's active blocks, in order
+    /// Per thread of the team: its candidates, the contacts it dropped and moved,
+    /// and its broad-phase scratch (one cache line apart).
+    struct alignas(64) ThreadScratch {
+        std::vector<Candidate> candidates;
+        std::vector<int> near;
+        int dropped = 0, dropped_tensile = 0, dropped_shear = 0, transferred = 0;
     };
+    std::vector<ThreadScratch> team_;
     std::vector<Candidate> candidates_;
     std::vector<int> order_, accepted_;
+    bool stale_ = false, left_box_ = false; ///< this pass: grid invalid, a piece left its box
+    DetectionResult result_;
 };
 
 } // namespace bbm::contact

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <omp.h>
 
 namespace bbm {
 
@@ -299,6 +300,14 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     active_.assign(nb, 0);
     body_.resize(nb);
     chunk_sums_.resize((nb + sum_chunk - 1) / sum_chunk + (nn + sum_chunk - 1) / sum_chunk);
+    if (settings_.threads > 1) {
+        // The contact pass's balance (balance_contact_pass): equal shares to start.
+        const int team = settings_.threads;
+        pass_time_.assign(team, {});
+        balance_scratch_.assign(2 * team, 0.0);
+        c_.team_split.resize(team + 1);
+        for (int t = 0; t <= team; ++t) c_.team_split[t] = double(t) / double(team);
+    }
     rebuild_contact_index();
 
     apply_boundaries(an, a);
@@ -462,12 +471,13 @@ void Solver::place_deformable_block(int i) {
 }
 
 void Solver::update_vertices() {
-    const int nb = b_.count();
-#pragma omp for schedule(static)
-    for (int i = 0; i < nb; ++i) {
+    // Blocks in contiguous runs of equal work (excavated ones cost nothing).
+    const auto [first, last] = contact::team_share(place_cost_before_, omp_get_thread_num(), omp_get_num_threads());
+    for (int i = first; i < last; ++i) {
         if (b_.deformable[i]) place_deformable_block(i);
         else if (!b_.removed[i]) place_rigid_block(i);
     }
+#pragma omp barrier
 }
 
 void Solver::update_timestep() {
@@ -631,6 +641,31 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
 
 void Solver::rebuild_contact_index() {
     c_.rebuild_index(int(laws_.size()), b_.count(), b_.deformable.data(), n_.count(), b_.vertex_node.data());
+    // The gather's cost per block: its contacts and its own terms (about two).
+    block_cost_before_.resize(b_.count() + 1);
+    double cost = 0.0;
+    for (int i = 0; i < b_.count(); ++i) {
+        block_cost_before_[i] = cost;
+        cost += 2.0 + (b_.deformable[i] ? 0.0 : double(c_.block_first[i + 1] - c_.block_first[i]));
+    }
+    block_cost_before_[b_.count()] = cost;
+    // Placing a block and integrating it: excavated ones (often a contiguous run:
+    // the blocks are numbered along a curve) next to nothing, a deformable block's
+    // placement its boundary vertices.
+    auto live = [&](int i) { return b_.removed[i] ? 0.05 : 1.0; };
+    place_cost_before_.resize(b_.count() + 1);
+    cost = 0.0;
+    for (int i = 0; i < b_.count(); ++i) {
+        place_cost_before_[i] = cost;
+        cost += b_.deformable[i] ? 0.5 * double(b_.first[i + 1] - b_.first[i]) : live(i);
+    }
+    place_cost_before_[b_.count()] = cost;
+    const int nb = b_.count(), nn = n_.count();
+    const int block_chunks = (nb + sum_chunk - 1) / sum_chunk, chunks = block_chunks + (nn + sum_chunk - 1) / sum_chunk;
+    chunk_cost_before_.assign(chunks + 1, 0.0);
+    for (int i = 0; i < nb; ++i) chunk_cost_before_[i / sum_chunk + 1] += b_.deformable[i] ? 0.05 : live(i);
+    for (int k = 0; k < nn; ++k) chunk_cost_before_[block_chunks + k / sum_chunk + 1] += b_.removed[n_.block[k]] ? 0.05 : 1.0;
+    for (int c = 0; c < chunks; ++c) chunk_cost_before_[c + 1] += chunk_cost_before_[c];
     contact::assign_face_groups(c_, view(), face_shear_);
 }
 
@@ -658,9 +693,19 @@ void Solver::compute_forces() {
             if (liners_.node_count() > 0) liner_pass();
         }
     }
+    // A team times its shares of the two passes: balance_contact_pass() moves the
+    // contacts' split toward equal times.
+    const bool timed = omp_get_num_threads() > 1 && int(pass_time_.size()) == omp_get_num_threads();
+    const double t0 = timed ? omp_get_wtime() : 0.0;
     contact::contact_pass(c_, laws_, view(), dt_, corner_radius_);
     normals_stale_ = true;
+    const double t1 = timed ? omp_get_wtime() : 0.0;
     if (z_.size() > 0) fem::zone_pass(z_, n_.position.data(), n_.velocity.data(), dt_, b_.removed.data());
+    if (timed) {
+        PassTime& mine = pass_time_[omp_get_thread_num()];
+        mine.contacts += t1 - t0;
+        mine.zones += omp_get_wtime() - t1;
+    }
 #pragma omp barrier
     const Vec2 g = settings_.gravity;
     // The support of the excavated rock: relaxed linearly to the fraction kept (a
@@ -669,9 +714,11 @@ void Solver::compute_forces() {
                          : relax_block_force_.empty() && relax_node_force_.empty() ? 0.0
                                                                                     : relax_keep_;
     const bool pressure = !pressure_block_force_.empty();
-    const int nb = b_.count(), nn = n_.count();
-#pragma omp for schedule(static) nowait
-    for (int i = 0; i < nb; ++i) {
+    const int nn = n_.count();
+    // Blocks in contiguous runs of equal work (a block's contacts), no barrier.
+    const auto [first_block, last_block] =
+        contact::team_share(block_cost_before_, omp_get_thread_num(), omp_get_num_threads());
+    for (int i = first_block; i < last_block; ++i) {
         Vec2 f{};
         double m = 0.0;
         if (!b_.deformable[i]) contact::block_contact_force(c_, i, f, m); // deformable: through its nodes
@@ -754,8 +801,9 @@ void Solver::integrate() {
     // over the chunks in order: the same bits on any thread count.
     const int nb = b_.count(), nn = n_.count();
     const int block_chunks = (nb + sum_chunk - 1) / sum_chunk, chunks = block_chunks + (nn + sum_chunk - 1) / sum_chunk;
-#pragma omp for schedule(static)
-    for (int chunk = 0; chunk < chunks; ++chunk) {
+    // Chunks in contiguous runs of equal work (excavated blocks cost nothing).
+    const auto [first, last] = contact::team_share(chunk_cost_before_, omp_get_thread_num(), omp_get_num_threads());
+    for (int chunk = first; chunk < last; ++chunk) {
         double w = 0.0, unbalanced = 0.0;
         if (chunk < block_chunks) {
             for (int i = chunk * sum_chunk; i < std::min(nb, (chunk + 1) * sum_chunk); ++i) w += block_work(i, unbalanced);
@@ -765,6 +813,7 @@ void Solver::integrate() {
         }
         chunk_sums_[chunk] = {w, unbalanced};
     }
+#pragma omp barrier
 #pragma omp single
     {
         sum_boundary_forces();
@@ -811,11 +860,14 @@ void Solver::detect_if_due() {
     // Every few steps: which blocks have moved a quarter of the tolerance since
     // their last pass? Only they (and their neighbours) are examined. A deformable
     // block counts as moved when any of its boundary vertices has. Called by every
-    // thread of the step's team: the scan is shared, the pass itself is serial.
+    // thread of the step's team: the scan and the pass's search are shared.
     if (steps_ % 4 != 0) return;
     const double limit = 0.25 * tolerance_;
     const int nb = b_.count();
-#pragma omp for schedule(static)
+#pragma omp single
+    any_active_ = false;
+    bool any = false;
+#pragma omp for schedule(static) nowait
     for (int i = 0; i < nb; ++i) {
         bool moved = false;
         if (b_.removed[i]) {
@@ -826,39 +878,84 @@ void Solver::detect_if_due() {
             moved = norm(b_.centroid[i] - detected_at_[i]) + std::abs(b_.theta[i] - detected_theta_[i]) * radius_[i] >= limit;
         }
         active_[i] = moved;
+        any = any || moved;
     }
-#pragma omp single
-    if (std::find(active_.begin(), active_.end(), 1) != active_.end()) detection_pass();
+    if (any) {
+#pragma omp atomic write
+        any_active_ = true;
+    }
+#pragma omp barrier
+    if (any_active_) detection_pass();
 }
 
 void Solver::detection_pass() {
+    // Called by every thread of the team (or outside one): the detector shares
+    // its search among them; what follows it runs on one thread.
     contact::DetectionInput in{view(), b_.count(), b_.removed.data(), active_.data(), tolerance_,
                                new_contact_property_, dt_, &junctions_, corner_radius_,
                                settings_.new_contact_length == SolverSpec::NewContactLength::overlap};
     const auto r = detector_.update(c_, in);
-    for (int i = 0; i < b_.count(); ++i) {
-        if (!active_[i]) continue;
-        detected_at_[i] = b_.centroid[i], detected_theta_[i] = b_.theta[i];
-        if (b_.deformable[i])
-            for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) detected_vertex_[v] = b_.vertex[v];
-    }
-    detection_totals_.created += r.created;
-    detection_totals_.removed += r.removed;
-    detection_totals_.transferred += r.transferred;
-    detection_totals_.removed_tensile += r.removed_tensile;
-    detection_totals_.removed_shear += r.removed_shear;
-    if (r.created > 0 || r.removed > 0) {
-        // New contacts are appended; once they are more than a sixteenth of all,
-        // renumber the contacts by block again (the loop's locality) — rarely
-        // enough that the renumbering costs little.
-        unsorted_contacts_ += r.created;
-        if (16 * unsorted_contacts_ > c_.size()) {
-            c_.sort_by_blocks();
-            unsorted_contacts_ = 0;
+#pragma omp single
+    {
+        for (int i = 0; i < b_.count(); ++i) {
+            if (!active_[i]) continue;
+            detected_at_[i] = b_.centroid[i], detected_theta_[i] = b_.theta[i];
+            if (b_.deformable[i])
+                for (std::uint32_t v = b_.first[i]; v < b_.first[i + 1]; ++v) detected_vertex_[v] = b_.vertex[v];
         }
-        rebuild_contact_index();
-        update_timestep();
+        detection_totals_.created += r.created;
+        detection_totals_.removed += r.removed;
+        detection_totals_.transferred += r.transferred;
+        detection_totals_.removed_tensile += r.removed_tensile;
+        detection_totals_.removed_shear += r.removed_shear;
+        if (r.created > 0 || r.removed > 0) {
+            // New contacts are appended; once they are more than a sixteenth of all,
+            // renumber the contacts by block again (the loop's locality) — rarely
+            // enough that the renumbering costs little.
+            unsorted_contacts_ += r.created;
+            if (16 * unsorted_contacts_ > c_.size()) {
+                c_.sort_by_blocks();
+                unsorted_contacts_ = 0;
+            }
+            rebuild_contact_index();
+            update_timestep();
+        }
     }
+}
+
+void Solver::balance_contact_pass() {
+    // Thread t ran the share s_t of the contacts' estimated cost in C_t seconds
+    // (ρ_t = C_t / s_t per unit share) and its equal part of the zones in Z_t.
+    // Equal times ρ_t s'_t + Z_t = K with Σ s'_t = 1 give
+    //   s'_t = (K − Z_t) / ρ_t,  K = (1 + Σ Z_t / ρ_t) / Σ 1 / ρ_t;
+    // the split moves half way there (the rates are local and the clock noisy).
+    // The arrays are sized by the constructor: a step allocates nothing.
+    const int team = settings_.threads;
+    auto& split = c_.team_split;
+    if (team < 2 || int(pass_time_.size()) != team || int(split.size()) != team + 1) return;
+    double* rate = balance_scratch_.data();
+    double* target = rate + team;
+    double inverse_rates = 0.0, zone_terms = 0.0;
+    bool measured = true;
+    for (int t = 0; t < team; ++t) {
+        const double share = split[t + 1] - split[t];
+        measured = measured && pass_time_[t].contacts > 0.0 && share > 0.0;
+        rate[t] = pass_time_[t].contacts / std::max(share, 1e-6);
+        if (rate[t] <= 0.0) continue;
+        inverse_rates += 1.0 / rate[t];
+        zone_terms += pass_time_[t].zones / rate[t];
+    }
+    if (measured) {
+        const double level = (1.0 + zone_terms) / inverse_rates;
+        double total = 0.0;
+        for (int t = 0; t < team; ++t) total += target[t] = std::max(0.02, (level - pass_time_[t].zones) / rate[t]);
+        double at = 0.0;
+        for (int t = 1; t < team; ++t) {
+            at += target[t - 1] / total;
+            split[t] = 0.5 * (split[t] + at);
+        }
+    }
+    std::fill(pass_time_.begin(), pass_time_.end(), PassTime{});
 }
 
 void Solver::step() {
@@ -877,6 +974,7 @@ void Solver::step() {
             release_relaxation();
             time_ += dt_;
             ++steps_;
+            if (steps_ % balance_every == 0) balance_contact_pass();
         }
     }
 }

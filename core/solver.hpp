@@ -296,6 +296,19 @@ private:
     /// Work of the loads and largest unbalanced force of a step per fixed chunk of
     /// bodies (integrate()).
     static constexpr int sum_chunk = 512;
+    /// Per thread, the seconds its share of the contact and zone passes took since
+    /// the last rebalance (one cache line each: written every step by its thread).
+    struct alignas(64) PassTime { double contacts = 0.0, zones = 0.0; };
+    std::vector<PassTime> pass_time_;
+    std::vector<double> balance_scratch_; ///< balance_contact_pass()'s rates and targets
+    static constexpr int balance_every = 64; ///< steps between rebalances of the contact pass
+    void balance_contact_pass();
+    /// Per block, the gather's estimated cost of the blocks before it (and the
+    /// total): a team shares the blocks by it (rebuild_contact_index()).
+    std::vector<double> block_cost_before_;
+    /// Likewise for placing the blocks, and for integrate()'s chunks.
+    std::vector<double> place_cost_before_, chunk_cost_before_;
+    bool any_active_ = false; ///< detect_if_due(): some block has moved (shared by the team)
     struct ChunkSums { double work, unbalanced; };
     std::vector<ChunkSums> chunk_sums_;
     /// The blocks' position and velocity packed for the contact loop, refreshed by
