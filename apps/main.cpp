@@ -161,7 +161,8 @@ int run_cli(int argc, char** argv) {
     compare->add_option("--envelope-confinements", compare_envelope.confinements,
                         "--envelope: lateral stresses of the biaxial tests, Pa, comma-separated (default: 0.1 to 0.5 "
                         "times each rock's UCS)")
-        ->delimiter(',');
+        ->delimiter(',')
+        ->check(cli::positive());
     compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
 
     studies::CalibrateCli calibrate_values;
@@ -252,9 +253,6 @@ int run_cli(int argc, char** argv) {
             return studies::run_sweep(sweep_options);
         }
         if (*compare) {
-            for (double s3 : compare_envelope.confinements)
-                if (!(s3 > 0.0) || !std::isfinite(s3))
-                    throw InputError("--envelope-confinements", 0, "", "each confinement must be a positive stress in Pa");
             if (check_only) {
                 for (const auto& m : compare_models) {
                     const auto model = io::read_model(m);
