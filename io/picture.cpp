@@ -4,13 +4,17 @@
 
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <png.h>
 
 #include <algorithm>
 #include <cstring>
 #include <array>
 #include <cmath>
+#include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 namespace bbm::io {
 namespace {
@@ -32,6 +36,51 @@ Rgb joint_colour(meshing::JointTag t) {
     case T::fracture: return {0.80, 0.40, 0.0};
     }
     return {0, 0, 0};
+}
+
+/// Writes an opaque cairo image surface as an RGB PNG. cairo's own writer uses
+/// zlib's default level with every row filter tried: 0.12-0.14 s for a 1200 x
+/// 2400 failure.png, the largest serial piece of a short run's output. zlib level
+/// 3 with no filter writes these flat-coloured line drawings in 0.035 s and a few
+/// percent smaller. Returns an error message, empty on success.
+std::string write_png_fast(cairo_surface_t* surface, const char* path) {
+    cairo_surface_flush(surface);
+    const int w = cairo_image_surface_get_width(surface), h = cairo_image_surface_get_height(surface);
+    const int stride = cairo_image_surface_get_stride(surface);
+    const unsigned char* data = cairo_image_surface_get_data(surface);
+    if (!data) return "no image data";
+    std::vector<unsigned char> row(3 * std::size_t(w));
+    FILE* file = std::fopen(path, "wb");
+    if (!file) return std::strerror(errno);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    // libpng reports errors by longjmp to here; no C++ object is created between
+    // this point and the calls that may jump.
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        std::fclose(file);
+        return "libpng could not write the image";
+    }
+    png_init_io(png, file);
+    png_set_compression_level(png, 3);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+    png_set_IHDR(png, info, png_uint_32(w), png_uint_32(h), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    for (int y = 0; y < h; ++y) {
+        // CAIRO_FORMAT_ARGB32 is one native-endian 32-bit word per pixel; the
+        // canvas is painted white first, so alpha is 255 and nothing is premultiplied.
+        const auto* px = reinterpret_cast<const std::uint32_t*>(data + std::size_t(y) * std::size_t(stride));
+        for (int x = 0; x < w; ++x) {
+            row[3 * x] = static_cast<unsigned char>(px[x] >> 16);
+            row[3 * x + 1] = static_cast<unsigned char>(px[x] >> 8);
+            row[3 * x + 2] = static_cast<unsigned char>(px[x]);
+        }
+        png_write_row(png, row.data());
+    }
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return std::fclose(file) == 0 ? std::string() : std::string(std::strerror(errno));
 }
 
 /// A cairo surface writing to `file` + ".tmp", renamed over `file` by finish().
@@ -59,17 +108,17 @@ public:
     void finish() {
         cairo_destroy(cr);
         cr = nullptr;
-        cairo_status_t status;
+        std::string error;
         if (svg_) {
             cairo_surface_finish(surface_);
-            status = cairo_surface_status(surface_);
+            const cairo_status_t status = cairo_surface_status(surface_);
+            if (status != CAIRO_STATUS_SUCCESS) error = cairo_status_to_string(status);
         } else {
-            status = cairo_surface_write_to_png(surface_, tmp_.c_str());
+            error = write_png_fast(surface_, tmp_.c_str());
         }
         cairo_surface_destroy(surface_);
         surface_ = nullptr;
-        if (status != CAIRO_STATUS_SUCCESS)
-            throw std::runtime_error("cannot write '" + file_.string() + "': " + cairo_status_to_string(status));
+        if (!error.empty()) throw std::runtime_error("cannot write '" + file_.string() + "': " + error);
         std::filesystem::rename(tmp_, file_);
         done_ = true;
     }

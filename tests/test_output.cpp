@@ -5,6 +5,7 @@
 #include "io/vtk_output.hpp"
 
 #include <doctest/doctest.h>
+#include <png.h>
 
 // VTK 9.1's type macros end in a stray ';' that -Wpedantic reports (see vtk_output.cpp).
 #pragma GCC diagnostic push
@@ -22,6 +23,7 @@
 #include <vtkXMLUnstructuredGridReader.h>
 #pragma GCC diagnostic pop
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -369,4 +371,37 @@ TEST_CASE("a plot with nothing to draw on its log axis is written (a run stopped
     const std::vector<bbm::io::Series> none{{"nothing", {}, {}}};
     bbm::io::draw_curves(none, "step", "cracks", dir.path / "empty.png");
     CHECK(fs::file_size(dir.path / "empty.png") > 0);
+}
+
+TEST_CASE("the PNG writer writes what was drawn: a valid RGB file of the canvas's size, white paper and a curve") {
+    // bbm writes PNGs with libpng at a fast zlib level rather than cairo's
+    // writer; read back with libpng, the file must decode (CRCs, zlib stream)
+    // to the picture: the paper white, the curve not.
+    TempDir dir;
+    const std::vector<bbm::io::Series> line{{"line", {0.0, 1.0, 2.0}, {0.0, 1.0, 4.0}}};
+    const fs::path file = dir.path / "line.png";
+    bbm::io::draw_curves(line, "x", "y", file);
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    REQUIRE(png_image_begin_read_from_file(&image, file.string().c_str()) != 0);
+    CHECK((image.format & PNG_FORMAT_FLAG_COLOR) != 0);
+    CHECK((image.format & PNG_FORMAT_FLAG_ALPHA) == 0);
+    CHECK(image.width == 900);
+    CHECK(image.height == 600);
+    image.format = PNG_FORMAT_RGB;
+    std::vector<unsigned char> pixels(PNG_IMAGE_SIZE(image));
+    REQUIRE(png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr) != 0);
+    auto rgb = [&](unsigned x, unsigned y) { return &pixels[3 * (std::size_t(y) * image.width + x)]; };
+    for (const unsigned char* corner : {rgb(0, 0), rgb(image.width - 1, image.height - 1)})
+        CHECK((corner[0] == 255 && corner[1] == 255 && corner[2] == 255));
+    // The first series is drawn in dark blue (0.1, 0.2, 0.7): channels in order.
+    std::size_t coloured = 0, blue = 0; // in a colour, not grey axes or black text
+    for (std::size_t i = 0; i < pixels.size(); i += 3) {
+        const unsigned char r = pixels[i], g = pixels[i + 1], b = pixels[i + 2];
+        if (std::max({r, g, b}) - std::min({r, g, b}) <= 60) continue;
+        ++coloured;
+        blue += b > r + 60 && b > g + 60;
+    }
+    CHECK(coloured > 500);
+    CHECK(blue > coloured * 9 / 10);
 }
