@@ -18,6 +18,18 @@ using meshing::JointTag;
 
 namespace {
 
+/// out[i] = the cost of items 0 … i−1, out[n] the total: the prefix a team is
+/// shared by (contact::team_share). Sized once; reused without allocating.
+template <class Cost> void fill_cost_before(std::vector<double>& out, int n, Cost cost) {
+    out.resize(std::size_t(n) + 1);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+        out[i] = sum;
+        sum += cost(i);
+    }
+    out[n] = sum;
+}
+
 bool selected(const std::vector<std::string>& names, const std::string& name) {
     return names.empty() || std::find(names.begin(), names.end(), name) != names.end();
 }
@@ -299,7 +311,7 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     }
     active_.assign(nb, 0);
     body_.resize(nb);
-    chunk_sums_.resize((nb + sum_chunk - 1) / sum_chunk + (nn + sum_chunk - 1) / sum_chunk);
+    chunk_sums_.resize(chunks_of(nb) + chunks_of(nn));
     if (settings_.threads > 1) {
         // The contact pass's balance (balance_contact_pass): equal shares to start.
         const int team = settings_.threads;
@@ -642,30 +654,28 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
 void Solver::rebuild_contact_index() {
     c_.rebuild_index(int(laws_.size()), b_.count(), b_.deformable.data(), n_.count(), b_.vertex_node.data());
     // The gather's cost per block: its contacts and its own terms (about two).
-    block_cost_before_.resize(b_.count() + 1);
-    double cost = 0.0;
-    for (int i = 0; i < b_.count(); ++i) {
-        block_cost_before_[i] = cost;
-        cost += 2.0 + (b_.deformable[i] ? 0.0 : double(c_.block_first[i + 1] - c_.block_first[i]));
-    }
-    block_cost_before_[b_.count()] = cost;
+    fill_cost_before(block_cost_before_, b_.count(), [&](int i) {
+        return 2.0 + (b_.deformable[i] ? 0.0 : double(c_.block_first[i + 1] - c_.block_first[i]));
+    });
     // Placing a block and integrating it: excavated ones (often a contiguous run:
     // the blocks are numbered along a curve) next to nothing, a deformable block's
-    // placement its boundary vertices.
+    // placement its boundary vertices, its integration its nodes' (the node chunks).
     auto live = [&](int i) { return b_.removed[i] ? 0.05 : 1.0; };
-    place_cost_before_.resize(b_.count() + 1);
-    cost = 0.0;
-    for (int i = 0; i < b_.count(); ++i) {
-        place_cost_before_[i] = cost;
-        cost += b_.deformable[i] ? 0.5 * double(b_.first[i + 1] - b_.first[i]) : live(i);
-    }
-    place_cost_before_[b_.count()] = cost;
-    const int nb = b_.count(), nn = n_.count();
-    const int block_chunks = (nb + sum_chunk - 1) / sum_chunk, chunks = block_chunks + (nn + sum_chunk - 1) / sum_chunk;
-    chunk_cost_before_.assign(chunks + 1, 0.0);
-    for (int i = 0; i < nb; ++i) chunk_cost_before_[i / sum_chunk + 1] += b_.deformable[i] ? 0.05 : live(i);
-    for (int k = 0; k < nn; ++k) chunk_cost_before_[block_chunks + k / sum_chunk + 1] += b_.removed[n_.block[k]] ? 0.05 : 1.0;
-    for (int c = 0; c < chunks; ++c) chunk_cost_before_[c + 1] += chunk_cost_before_[c];
+    fill_cost_before(place_cost_before_, b_.count(), [&](int i) {
+        return b_.deformable[i] ? 0.5 * double(b_.first[i + 1] - b_.first[i]) : live(i);
+    });
+    const int nb = b_.count(), nn = n_.count(), block_chunks = chunks_of(nb);
+    fill_cost_before(chunk_cost_before_, block_chunks + chunks_of(nn), [&](int chunk) {
+        double cost = 0.0;
+        if (chunk < block_chunks) {
+            for (int i = chunk * sum_chunk; i < std::min(nb, (chunk + 1) * sum_chunk); ++i)
+                cost += b_.deformable[i] ? 0.05 : live(i);
+        } else {
+            const int c = chunk - block_chunks;
+            for (int k = c * sum_chunk; k < std::min(nn, (c + 1) * sum_chunk); ++k) cost += live(n_.block[k]);
+        }
+        return cost;
+    });
     contact::assign_face_groups(c_, view(), face_shear_);
 }
 
@@ -800,7 +810,7 @@ void Solver::integrate() {
     // The work and the largest unbalanced force per fixed chunk of bodies, then
     // over the chunks in order: the same bits on any thread count.
     const int nb = b_.count(), nn = n_.count();
-    const int block_chunks = (nb + sum_chunk - 1) / sum_chunk, chunks = block_chunks + (nn + sum_chunk - 1) / sum_chunk;
+    const int block_chunks = chunks_of(nb), chunks = block_chunks + chunks_of(nn);
     // Chunks in contiguous runs of equal work (excavated blocks cost nothing).
     const auto [first, last] = contact::team_share(chunk_cost_before_, omp_get_thread_num(), omp_get_num_threads());
     for (int chunk = first; chunk < last; ++chunk) {

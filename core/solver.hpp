@@ -296,6 +296,7 @@ private:
     /// Work of the loads and largest unbalanced force of a step per fixed chunk of
     /// bodies (integrate()).
     static constexpr int sum_chunk = 512;
+    static constexpr int chunks_of(int bodies) { return (bodies + sum_chunk - 1) / sum_chunk; }
     /// Per thread, the seconds its share of the contact and zone passes took since
     /// the last rebalance (one cache line each: written every step by its thread).
     struct alignas(64) PassTime { double contacts = 0.0, zones = 0.0; };
