@@ -117,10 +117,16 @@ struct StageSpec {
     StressFieldSpec stress;            ///< initialize
     double ratio = 1e-5;               ///< solve: target unbalanced-force ratio
     long max_steps = 200000;           ///< solve: step limit
-    /// solve: also stop once the rock mass is at rest (core/verdict.hpp): no crack
-    /// in the last quiet_steps and the ratio of the rock mass, fragments left out,
-    /// at `ratio` (until = "rest"; "ratio", the default, waits for the model's ratio).
-    bool until_rest = false;
+    /// solve: where the stage ends (core/verdict.hpp).
+    ///   ratio        the model's unbalanced-force ratio at `ratio` (the default);
+    ///   rest         that, or the rock mass at rest: no crack in the last
+    ///                quiet_steps and its ratio, fragments left out, at `ratio`;
+    ///   equilibrium  only the verdict "equilibrium" (with or without fragments):
+    ///                no crack over the verdict's window and the ratio at `ratio`.
+    ///                A brittle rock can reach the ratio while it still cracks,
+    ///                a few cracks per thousand steps; this waits for it to stop.
+    enum class Until { ratio, rest, equilibrium };
+    Until until = Until::ratio;
     long quiet_steps = 2000;
     long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps)
     std::vector<std::string> regions;  ///< excavate

@@ -34,12 +34,19 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         // at fixed steps of the run, so a resumed stage samples where the
         // uninterrupted one does.
         const bool judged = st.kind == StageSpec::Kind::solve || st.kind == StageSpec::Kind::cycle;
-        // Where a solve stage ends: its ratio reached (after a few steps: at rest
-        // the ratio is 0 before anything moves), or, asked for, the rock at rest.
+        // Where a solve stage ends (StageSpec::Until): its ratio reached (after a
+        // few steps: at rest the ratio is 0 before anything moves), or, asked for,
+        // the rock at rest, or only the verdict of equilibrium.
         auto solved = [&](long k) {
+            using U = StageSpec::Until;
+            const bool sampled = s.steps() % StageMonitor::sample_every == 0;
+            if (st.until == U::equilibrium) {
+                if (!sampled) return false;
+                const auto kind = s.monitor().verdict(st.ratio).kind;
+                return kind == Verdict::Kind::equilibrium || kind == Verdict::Kind::equilibrium_with_fragments;
+            }
             if (k >= 10 && s.unbalanced_ratio() <= st.ratio) return true;
-            return st.until_rest && s.steps() % StageMonitor::sample_every == 0 &&
-                   s.monitor().at_rest(st.ratio, st.quiet_steps);
+            return st.until == U::rest && sampled && s.monitor().at_rest(st.ratio, st.quiet_steps);
         };
         auto run = [&](long max_steps, bool solve) {
             for (long k = cursor.step + 1; k <= max_steps; ++k) {

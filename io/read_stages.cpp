@@ -65,7 +65,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
     static constexpr std::array<std::string_view, 6> solve_keys{"name",  "type",       "ratio",
                                                                 "max_steps", "until", "quiet_steps"};
-    static constexpr std::array<std::string_view, 2> until_options{"ratio", "rest"};
+    static constexpr std::array<std::string_view, 3> until_options{"ratio", "rest", "equilibrium"};
     static constexpr std::array<std::string_view, 7> excavate_keys{"name",  "type", "regions",  "relax_steps",
                                                                    "steps", "keep", "pressure"};
     static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
@@ -104,7 +104,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
                       .value_or(s.ratio);
         s.max_steps = integer(c, t, p, "max_steps", 1, long_max).value_or(s.max_steps);
         if (const toml::node* n = find(c, t, p, "until"))
-            s.until_rest = to_choice(c, *n, p.key("until"), until_options, "stopping rule") == 1;
+            s.until = StageSpec::Until(to_choice(c, *n, p.key("until"), until_options, "stopping rule"));
         s.quiet_steps = integer(c, t, p, "quiet_steps", StageMonitor::sample_every, long_max).value_or(s.quiet_steps);
         break;
     case Kind::excavate:

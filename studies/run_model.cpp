@@ -160,7 +160,8 @@ public:
         snapshot(s);
         flush_history();
         if (options_.quiet) return;
-        // A solve stage ends at its ratio, at rest (until = "rest") or at its step limit.
+        // A solve stage ends at its ratio, at rest (until = "rest"), at equilibrium
+        // (until = "equilibrium", its ratio reached too) or at its step limit.
         const char* end = r.converged || r.kind != "solve" ? ""
                         : r.verdict.at_rest()               ? "  (rock at rest)"
                                                             : "  (step limit reached)";

@@ -2,7 +2,8 @@
 // real models — a block that comes to rest, one sliding down a plane steeper than
 // its friction angle (a collapse), a block falling free above a supported base
 // (a fragment: the rock mass is at rest although the model's ratio is not), a
-// stage that stops at rest, and a resumed run that gives the same verdict.
+// stage that stops at rest, one that waits for equilibrium, and a resumed run
+// that gives the same verdict.
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
@@ -14,6 +15,7 @@
 #include <iterator>
 #include <numbers>
 #include <sstream>
+#include <string>
 
 using namespace bbm;
 
@@ -180,6 +182,39 @@ max_steps = 100000
     // It stopped at rest, before the block landed (it is still above the base).
     CHECK(r.back().steps < 100000);
     CHECK(s.time() < std::sqrt(2.0 * 4.0 / 9.81));
+}
+
+TEST_CASE("verdict: a stage can wait for equilibrium where the ratio comes while the rock still cracks") {
+    // The paper's Voronoi tunnel with a loose ratio (1e-3): the model's ratio is
+    // reached 620 steps into the failure stage while a crack still forms, and a
+    // stage ending there leaves a rock that is failing. until = "equilibrium"
+    // runs on until the verdict is equilibrium (no crack over its window).
+    Verdict::Kind kinds[2];
+    long steps[2];
+    int cracks[2];
+    for (int mode = 0; mode < 2; ++mode) {
+        Built m;
+        m.file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/tunnel_voronoi.toml");
+        auto& failure = m.file.analysis.stages.back();
+        REQUIRE(failure.kind == StageSpec::Kind::solve);
+        failure.ratio = 1e-3;
+        failure.until = mode == 0 ? StageSpec::Until::ratio : StageSpec::Until::equilibrium;
+        m.blocks = meshing::generate_blocks(m.file.geometry);
+        Solver s(m.blocks, m.file.analysis);
+        Silent quiet;
+        const auto r = run_stages(s, m.file.analysis.stages, quiet);
+        INFO(std::string(mode == 0 ? "ratio: " : "equilibrium: ") << describe(r.back().verdict) << ", " << r.back().steps
+                                                      << " steps");
+        CHECK(r.back().converged);
+        kinds[mode] = r.back().verdict.kind;
+        steps[mode] = r.back().steps;
+        cracks[mode] = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
+    }
+    CHECK(kinds[0] == K::failing);
+    CHECK(kinds[1] == K::equilibrium);
+    CHECK(steps[1] > steps[0]);
+    CHECK(steps[1] < 30000); // it stopped at the verdict, not at the step limit
+    CHECK(cracks[1] >= cracks[0]);
 }
 
 TEST_CASE("verdict: a run stopped and resumed gives the uninterrupted run's verdict") {
