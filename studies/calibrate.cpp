@@ -63,6 +63,9 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
 }
 
 namespace {
+/// The bonds' strength heterogeneity h = 1/m of a Weibull modulus m (0: uniform).
+double heterogeneity_of(const JointPropertySpec& j) { return j.weibull_modulus > 0.0 ? 1.0 / j.weibull_modulus : 0.0; }
+
 /// The mean strengths' loss to heterogeneity h = 1/m, measured on the paper's rock
 /// (docs/calibration.md, "Heterogeneous bonds", rigid Voronoi 8 × 16 m, 3 seeds):
 /// m = 4 took the UCS to 0.83 and the tension to 0.69, m = 2 to 0.73 and 0.49
@@ -84,7 +87,7 @@ JointPropertySpec calibration_start(const CalibrationTargets& t, const Calibrati
     if (!o.start_tensile) j.tensile = t.tensile / 0.66;
     if (!o.start_cohesion) j.cohesion = 9.5e6 * t.ucs / 22.9e6;
     // Heterogeneous bonds (--weibull-m) are weaker on the mean: start stronger.
-    const double h = j.weibull_modulus > 0.0 ? 1.0 / j.weibull_modulus : 0.0;
+    const double h = heterogeneity_of(j);
     if (!o.start_tensile) j.tensile /= tension_loss(h);
     if (!o.start_cohesion) j.cohesion /= ucs_loss(h);
     return j;
@@ -264,7 +267,7 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
             j.friction = phi_new;
         }
         if (with_ci && std::abs(it.ci_ratio - t.ci_ratio) > 0.25 * o.tolerance_ci) {
-            const double h = j.weibull_modulus > 0.0 ? 1.0 / j.weibull_modulus : 0.0;
+            const double h = heterogeneity_of(j);
             const double h_new = next_heterogeneity(prev_h, prev_ci, h, it.ci_ratio, t.ci_ratio);
             prev_h = h, prev_ci = it.ci_ratio;
             j.cohesion *= ucs_loss(h) / ucs_loss(h_new);
