@@ -106,9 +106,9 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     // Runs k: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests at
     // each confinement; shared among the threads and ranks.
     const int runs = (2 + int(confinements.size())) * n;
-    // Each run travels (between ranks under mpirun) as the four numbers used here.
+    // Each run travels (between ranks under mpirun) as the five numbers used here.
     struct Measured {
-        double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0;
+        double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0, still_loading = 0;
     };
     auto run = [&](int k) -> std::string {
         LabTestOptions lo = o.base;
@@ -128,8 +128,8 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
         }
         const LabTestResult r = run_labtest(lo);
         char text[128];
-        std::snprintf(text, sizeof text, "%.17g %.17g %.17g %.17g", r.E, r.nu, r.peak_stress,
-                      r.crack_initiation_stress);
+        std::snprintf(text, sizeof text, "%.17g %.17g %.17g %.17g %d", r.E, r.nu, r.peak_stress,
+                      r.crack_initiation_stress, int(r.still_loading));
         return text;
     };
     // Runs over ranks and threads; every rank gets every result.
@@ -137,10 +137,12 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     const auto texts = studies::run_spread(runs, o.threads, run);
     for (int k = 0; k < runs; ++k) {
         Measured& m = measured[std::size_t(k)];
-        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation) != 4)
+        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf %lf", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation,
+                        &m.still_loading) != 5)
             throw std::runtime_error("calibration: a run's result did not arrive");
     }
     CalibrationIteration it;
+    for (const Measured& m : measured) it.still_loading += m.still_loading > 0.0;
     it.joint = joint;
     std::vector<double> E, peak, ten, ci;
     for (int k = 0; k < n; ++k) {

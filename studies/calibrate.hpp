@@ -98,6 +98,9 @@ struct CalibrationIteration {
     double misfit = 0;
     double seconds = 0;
     bool converged = false;
+    /// Runs that reached the lab test's max_strain still loading (LabTestResult::
+    /// still_loading): their peaks, and the means with them, are lower bounds.
+    int still_loading = 0;
 };
 
 /// The calibrated set of an iteration table: the converged iteration, or else the

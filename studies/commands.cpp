@@ -327,7 +327,7 @@ nlohmann::json labtest_json(const LabTestResult& r) {
             {"peak_stress", r.peak_stress}, {"strain_at_peak", r.strain_at_peak},
             {"crack_initiation_stress", r.crack_initiation_stress}, {"crack_damage_stress", r.crack_damage_stress},
             {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
-            {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed},
+            {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed}, {"still_loading", r.still_loading},
             {"post_peak_locking", r.post_peak_locking}, {"preload_skipped", r.preload_skipped},
             {"joint_slip_stress", r.joint_slip_stress}, {"joint_slip_stress_half", r.joint_slip_stress_half},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
@@ -359,6 +359,7 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.tensile_strength = j["tensile_strength"], r.blocks = j["blocks"], r.contacts = j["contacts"];
     r.steps = j["steps"], r.wall_seconds = j["wall_seconds"], r.peak_passed = j["peak_passed"];
     r.post_peak_locking = j["post_peak_locking"], r.preload_skipped = j["preload_skipped"];
+    r.still_loading = j.value("still_loading", false);
     r.joint_slip_stress = j["joint_slip_stress"], r.joint_slip_stress_half = j["joint_slip_stress_half"];
     r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
     const auto& o = j["crack_orientation"];
@@ -594,6 +595,10 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                     std::fprintf(stderr, "  seed %llu: the confinement left blocks the implicit preload cannot solve "
                                          "(held at one point, or loose): loaded explicitly from the start\n",
                                  static_cast<unsigned long long>(ok.seed));
+                if (r.still_loading)
+                    std::fprintf(stderr, "  seed %llu: still loading at --max-strain %g, not failed: the peak is a "
+                                         "lower bound of the strength (raise --max-strain)\n",
+                                 static_cast<unsigned long long>(ok.seed), ok.max_strain);
                 if (r.post_peak_locking)
                     std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",
@@ -756,6 +761,10 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                 for (double s1 : it.confined) std::fprintf(stderr, " %7.2f", s1 / 1e6);
             }
             std::fprintf(stderr, "  misfit %.3f%s\n", it.misfit, it.converged ? "  converged" : "");
+            if (it.still_loading > 0)
+                std::fprintf(stderr, "     %d test%s still loading at --max-strain %g: lower bounds, not strengths "
+                                     "(raise --max-strain)\n",
+                             it.still_loading, it.still_loading == 1 ? "" : "s", o.base.max_strain);
         }
         table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
                          {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
@@ -765,7 +774,7 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                          {"confined_strength_std", confined_json(it.confined_std)}, {"ci_ratio", it.ci_ratio},
                          {"ci_ratio_std", it.ci_ratio_std}, {"weibull_modulus", it.joint.weibull_modulus},
                          {"misfit", it.misfit}, {"seconds", it.seconds},
-                         {"converged", it.converged}});
+                         {"converged", it.converged}, {"still_loading", it.still_loading}});
     });
     // The converged set, or else the best one (the smallest misfit).
     const auto& last = best_iteration(iterations_done);

@@ -382,7 +382,9 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                              test_name(job.kind), job.confinement / 1e6, static_cast<unsigned long long>(o.seed),
                              result.peak_stress / 1e6, result.crack_initiation_stress / 1e6,
                              result.crack_damage_stress / 1e6, result.steps, result.wall_seconds,
-                             result.post_peak_locking ? "  (fragments jammed after failure)" : "");
+                             result.still_loading       ? "  (still loading at --max-strain: a lower bound)"
+                             : result.post_peak_locking ? "  (fragments jammed after failure)"
+                                                        : "");
             }
             return labtest_record_text(result);
         });
@@ -421,21 +423,23 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     levels_s3.insert(levels_s3.end(), confinements.begin(), confinements.end());
     for (double level : levels_s3) {
         std::vector<double> peak, ci, cd, ci_ratio, cd_ratio, E, nu;
+        int still_loading = 0;
         for (const auto& r : runs) {
             if ((r.test != "ucs" && r.test != "biaxial") || r.confinement != level) continue;
             const auto& x = r.result;
             peak.push_back(x.peak_stress), E.push_back(x.E), nu.push_back(x.nu);
+            still_loading += x.still_loading;
             if (x.crack_initiation_stress > 0) ci.push_back(x.crack_initiation_stress), ci_ratio.push_back(x.crack_initiation_stress / x.peak_stress);
             if (x.crack_damage_stress > 0) cd.push_back(x.crack_damage_stress), cd_ratio.push_back(x.crack_damage_stress / x.peak_stress);
         }
         levels.push_back({{"sigma3", level}, {"peak", stats(peak)}, {"sigma_ci", stats(ci)}, {"sigma_cd", stats(cd)},
                           {"sigma_ci_over_peak", stats(ci_ratio)}, {"sigma_cd_over_peak", stats(cd_ratio)},
-                          {"E", stats(E)}, {"nu", stats(nu)}});
+                          {"E", stats(E)}, {"nu", stats(nu)}, {"still_loading", still_loading}});
     }
     nlohmann::json per_run = nlohmann::json::array();
     std::ostringstream csv;
     csv << "test,sigma3_Pa,seed,peak_Pa,sigma_ci_Pa,sigma_cd_Pa,tensile_strength_Pa,E_Pa,nu,cracks_tensile,cracks_shear,"
-           "steps,post_peak_locking\n";
+           "steps,post_peak_locking,still_loading\n";
     csv.precision(10);
     for (const auto& r : runs) {
         const auto& x = r.result;
@@ -444,11 +448,11 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                            {"tensile_strength", x.tensile_strength}, {"E", x.E}, {"nu", x.nu},
                            {"cracks", {{"tensile", x.cracks_tensile}, {"shear", x.cracks_shear}}},
                            {"steps", x.steps}, {"wall_seconds", x.wall_seconds},
-                           {"post_peak_locking", x.post_peak_locking}});
+                           {"post_peak_locking", x.post_peak_locking}, {"still_loading", x.still_loading}});
         csv << r.test << ',' << r.confinement << ',' << r.seed << ',' << x.peak_stress << ','
             << x.crack_initiation_stress << ',' << x.crack_damage_stress << ',' << x.tensile_strength << ',' << x.E
             << ',' << x.nu << ',' << x.cracks_tensile << ',' << x.cracks_shear << ',' << x.steps << ','
-            << x.post_peak_locking << '\n';
+            << x.post_peak_locking << ',' << x.still_loading << '\n';
     }
     const auto ucs_stats = stats(ucs), t_stats = stats(strength_t);
     const double t_over_c = ucs_stats["mean"].get<double>() > 0
@@ -481,6 +485,12 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                      ucs_stats["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
                      t_stats["mean"].get<double>() / 1e6, t_over_c);
         print_fits(summary);
+        int still_loading = 0;
+        for (const auto& r : runs) still_loading += r.result.still_loading;
+        if (still_loading > 0)
+            std::fprintf(stderr, "warning: %d test%s reached --max-strain %g still loading: %s peak is a lower bound of "
+                                 "the strength, and the fits with it; raise --max-strain\n",
+                         still_loading, still_loading == 1 ? "" : "s", c.o.max_strain, still_loading == 1 ? "its" : "their");
         if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
     }
     if (study) {

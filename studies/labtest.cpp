@@ -623,7 +623,10 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             r.peak_passed = true;
             break;
         }
-        if (p.axial_strain >= o.max_strain) break;
+        if (p.axial_strain >= o.max_strain) {
+            r.still_loading = !failed;
+            break;
+        }
     }
     r.steps = s.steps();
     r.peak_stress = peak;

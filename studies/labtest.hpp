@@ -169,6 +169,12 @@ struct LabTestResult {
     /// pieces jam against the platens. 0: never.
     double joint_slip_stress_half = 0.0, joint_slip_stress = 0.0;
     bool peak_passed = false;
+    /// The test reached max_strain with its specimen not failed (no drop, no
+    /// stall): the stress was still rising and peak_stress is the stress at the
+    /// limit — a lower bound of the strength, not a strength. A strong rock's
+    /// confined test needs more strain than the default 1% (Lac du Bonnet at
+    /// σ3 = 35.5 MPa: still rising at 601 MPa at 1%; docs/calibration.md).
+    bool still_loading = false;
     /// After failure the stress climbed back above the peak (a jammed rubble core):
     /// the run stopped there and peak_stress is the peak before failure.
     bool post_peak_locking = false;

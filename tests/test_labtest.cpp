@@ -208,7 +208,25 @@ TEST_CASE("post-peak, mechanism 1: local crack bursts of a small rigid specimen 
     o.width = 2.0, o.height = 4.0, o.seed = 1;
     const auto p = post_peak_run(o);
     CHECK(p.r.peak_passed);
+    CHECK_FALSE(p.r.still_loading);
     check_softens(p, 0.01);
+}
+
+TEST_CASE("a test that reaches its strain limit before failing says its peak is a lower bound") {
+    // The same specimen stopped at half its peak's strain: the stress is still
+    // rising there, so the "peak" is the stress at the limit, and the result says
+    // so (a strong rock's confined test at the default 1% did this silently).
+    auto o = LabTestOptions::paper_ucs();
+    o.width = 2.0, o.height = 4.0, o.seed = 1;
+    o.threads = 2;
+    o.max_strain = 5e-4;
+    const auto r = run_labtest(o);
+    REQUIRE(!r.curve.empty());
+    CHECK(r.still_loading);
+    CHECK_FALSE(r.peak_passed);
+    CHECK(r.curve.back().axial_strain >= 5e-4);
+    CHECK(r.peak_stress == doctest::Approx(r.curve.back().axial_stress).epsilon(0.02));
+    CHECK(r.peak_stress < 0.8 * 22e6); // below the specimen's strength, about 22 MPa
 }
 
 TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, the serial meshes") {
