@@ -99,8 +99,15 @@ std::vector<std::pair<double, double>> hoek_brown_targets(double sigma_ci, doubl
     return points;
 }
 
+std::vector<double> confined_strain_limits(const CalibrationTargets& t, double base_max_strain) {
+    std::vector<double> limits;
+    for (const auto& [s3, s1] : t.envelope) limits.push_back(std::max(base_max_strain, 2.0 * s1 / t.E));
+    return limits;
+}
+
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed, const std::vector<double>& confinements) {
+                                              std::uint64_t first_seed, const std::vector<double>& confinements,
+                                              const std::vector<double>& max_strains) {
     const auto t0 = std::chrono::steady_clock::now();
     const int n = o.realizations;
     // Runs k: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests at
@@ -123,7 +130,9 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
             lo.platen_friction = -1.0;                           // tension needs platens that hold
         } else {
             lo.kind = LabTestOptions::Kind::biaxial;
-            lo.confinement = confinements[std::size_t(k / n - 2)];
+            const std::size_t c = std::size_t(k / n - 2);
+            lo.confinement = confinements[c];
+            if (c < max_strains.size()) lo.max_strain = std::max(lo.max_strain, max_strains[c]);
             lo.post_peak_strain = envelope_post_peak_strain; // as bbm envelope: a confined peak is final once failed
         }
         const LabTestResult r = run_labtest(lo);
@@ -227,8 +236,9 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
     // σci/UCS by the strength heterogeneity h = 1/m.
     const bool with_ci = o.fit_ci && t.ci_ratio > 0;
     double prev_h = -1.0, prev_ci = 0.0;
+    const std::vector<double> strain_limits = confined_strain_limits(t, o.base.max_strain);
     for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
-        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, sigma3);
+        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, sigma3, strain_limits);
         it.misfit = calibration_misfit(it, t, with_ci);
         it.converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
                        std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&

@@ -125,9 +125,18 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
 /// Mean and sample standard deviation of the measures for a joint set (E and ν
 /// from elastic_measure, the strengths and σci/UCS from the UCS and tension
 /// tests, and σ1 from biaxial tests at each of `confinements`), without misfit.
+/// `max_strains` (optional, one per confinement): the biaxial tests' strain limits.
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
                                               std::uint64_t first_seed,
-                                              const std::vector<double>& confinements = {});
+                                              const std::vector<double>& confinements = {},
+                                              const std::vector<double>& max_strains = {});
+
+/// The confined tests' strain limits for a record: room for twice each target
+/// σ1's elastic strain (2 σ1 / E), never less than the lab test's own limit. At
+/// the default 1% a strong rock's confined test stopped still loading (Lac du
+/// Bonnet at σ3 = 71 MPa: σ1 777 MPa needs 1.1% of elastic strain), and the
+/// stress at the limit was taken for its strength.
+std::vector<double> confined_strain_limits(const CalibrationTargets& t, double base_max_strain);
 
 /// The misfit of measured properties against the targets (CalibrationIteration::misfit);
 /// with `with_ci`, |σci/UCS / target − 1| too.

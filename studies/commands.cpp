@@ -762,8 +762,8 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
             }
             std::fprintf(stderr, "  misfit %.3f%s\n", it.misfit, it.converged ? "  converged" : "");
             if (it.still_loading > 0)
-                std::fprintf(stderr, "     %d test%s still loading at --max-strain %g: lower bounds, not strengths "
-                                     "(raise --max-strain)\n",
+                std::fprintf(stderr, "     %d test%s still loading at the strain limit (--max-strain %g; a confined "
+                                     "test: at least twice its target's elastic strain): lower bounds, not strengths\n",
                              it.still_loading, it.still_loading == 1 ? "" : "s", o.base.max_strain);
         }
         table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
@@ -780,7 +780,8 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     const auto& last = best_iteration(iterations_done);
     const auto& j = last.joint;
     // The calibrated set on seeds it has not seen: what a new model will get.
-    auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, sigma3);
+    auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, sigma3,
+                                          confined_strain_limits(targets, o.base.max_strain));
     fresh.misfit = calibration_misfit(fresh, targets, o.fit_ci);
     if (!quiet) {
         std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "

@@ -28,6 +28,22 @@ TEST_CASE("calibrate: Hoek-Brown targets lie on the criterion") {
     CHECK(points[0].second == doctest::Approx(35.5e6 + 213e6 * std::sqrt(6.0)).epsilon(1e-12));
 }
 
+TEST_CASE("calibrate: a confined test has strain for twice its target's elastic strain (a strong rock needs more than 1%)") {
+    // Lac du Bonnet (E 69 GPa, mi 30): sigma1 557 and 777 MPa at 35.5 and 71 MPa,
+    // 0.81% and 1.13% of elastic strain; the paper's rock needs far less than 1%.
+    CalibrationTargets granite;
+    granite.E = 69e9;
+    granite.envelope = hoek_brown_targets(213e6, 30.0, {35.5e6, 71e6});
+    const auto limits = confined_strain_limits(granite, 0.01);
+    REQUIRE(limits.size() == 2);
+    CHECK(limits[0] == doctest::Approx(2.0 * granite.envelope[0].second / 69e9));
+    CHECK(limits[1] == doctest::Approx(2.0 * granite.envelope[1].second / 69e9));
+    CHECK(limits[1] > 0.022);
+    CalibrationTargets paper;
+    paper.envelope = {{5e6, 40e6}};
+    CHECK(confined_strain_limits(paper, 0.01) == std::vector<double>{0.01});
+}
+
 TEST_CASE("calibrate: the misfit is the largest relative miss, and the best set is the converged or least misfit") {
     CalibrationTargets t;
     t.E = 20e9, t.nu = 0.2, t.ucs = 20e6, t.tensile = 2e6;
