@@ -4,6 +4,8 @@
 
 #include "core/solver.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -99,15 +101,8 @@ std::vector<std::pair<double, double>> hoek_brown_targets(double sigma_ci, doubl
     return points;
 }
 
-std::vector<double> confined_strain_limits(const CalibrationTargets& t, double base_max_strain) {
-    std::vector<double> limits;
-    for (const auto& [s3, s1] : t.envelope) limits.push_back(std::max(base_max_strain, 2.0 * s1 / t.E));
-    return limits;
-}
-
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed, const std::vector<double>& confinements,
-                                              const std::vector<double>& max_strains) {
+                                              std::uint64_t first_seed, const std::vector<double>& confinements) {
     const auto t0 = std::chrono::steady_clock::now();
     const int n = o.realizations;
     // Runs k: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests at
@@ -115,7 +110,8 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     const int runs = (2 + int(confinements.size())) * n;
     // Each run travels (between ranks under mpirun) as the five numbers used here.
     struct Measured {
-        double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0, still_loading = 0;
+        double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0;
+        int still_loading = 0;
     };
     auto run = [&](int k) -> std::string {
         LabTestOptions lo = o.base;
@@ -132,7 +128,6 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
             lo.kind = LabTestOptions::Kind::biaxial;
             const std::size_t c = std::size_t(k / n - 2);
             lo.confinement = confinements[c];
-            if (c < max_strains.size()) lo.max_strain = std::max(lo.max_strain, max_strains[c]);
             lo.post_peak_strain = envelope_post_peak_strain; // as bbm envelope: a confined peak is final once failed
         }
         const LabTestResult r = run_labtest(lo);
@@ -146,12 +141,12 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     const auto texts = studies::run_spread(runs, o.threads, run);
     for (int k = 0; k < runs; ++k) {
         Measured& m = measured[std::size_t(k)];
-        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf %lf", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation,
+        if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf %d", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation,
                         &m.still_loading) != 5)
             throw std::runtime_error("calibration: a run's result did not arrive");
     }
     CalibrationIteration it;
-    for (const Measured& m : measured) it.still_loading += m.still_loading > 0.0;
+    for (const Measured& m : measured) it.still_loading += m.still_loading;
     it.joint = joint;
     std::vector<double> E, peak, ten, ci;
     for (int k = 0; k < n; ++k) {
@@ -214,14 +209,54 @@ double next_heterogeneity(double h_prev, double ci_prev, double h, double ci, do
     return std::clamp(std::clamp(h_new, h - 0.3, h + 0.3), 0.0, 1.0);
 }
 
-namespace {
-/// The envelope's mean slope through the UCS: least squares of σ1 − UCS = k σ3.
-double envelope_slope(const std::vector<double>& sigma3, const std::vector<double>& sigma1, double ucs) {
-    double num = 0.0, den = 0.0;
-    for (std::size_t c = 0; c < sigma3.size(); ++c) num += sigma3[c] * (sigma1[c] - ucs), den += sigma3[c] * sigma3[c];
-    return num / den;
+std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
+                                                 const std::vector<double>& sigma3,
+                                                 const std::vector<double>& log_target) {
+    if (history.empty()) throw std::logic_error("next_cohesion_friction: no sample");
+    constexpr double deg = std::numbers::pi / 180.0;
+    const StrengthSample& last = history.back();
+    const std::size_t measures = log_target.size();
+    if (last.log_strength.size() != measures || sigma3.size() + 1 != measures)
+        throw std::logic_error("next_cohesion_friction: a UCS and one σ1 per confinement");
+    // Coulomb's slopes at the last sample: UCS = 2c√N, σ1 = UCS + N σ3,
+    // d ln √N/dφ = 1/cos φ, d ln N/dφ = 2/cos φ (per radian).
+    const double phi = last.friction * deg, n_phi = (1.0 + std::sin(phi)) / (1.0 - std::sin(phi));
+    const double ucs = std::exp(last.log_strength[0]);
+    constexpr double prior_c = 0.5, prior_phi = 3.0; // the prior rows' weights: ln c and degrees
+    Eigen::MatrixXd jacobian(measures, 2);
+    Eigen::VectorXd intercept(measures);
+    for (std::size_t m = 0; m < measures; ++m) {
+        const double s3 = m == 0 ? 0.0 : sigma3[m - 1], s1 = std::exp(last.log_strength[m]);
+        const double b0 = ucs / s1, g0 = (ucs / std::cos(phi) + s3 * n_phi * 2.0 / std::cos(phi)) * deg / s1;
+        // Rows: the samples (1, ln c, φ) → ln s, then the two priors on the slopes.
+        const Eigen::Index rows = Eigen::Index(history.size()) + 2;
+        Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, 3);
+        Eigen::VectorXd y(rows);
+        for (std::size_t k = 0; k < history.size(); ++k) {
+            a.row(Eigen::Index(k)) << 1.0, history[k].log_cohesion, history[k].friction;
+            y(Eigen::Index(k)) = history[k].log_strength[m];
+        }
+        a(rows - 2, 1) = prior_c, y(rows - 2) = prior_c * b0;
+        a(rows - 1, 2) = prior_phi, y(rows - 1) = prior_phi * g0;
+        const Eigen::Vector3d fit = a.colPivHouseholderQr().solve(y);
+        intercept(Eigen::Index(m)) = fit(0);
+        jacobian.row(Eigen::Index(m)) << fit(1), fit(2);
+    }
+    // Targets in least squares, the UCS row twice as heavy.
+    Eigen::VectorXd weight = Eigen::VectorXd::Ones(Eigen::Index(measures));
+    weight(0) = 2.0;
+    const Eigen::MatrixXd wj = weight.asDiagonal() * jacobian;
+    const Eigen::VectorXd wr = weight.asDiagonal() * (Eigen::Map<const Eigen::VectorXd>(log_target.data(),
+                                                                                          Eigen::Index(measures)) -
+                                                      intercept);
+    const Eigen::Vector2d u = wj.colPivHouseholderQr().solve(wr);
+    double log_c = last.log_cohesion, friction = last.friction;
+    if (u.allFinite()) {
+        log_c = std::clamp(u(0), last.log_cohesion - 0.7, last.log_cohesion + 0.7);
+        friction = std::clamp(std::clamp(u(1), last.friction - 8.0, last.friction + 8.0), 5.0, 55.0);
+    }
+    return {log_c, friction};
 }
-} // namespace
 
 std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
                                             const std::function<void(const CalibrationIteration&)>& report) {
@@ -230,15 +265,15 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
     const bool with_phi = !t.envelope.empty();
     std::vector<double> sigma3, sigma1_target;
     for (const auto& [s3, s1] : t.envelope) sigma3.push_back(s3), sigma1_target.push_back(s1);
-    // Slope of the strength envelope, σ1 = UCS + k σ3 (k = tan²(45° + φ/2) for Coulomb).
-    const double k_target = with_phi ? envelope_slope(sigma3, sigma1_target, t.ucs) : 0.0;
-    double prev_tan = 0.0, prev_k = 0.0;
+    // The strengths the cohesion and friction steer by, targets and history.
+    std::vector<double> log_strength_target{std::log(t.ucs)};
+    for (double s1 : sigma1_target) log_strength_target.push_back(std::log(s1));
+    std::vector<StrengthSample> strength_history;
     // σci/UCS by the strength heterogeneity h = 1/m.
     const bool with_ci = o.fit_ci && t.ci_ratio > 0;
     double prev_h = -1.0, prev_ci = 0.0;
-    const std::vector<double> strain_limits = confined_strain_limits(t, o.base.max_strain);
     for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
-        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, sigma3, strain_limits);
+        CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, sigma3);
         it.misfit = calibration_misfit(it, t, with_ci);
         it.converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
                        std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&
@@ -257,26 +292,16 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         j.kn *= (t.E / it.E) * ((1.0 + r) / (3.0 + r)) / ((1.0 + r_new) / (3.0 + r_new));
         j.ks = r_new * j.kn;
         j.tensile *= t.tensile / it.tensile;
-        j.cohesion *= t.ucs / it.ucs;
         if (with_phi) {
-            constexpr double deg = std::numbers::pi / 180.0;
-            const double k = envelope_slope(sigma3, it.confined, it.ucs), tan_phi = std::tan(j.friction * deg);
-            double tan_new = tan_phi * std::max(0.05, k_target - 1.0) / std::max(0.05, k - 1.0);
-            if (iteration > 0 && std::abs(k - prev_k) > 1e-6 * std::abs(k) && std::abs(tan_phi - prev_tan) > 1e-9)
-                tan_new = tan_phi + (k_target - k) * (tan_phi - prev_tan) / (k - prev_k); // secant
-            prev_tan = tan_phi, prev_k = k;
-            const double phi = std::clamp(std::atan(std::max(tan_new, 0.0)) / deg, j.friction - 10.0, j.friction + 10.0);
-            // The UCS rises with φ as well as with c: for Coulomb, UCS = 2 c √Nφ with
-            // Nφ = (1 + sin φ)/(1 − sin φ). Without this the cohesion, corrected for
-            // the old φ, overshoots the UCS whenever φ moves (Lac du Bonnet: φ 25° →
-            // 35° took the UCS from 191 to 276 MPa against 213).
-            auto n_phi = [](double degrees) {
-                const double s = std::sin(degrees * deg);
-                return (1.0 + s) / (1.0 - s);
-            };
-            const double phi_new = std::clamp(phi, 5.0, 60.0);
-            j.cohesion *= std::sqrt(n_phi(j.friction) / n_phi(phi_new));
-            j.friction = phi_new;
+            const double loss = ucs_loss(heterogeneity_of(j));
+            StrengthSample sample{std::log(j.cohesion * loss), j.friction, {std::log(it.ucs)}};
+            for (double s1 : it.confined) sample.log_strength.push_back(std::log(s1));
+            strength_history.push_back(std::move(sample));
+            const auto [log_c, friction] = next_cohesion_friction(strength_history, sigma3, log_strength_target);
+            j.cohesion = std::exp(log_c) / loss;
+            j.friction = friction;
+        } else {
+            j.cohesion *= t.ucs / it.ucs;
         }
         if (with_ci && std::abs(it.ci_ratio - t.ci_ratio) > 0.25 * o.tolerance_ci) {
             const double h = heterogeneity_of(j);

@@ -19,13 +19,11 @@
 //   kn ← kn × E*/E,   r: shifted by the lattice value of r at ν* minus that at ν,
 //   σt ← σt × T*/T,   c ← c × UCS*/UCS,
 // and, with confined targets (the record's triaxial or biaxial strengths, or
-// points of its Hoek–Brown curve), φ by the envelope's mean slope k: the least-
-// squares slope through the UCS, k = Σ σ3 (σ1 − UCS) / Σ σ3², measured and
-// target (k = tan²(45° + φ/2) for Coulomb): tan φ scaled by (k* − 1)/(k − 1) at
-// first, then by the secant through the last two iterations, steps within ±10°,
-// φ within 5–60°, and c scaled by √(Nφ_old/Nφ_new), Nφ = (1 + sin φ)/(1 − sin φ),
-// as the Coulomb UCS 2c√Nφ would need to stay put. One friction angle sets one slope: the curvature of a record's
-// envelope is not fitted, and the misfit at each σ3 is reported.
+// points of its Hoek–Brown curve), c and φ together (next_cohesion_friction):
+// the strengths (ln UCS, ln σ1 at each σ3) as planes in (ln c, φ) fitted to
+// every iteration so far, solved for the targets. One friction angle sets one
+// slope: the curvature of a record's envelope is not fitted, and the misfit at
+// each σ3 is reported.
 // Converged when every mean is within its tolerance; otherwise, after
 // max_iterations, the best set (the smallest largest misfit) is the result.
 // The means are over realizations, so the result carries their scatter: a new
@@ -80,6 +78,31 @@ struct CalibrationOptions {
     double tolerance_ci = 0.05;
 };
 
+/// One iteration's strengths against the bonds' cohesion and friction.
+struct StrengthSample {
+    /// ln of the cohesion the UCS sees: c × ucs_loss(h), the loss of the
+    /// weakest bonds of heterogeneity h taken out (the σci step moves c for it).
+    double log_cohesion = 0.0;
+    double friction = 0.0;              ///< degrees
+    std::vector<double> log_strength;   ///< ln UCS, then ln σ1 at each confinement
+};
+
+/// The next (ln c, φ) for the strength targets (ln UCS, then ln σ1 at each of
+/// `sigma3`). Each strength is taken as a plane, ln s = a + b ln c + g φ, fitted
+/// by least squares to every sample, its slopes held near the Coulomb ones
+/// (UCS = 2c√Nφ, σ1 = UCS + Nφ σ3 at the last sample) by prior rows worth a
+/// log-unit of 0.5 in ln c and 3° in φ: with one sample the step is Newton's on
+/// the Coulomb slopes, with more the measured slopes take over. Why not one
+/// secant per unknown: the UCS of bonded blocks rises with φ about three times
+/// as fast as the Coulomb UCS (Lac du Bonnet, 6 iterations: d ln UCS/dφ =
+/// 0.055/° against 0.023/°), so each friction step threw the UCS off (134–345
+/// MPa against 213) and φ swung (25° → 35° → 43° → 33° → 43° → 41°). The targets
+/// are met in least squares, the UCS row weighted twice (its tolerance is half
+/// the envelope's); steps within ±0.7 in ln c and ±8° in φ, φ within 5–55°.
+std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
+                                                 const std::vector<double>& sigma3,
+                                                 const std::vector<double>& log_target);
+
 /// The next heterogeneity h = 1/m of the σci/UCS calibration from the last two
 /// iterations (h_prev < 0: none before): the secant when the two show σci/UCS
 /// falling with h, else a step of 0.2 toward the target; steps within ±0.3 and h
@@ -125,18 +148,10 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
 /// Mean and sample standard deviation of the measures for a joint set (E and ν
 /// from elastic_measure, the strengths and σci/UCS from the UCS and tension
 /// tests, and σ1 from biaxial tests at each of `confinements`), without misfit.
-/// `max_strains` (optional, one per confinement): the biaxial tests' strain limits.
 CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
                                               std::uint64_t first_seed,
-                                              const std::vector<double>& confinements = {},
-                                              const std::vector<double>& max_strains = {});
+                                              const std::vector<double>& confinements = {});
 
-/// The confined tests' strain limits for a record: room for twice each target
-/// σ1's elastic strain (2 σ1 / E), never less than the lab test's own limit. At
-/// the default 1% a strong rock's confined test stopped still loading (Lac du
-/// Bonnet at σ3 = 71 MPa: σ1 777 MPa needs 1.1% of elastic strain), and the
-/// stress at the limit was taken for its strength.
-std::vector<double> confined_strain_limits(const CalibrationTargets& t, double base_max_strain);
 
 /// The misfit of measured properties against the targets (CalibrationIteration::misfit);
 /// with `with_ci`, |σci/UCS / target − 1| too.

@@ -382,7 +382,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                              test_name(job.kind), job.confinement / 1e6, static_cast<unsigned long long>(o.seed),
                              result.peak_stress / 1e6, result.crack_initiation_stress / 1e6,
                              result.crack_damage_stress / 1e6, result.steps, result.wall_seconds,
-                             result.still_loading       ? "  (still loading at --max-strain: a lower bound)"
+                             result.still_loading       ? "  (still loading at the strain cap: a lower bound)"
                              : result.post_peak_locking ? "  (fragments jammed after failure)"
                                                         : "");
             }
@@ -488,9 +488,10 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         int still_loading = 0;
         for (const auto& r : runs) still_loading += r.result.still_loading;
         if (still_loading > 0)
-            std::fprintf(stderr, "warning: %d test%s reached --max-strain %g still loading: %s peak is a lower bound of "
-                                 "the strength, and the fits with it; raise --max-strain\n",
-                         still_loading, still_loading == 1 ? "" : "s", c.o.max_strain, still_loading == 1 ? "its" : "their");
+            std::fprintf(stderr, "warning: %d test%s reached the strain cap %g still loading: %s peak is a lower bound "
+                                 "of the strength, and the fits with it (blocks jammed, or raise --strain-cap)\n",
+                         still_loading, still_loading == 1 ? "" : "s", std::max(c.o.max_strain, c.o.strain_cap),
+                         still_loading == 1 ? "its" : "their");
         if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
     }
     if (study) {

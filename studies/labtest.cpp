@@ -624,8 +624,19 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             break;
         }
         if (p.axial_strain >= o.max_strain) {
-            r.still_loading = !failed;
-            break;
+            // Not failed yet: the strength is still ahead, load on to the cap.
+            // Failed after loading on: stop max_strain past the peak at the latest
+            // (the locking check above gets the room it had before max_strain).
+            const double cap = std::max(o.max_strain, o.strain_cap);
+            if (!failed && p.axial_strain < cap) {
+                r.loaded_past_max_strain = true;
+            } else if (!failed) {
+                r.still_loading = true;
+                break;
+            } else if (!r.loaded_past_max_strain || p.axial_strain >= cap ||
+                       p.axial_strain >= strain_at_peak + o.max_strain) {
+                break;
+            }
         }
     }
     r.steps = s.steps();

@@ -25,7 +25,8 @@
 //   ν  = −(least-squares slope of lateral against axial strain) over the same points
 // Brazilian: indirect tensile strength σt = 2P / (π D), P the peak line load.
 // The run stops when the stress has dropped below `stop_fraction` of the peak
-// after it, at `max_strain`, or when after failure (a drop by `failure_drop`, or
+// after it, at `max_strain` (a specimen not yet failed there loads on, up to
+// `strain_cap`: its strength is not measured yet), or when after failure (a drop by `failure_drop`, or
 // a stall of the stress over 2e-4 of strain) it stays above the peak for 10
 // records with broken and new contacts carrying at least half of the contact
 // compression: fragments locked between the platens (post_peak_locking). Above
@@ -99,7 +100,16 @@ struct LabTestOptions {
     /// A drop by this fraction from the peak marks failure: the peak is then the
     /// strength, and the run stops if the stress climbs back above it.
     double failure_drop = 0.1;
+    /// The strain at which a test stops, failed or not, unless it is still
+    /// loading: a specimen that has not failed by then (no drop, no stall) loads
+    /// on up to strain_cap, and once it fails stops by the same rules, at most
+    /// max_strain past its peak.
     double max_strain = 0.01;
+    /// Hard limit for a specimen still loading at max_strain (≤ max_strain: stop
+    /// there). 3% is three times the elastic strain of a strong rock's confined
+    /// peak (Lac du Bonnet at σ3 = 71 MPa: 777 / 70 000 = 1.1%); a specimen still
+    /// loading at 3% is jammed, not strong (LabTestResult::still_loading).
+    double strain_cap = 0.03;
     /// Confined tests (biaxial): stop this much axial strain past the peak once the
     /// specimen has failed (0: go on to max_strain or stop_fraction). Exact for the
     /// peak: under confinement a failed specimen's peak is final (a climb back
@@ -169,12 +179,15 @@ struct LabTestResult {
     /// pieces jam against the platens. 0: never.
     double joint_slip_stress_half = 0.0, joint_slip_stress = 0.0;
     bool peak_passed = false;
-    /// The test reached max_strain with its specimen not failed (no drop, no
-    /// stall): the stress was still rising and peak_stress is the stress at the
-    /// limit — a lower bound of the strength, not a strength. A strong rock's
-    /// confined test needs more strain than the default 1% (Lac du Bonnet at
-    /// σ3 = 35.5 MPa: still rising at 601 MPa at 1%; docs/calibration.md).
+    /// The test reached its hard limit (strain_cap, or max_strain when that is
+    /// larger) with its specimen not failed (no drop, no stall): the stress was
+    /// still rising and peak_stress is the stress at the limit — a lower bound of
+    /// the strength, not a strength (docs/calibration.md).
     bool still_loading = false;
+    /// The specimen had not failed at max_strain and loaded on past it (a strong
+    /// rock's confined test: Lac du Bonnet at σ3 = 35.5 MPa was still rising at
+    /// 601 MPa at 1%).
+    bool loaded_past_max_strain = false;
     /// After failure the stress climbed back above the peak (a jammed rubble core):
     /// the run stopped there and peak_stress is the peak before failure.
     bool post_peak_locking = false;

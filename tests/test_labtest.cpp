@@ -212,21 +212,42 @@ TEST_CASE("post-peak, mechanism 1: local crack bursts of a small rigid specimen 
     check_softens(p, 0.01);
 }
 
-TEST_CASE("a test that reaches its strain limit before failing says its peak is a lower bound") {
-    // The same specimen stopped at half its peak's strain: the stress is still
-    // rising there, so the "peak" is the stress at the limit, and the result says
-    // so (a strong rock's confined test at the default 1% did this silently).
+TEST_CASE("a test not failed at its strain limit loads on to its strength and at the hard cap says its peak is a lower bound") {
+    // The same specimen with max_strain at half its peak's strain. With the cap at
+    // max_strain the stress is still rising there, so the "peak" is the stress at
+    // the limit, and the result says so (a strong rock's confined test at the
+    // default 1% did this silently). With the default cap it loads on, fails, and
+    // its peak is the one of a run limited at 1%: the same steps up to the peak.
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0, o.seed = 1;
     o.threads = 2;
     o.max_strain = 5e-4;
-    const auto r = run_labtest(o);
-    REQUIRE(!r.curve.empty());
-    CHECK(r.still_loading);
-    CHECK_FALSE(r.peak_passed);
-    CHECK(r.curve.back().axial_strain >= 5e-4);
-    CHECK(r.peak_stress == doctest::Approx(r.curve.back().axial_stress).epsilon(0.02));
-    CHECK(r.peak_stress < 0.8 * 22e6); // below the specimen's strength, about 22 MPa
+    o.strain_cap = 0.0;
+    const auto capped = run_labtest(o);
+    REQUIRE(!capped.curve.empty());
+    CHECK(capped.still_loading);
+    CHECK_FALSE(capped.loaded_past_max_strain);
+    CHECK_FALSE(capped.peak_passed);
+    CHECK(capped.curve.back().axial_strain >= 5e-4);
+    CHECK(capped.peak_stress == doctest::Approx(capped.curve.back().axial_stress).epsilon(0.02));
+    CHECK(capped.peak_stress < 0.8 * 22e6); // below the specimen's strength, about 22 MPa
+
+    o.strain_cap = LabTestOptions{}.strain_cap;
+    const auto on = run_labtest(o);
+    o.max_strain = LabTestOptions{}.max_strain;
+    const auto full = run_labtest(o);
+    CHECK_FALSE(full.loaded_past_max_strain);
+    CHECK(on.loaded_past_max_strain);
+    CHECK_FALSE(on.still_loading);
+    CHECK(on.strain_at_peak > 5e-4);
+    CHECK(on.peak_stress == full.peak_stress);
+    CHECK(on.strain_at_peak == full.strain_at_peak);
+    // Its first burst of cracks (30.1 MPa) is not taken for failure: the bonds
+    // still carry the load (mechanism 1), as in the run limited at 1%.
+    CHECK(on.peak_stress > 30.5e6);
+    // Stopped past the peak by the drop rule, within max_strain of it.
+    CHECK(on.curve.back().axial_strain <= on.strain_at_peak + 5e-4);
+    CHECK(on.steps == full.steps);
 }
 
 TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, the serial meshes") {
@@ -241,6 +262,7 @@ TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, 
     o.width = 2.0, o.height = 4.0;
     o.deformable_fraction = 0.95;
     o.max_strain = 2e-4;
+    o.strain_cap = 0.0; // the preload and a few steps are what this compares
     o.threads = 1;
     std::vector<LabTestResult> serial, parallel(3);
     for (int k = 0; k < 3; ++k) {
@@ -292,7 +314,8 @@ TEST_CASE("a single plane of weakness slides where Jaeger's closed form says (bi
         o.joint_set_angle = beta;
         o.joint_set_joint.kn = o.joint.kn, o.joint_set_joint.ks = o.joint.ks;
         o.joint_set_joint.friction = 30.0;
-        o.max_strain = 2e-3;
+        o.max_strain = 2e-3; // the slip is read before; the pieces then jam
+        o.strain_cap = 0.0;
         o.threads = 2;
         const auto r = run_labtest(o);
         const double b = beta * std::numbers::pi / 180.0, mu = std::tan(std::numbers::pi / 6.0);
