@@ -242,18 +242,21 @@ std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSampl
         intercept(Eigen::Index(m)) = fit(0);
         jacobian.row(Eigen::Index(m)) << fit(1), fit(2);
     }
-    // Targets in least squares, the UCS row twice as heavy.
+    // The step from the last sample to the targets in least squares (a step, so
+    // that a direction the planes cannot see stays put), the UCS row twice as heavy.
     Eigen::VectorXd weight = Eigen::VectorXd::Ones(Eigen::Index(measures));
     weight(0) = 2.0;
+    const Eigen::Vector2d at(last.log_cohesion, last.friction);
+    const Eigen::VectorXd predicted = intercept + jacobian * at;
     const Eigen::MatrixXd wj = weight.asDiagonal() * jacobian;
-    const Eigen::VectorXd wr = weight.asDiagonal() * (Eigen::Map<const Eigen::VectorXd>(log_target.data(),
-                                                                                          Eigen::Index(measures)) -
-                                                      intercept);
-    const Eigen::Vector2d u = wj.colPivHouseholderQr().solve(wr);
+    const Eigen::VectorXd wr =
+        weight.asDiagonal() *
+        (Eigen::Map<const Eigen::VectorXd>(log_target.data(), Eigen::Index(measures)) - predicted);
+    const Eigen::Vector2d step = wj.colPivHouseholderQr().solve(wr);
     double log_c = last.log_cohesion, friction = last.friction;
-    if (u.allFinite()) {
-        log_c = std::clamp(u(0), last.log_cohesion - 0.7, last.log_cohesion + 0.7);
-        friction = std::clamp(std::clamp(u(1), last.friction - 8.0, last.friction + 8.0), 5.0, 55.0);
+    if (step.allFinite()) {
+        log_c += std::clamp(step(0), -0.7, 0.7);
+        friction = std::clamp(friction + std::clamp(step(1), -8.0, 8.0), 5.0, 55.0);
     }
     return {log_c, friction};
 }

@@ -533,6 +533,10 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     // Locking: the stress above the peak after failure for this many records in a row.
     constexpr int lock_records = 10;
     int records_above_peak = 0;
+    // Stopped unfailed with the stress at its peak (within 2%): the peak is a lower
+    // bound. 2% down from it the specimen has passed its peak, though the drop
+    // rule wants 10%: that peak is a strength.
+    auto still_at_peak = [&peak](const StressStrainPoint& p) { return p.axial_stress >= 0.98 * peak; };
     while (s.steps() - start < o.max_steps) {
         s.step();
         strain += rate;
@@ -631,7 +635,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             if (!failed && p.axial_strain < cap) {
                 r.loaded_past_max_strain = true;
             } else if (!failed) {
-                r.still_loading = true;
+                r.still_loading = still_at_peak(p);
                 break;
             } else if (!r.loaded_past_max_strain || p.axial_strain >= cap ||
                        p.axial_strain >= strain_at_peak + o.max_strain) {
@@ -639,6 +643,9 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             }
         }
     }
+    // Out of steps while loading on: the peak is a lower bound too.
+    if (s.steps() - start >= o.max_steps && r.loaded_past_max_strain && !failed && !r.curve.empty())
+        r.still_loading = still_at_peak(r.curve.back());
     r.steps = s.steps();
     r.peak_stress = peak;
     r.strain_at_peak = strain_at_peak;

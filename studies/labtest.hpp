@@ -180,9 +180,10 @@ struct LabTestResult {
     double joint_slip_stress_half = 0.0, joint_slip_stress = 0.0;
     bool peak_passed = false;
     /// The test reached its hard limit (strain_cap, or max_strain when that is
-    /// larger) with its specimen not failed (no drop, no stall): the stress was
-    /// still rising and peak_stress is the stress at the limit — a lower bound of
-    /// the strength, not a strength (docs/calibration.md).
+    /// larger; or max_steps while loading on) with its specimen not failed (no
+    /// drop, no stall) and the stress at its peak (within 2%): peak_stress is the
+    /// stress at the limit — a lower bound of the strength, not a strength
+    /// (docs/calibration.md).
     bool still_loading = false;
     /// The specimen had not failed at max_strain and loaded on past it (a strong
     /// rock's confined test: Lac du Bonnet at σ3 = 35.5 MPa was still rising at
