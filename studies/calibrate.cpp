@@ -4,9 +4,9 @@
 
 #include "core/solver.hpp"
 
-#include <Eigen/Dense>
-
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
@@ -209,6 +209,37 @@ double next_heterogeneity(double h_prev, double ci_prev, double h, double ci, do
     return std::clamp(std::clamp(h_new, h - 0.3, h + 0.3), 0.0, 1.0);
 }
 
+namespace {
+/// The solution of a small linear system given as its augmented matrix [A | b],
+/// by Gaussian elimination with partial pivoting; none when A is singular.
+template <int N>
+std::optional<std::array<double, N>> solve_small(std::array<std::array<double, N + 1>, N> a) {
+    double scale = 0.0;
+    for (const auto& row : a)
+        for (int c = 0; c < N; ++c) scale = std::max(scale, std::abs(row[c]));
+    for (int col = 0; col < N; ++col) {
+        int pivot = col;
+        for (int r = col + 1; r < N; ++r)
+            if (std::abs(a[r][col]) > std::abs(a[pivot][col])) pivot = r;
+        if (!(std::abs(a[pivot][col]) > 1e-12 * scale)) return std::nullopt;
+        std::swap(a[col], a[pivot]);
+        for (int r = col + 1; r < N; ++r) {
+            const double f = a[r][col] / a[col][col];
+            for (int c = col; c <= N; ++c) a[r][c] -= f * a[col][c];
+        }
+    }
+    std::array<double, N> x{};
+    for (int r = N - 1; r >= 0; --r) {
+        double v = a[r][N];
+        for (int c = r + 1; c < N; ++c) v -= a[r][c] * x[c];
+        x[r] = v / a[r][r];
+    }
+    for (double v : x)
+        if (!std::isfinite(v)) return std::nullopt;
+    return x;
+}
+} // namespace
+
 std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
                                                  const std::vector<double>& sigma3,
                                                  const std::vector<double>& log_target) {
@@ -223,40 +254,48 @@ std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSampl
     const double phi = last.friction * deg, n_phi = (1.0 + std::sin(phi)) / (1.0 - std::sin(phi));
     const double ucs = std::exp(last.log_strength[0]);
     constexpr double prior_c = 0.5, prior_phi = 3.0; // the prior rows' weights: ln c and degrees
-    Eigen::MatrixXd jacobian(measures, 2);
-    Eigen::VectorXd intercept(measures);
+    // Each plane in coordinates centred on the last sample, (1, ln c − ln c_last,
+    // φ − φ_last): its intercept is the strength predicted there, and the
+    // normal equations stay well conditioned. Small systems solved by hand:
+    // Eigen here would put its template code in bbm beside gmsh's own copy, and
+    // the dynamic linker binds gmsh's calls to ours (an ASan build then frees
+    // gmsh's matrices with the wrong allocator).
+    std::vector<double> predicted(measures), slope_c(measures), slope_phi(measures);
     for (std::size_t m = 0; m < measures; ++m) {
         const double s3 = m == 0 ? 0.0 : sigma3[m - 1], s1 = std::exp(last.log_strength[m]);
         const double b0 = ucs / s1, g0 = (ucs / std::cos(phi) + s3 * n_phi * 2.0 / std::cos(phi)) * deg / s1;
-        // Rows: the samples (1, ln c, φ) → ln s, then the two priors on the slopes.
-        const Eigen::Index rows = Eigen::Index(history.size()) + 2;
-        Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, 3);
-        Eigen::VectorXd y(rows);
-        for (std::size_t k = 0; k < history.size(); ++k) {
-            a.row(Eigen::Index(k)) << 1.0, history[k].log_cohesion, history[k].friction;
-            y(Eigen::Index(k)) = history[k].log_strength[m];
-        }
-        a(rows - 2, 1) = prior_c, y(rows - 2) = prior_c * b0;
-        a(rows - 1, 2) = prior_phi, y(rows - 1) = prior_phi * g0;
-        const Eigen::Vector3d fit = a.colPivHouseholderQr().solve(y);
-        intercept(Eigen::Index(m)) = fit(0);
-        jacobian.row(Eigen::Index(m)) << fit(1), fit(2);
+        // Normal equations of the rows: the samples (1, dx, dφ) → ln s, then the
+        // two priors on the slopes.
+        std::array<std::array<double, 4>, 3> normal{};
+        auto add_row = [&normal](std::array<double, 3> row, double y) {
+            for (int r = 0; r < 3; ++r) {
+                for (int c = 0; c < 3; ++c) normal[r][c] += row[r] * row[c];
+                normal[r][3] += row[r] * y;
+            }
+        };
+        for (const auto& sample : history)
+            add_row({1.0, sample.log_cohesion - last.log_cohesion, sample.friction - last.friction},
+                    sample.log_strength[m]);
+        add_row({0.0, prior_c, 0.0}, prior_c * b0);
+        add_row({0.0, 0.0, prior_phi}, prior_phi * g0);
+        const auto fit = solve_small<3>(normal);
+        if (!fit) return {last.log_cohesion, last.friction};
+        predicted[m] = (*fit)[0], slope_c[m] = (*fit)[1], slope_phi[m] = (*fit)[2];
     }
     // The step from the last sample to the targets in least squares (a step, so
     // that a direction the planes cannot see stays put), the UCS row twice as heavy.
-    Eigen::VectorXd weight = Eigen::VectorXd::Ones(Eigen::Index(measures));
-    weight(0) = 2.0;
-    const Eigen::Vector2d at(last.log_cohesion, last.friction);
-    const Eigen::VectorXd predicted = intercept + jacobian * at;
-    const Eigen::MatrixXd wj = weight.asDiagonal() * jacobian;
-    const Eigen::VectorXd wr =
-        weight.asDiagonal() *
-        (Eigen::Map<const Eigen::VectorXd>(log_target.data(), Eigen::Index(measures)) - predicted);
-    const Eigen::Vector2d step = wj.colPivHouseholderQr().solve(wr);
+    std::array<std::array<double, 3>, 2> normal{};
+    for (std::size_t m = 0; m < measures; ++m) {
+        const double w2 = m == 0 ? 4.0 : 1.0, miss = log_target[m] - predicted[m];
+        normal[0][0] += w2 * slope_c[m] * slope_c[m], normal[0][1] += w2 * slope_c[m] * slope_phi[m];
+        normal[1][0] += w2 * slope_phi[m] * slope_c[m], normal[1][1] += w2 * slope_phi[m] * slope_phi[m];
+        normal[0][2] += w2 * slope_c[m] * miss, normal[1][2] += w2 * slope_phi[m] * miss;
+    }
+    const auto step = solve_small<2>(normal);
     double log_c = last.log_cohesion, friction = last.friction;
-    if (step.allFinite()) {
-        log_c += std::clamp(step(0), -0.7, 0.7);
-        friction = std::clamp(friction + std::clamp(step(1), -8.0, 8.0), 5.0, 55.0);
+    if (step) {
+        log_c += std::clamp((*step)[0], -0.7, 0.7);
+        friction = std::clamp(friction + std::clamp((*step)[1], -8.0, 8.0), 5.0, 55.0);
     }
     return {log_c, friction};
 }
