@@ -296,8 +296,15 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
                     "Hard limit for a specimen still loading at --max-strain (at most --max-strain: stop there); "
                     "reached unfailed, the peak is a lower bound (still_loading)")
         ->check(cli::non_negative())->capture_default_str();
+    sub->add_option_function<std::string>(
+           "--confined-peak", [&o](const std::string& v) { o.confined_peak_at_stall = v == "first-stall"; },
+           "Confined tests: lab = the laboratory's peak, the largest stress before a lasting drop by --failure-drop "
+           "(a specimen that only hardens loads on to --strain-cap); first-stall = the rule until 2026-11-27, the "
+           "first stall of the stress after cracking (docs/calibration.md, The confined peak)")
+        ->check(CLI::IsMember({"lab", "first-stall"}))->default_str("lab");
     sub->add_option("--post-peak-strain", o.post_peak_strain,
-                    "Confined tests: stop this much axial strain past the peak once the specimen has failed (0: go on "
+                    "Confined tests: stop this much axial strain past the failure (the peak's drop; first-stall: past "
+                    "the peak) once the specimen has failed (0: go on "
                     "to --max-strain or --stop-fraction; bbm envelope and calibrate use 2e-4)")
         ->check(cli::non_negative());
     sub->add_option_function<double>(
@@ -336,7 +343,7 @@ nlohmann::json labtest_json(const LabTestResult& r) {
             {"tensile_strength", r.tensile_strength}, {"blocks", r.blocks}, {"contacts", r.contacts},
             {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed}, {"still_loading", r.still_loading},
             {"loaded_past_max_strain", r.loaded_past_max_strain},
-            {"post_peak_locking", r.post_peak_locking}, {"preload_skipped", r.preload_skipped},
+            {"post_peak_locking", r.post_peak_locking}, {"reloads", r.reloads}, {"first_stall_stress", r.first_stall_stress}, {"preload_skipped", r.preload_skipped},
             {"joint_slip_stress", r.joint_slip_stress}, {"joint_slip_stress_half", r.joint_slip_stress_half},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
@@ -369,6 +376,8 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.post_peak_locking = j["post_peak_locking"], r.preload_skipped = j["preload_skipped"];
     r.still_loading = j.value("still_loading", false);
     r.loaded_past_max_strain = j.value("loaded_past_max_strain", false);
+    r.reloads = j.value("reloads", 0);
+    r.first_stall_stress = j.value("first_stall_stress", 0.0);
     r.joint_slip_stress = j["joint_slip_stress"], r.joint_slip_stress_half = j["joint_slip_stress_half"];
     r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
     const auto& o = j["crack_orientation"];
@@ -622,6 +631,16 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                 else if (r.loaded_past_max_strain)
                     std::fprintf(stderr, "  seed %llu: not failed at --max-strain %g: loaded on, failed at strain %.4g\n",
                                  static_cast<unsigned long long>(ok.seed), ok.max_strain, r.strain_at_peak);
+                if (ok.confinement > 0.0 && r.first_stall_stress > 0.0 && r.peak_stress > 1.2 * r.first_stall_stress)
+                    std::fprintf(stderr, "  seed %llu: yielded at %.2f MPa (the stress's first stall) and hardened to its "
+                                         "peak, %.0f%% higher: broken blocks interlocking (a residual friction below "
+                                         "the joints' lets them slide; docs/calibration.md, The confined peak)\n",
+                                 static_cast<unsigned long long>(ok.seed), r.first_stall_stress / 1e6,
+                                 100.0 * (r.peak_stress / r.first_stall_stress - 1.0));
+                if (r.reloads > 0)
+                    std::fprintf(stderr, "  seed %llu: the stress dropped by --failure-drop and climbed back above its "
+                                         "peak %d time%s (bursts of cracks): loaded on to the peak that lasted\n",
+                                 static_cast<unsigned long long>(ok.seed), r.reloads, r.reloads == 1 ? "" : "s");
                 if (r.post_peak_locking)
                     std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",

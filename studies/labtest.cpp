@@ -537,6 +537,10 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     // bound. 2% down from it the specimen has passed its peak, though the drop
     // rule wants 10%: that peak is a strength.
     auto still_at_peak = [&peak](const StressStrainPoint& p) { return p.axial_stress >= 0.98 * peak; };
+    // Confined, the laboratory's peak: only a lasting drop is failure (no stall
+    // rule), and a climb back above a dropped peak is loading on.
+    const bool lab_peak = o.confinement > 0.0 && !o.confined_peak_at_stall;
+    double strain_at_failure = 0.0;
     while (s.steps() - start < o.max_steps) {
         s.step();
         strain += rate;
@@ -586,7 +590,9 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
                 // new contacts: fragments jammed between the platens. Not under
                 // confinement: there the stall is the strength (a confined rock
                 // yields along shear bands with most bonds intact around them).
-                if (o.confinement <= 0.0 && unbonded_compression_share(s) < 0.5) {
+                if (lab_peak) {
+                    failed = false, records_above_peak = 0, ++r.reloads;
+                } else if (o.confinement <= 0.0 && unbonded_compression_share(s) < 0.5) {
                     failed = false, records_above_peak = 0;
                 } else {
                     r.post_peak_locking = true;
@@ -615,15 +621,19 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
             const auto& back = r.curve[stall_from];
             stalled = p.axial_stress <= back.axial_stress && peak_step >= back.step;
         }
-        failed = failed || (cracking && (dropped || stalled));
+        if (cracking && (dropped || stalled) && !(r.first_stall_stress > 0.0)) r.first_stall_stress = peak;
+        if (lab_peak) stalled = false; // yielding, not failure: the peak is still ahead or here
+        if (!failed && cracking && (dropped || stalled)) failed = true, strain_at_failure = p.axial_strain;
         // Past the peak once the stress is clearly down from it (after cracking: not
         // in the start-up transient of the platens).
         if (cracking && peak > 0 && p.step > peak_step && p.axial_stress < o.stop_fraction * peak) {
             r.peak_passed = true;
             break;
         }
+        // (The laboratory's peak: past the drop, which gives a burst of cracks the
+        // room to be climbed back above.)
         if (failed && o.confinement > 0.0 && o.post_peak_strain > 0.0 &&
-            p.axial_strain >= strain_at_peak + o.post_peak_strain) {
+            p.axial_strain >= (lab_peak ? strain_at_failure : strain_at_peak) + o.post_peak_strain) {
             r.peak_passed = true;
             break;
         }

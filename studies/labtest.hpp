@@ -116,6 +116,16 @@ struct LabTestOptions {
     /// above it is the locking rule's stop). The envelope and calibration set
     /// envelope_post_peak_strain.
     double post_peak_strain = 0.0;
+    /// Confined tests: how the strength is read from the curve.
+    /// false (the laboratory's peak): the largest stress before a drop by
+    /// failure_drop that lasts — a stress climbing back above a dropped peak is
+    /// loading on (LabTestResult::reloads), and a specimen that only hardens runs
+    /// to strain_cap (still_loading). true (the rule until 2026-11-27): the first
+    /// stall after cracking (no net rise over 2e-4 of strain) is failure and a
+    /// climb back above its peak stops the run — a strength the specimen may exceed
+    /// by half when loaded on (Lac du Bonnet at σ3 = 71 MPa: 518 against 1,208 MPa;
+    /// docs/calibration.md, "The confined peak").
+    bool confined_peak_at_stall = false;
     long max_steps = 2000000;
     int record_every = 20;              ///< steps between stress-strain samples
     long frame_every = 4000;            ///< steps between frames of the failure series (0: none)
@@ -192,6 +202,13 @@ struct LabTestResult {
     /// After failure the stress climbed back above the peak (a jammed rubble core):
     /// the run stopped there and peak_stress is the peak before failure.
     bool post_peak_locking = false;
+    /// Confined tests, the laboratory's peak: drops by failure_drop the stress
+    /// climbed back above (bursts of cracks the specimen outlasted; loading went on).
+    int reloads = 0;
+    /// The peak before the first stall or drop after cracking (the strength the
+    /// first-stall rule reads): with peak_stress far above it, a confined specimen
+    /// yielded there and then hardened — its broken blocks interlock.
+    double first_stall_stress = 0.0;
     /// The implicit elastic preload could not be solved (the confinement left a
     /// block held at one point, or a loose group): the loading was explicit from
     /// the start, and E comes from the explicit curve.
