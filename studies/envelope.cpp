@@ -377,11 +377,12 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
             if (!quiet) {
                 // As each run ends (a long envelope shows its progress).
                 std::lock_guard lock(print);
-                std::fprintf(stderr, "  %-9s sigma3 %6.2f MPa seed %3llu: peak %8.2f MPa  sigma_ci %7.2f  sigma_cd %7.2f  "
-                                     "%ld steps %6.1f s%s\n",
+                std::fprintf(stderr, "  %-9s sigma3 %6.2f MPa seed %3llu: peak %8.2f MPa at %5.2f%%  first stall %8.2f  "
+                                     "sigma_ci %7.2f  sigma_cd %7.2f  %ld steps %6.1f s%s\n",
                              test_name(job.kind), job.confinement / 1e6, static_cast<unsigned long long>(o.seed),
-                             result.peak_stress / 1e6, result.crack_initiation_stress / 1e6,
-                             result.crack_damage_stress / 1e6, result.steps, result.wall_seconds,
+                             result.peak_stress / 1e6, 100.0 * result.strain_at_peak, result.first_stall_stress / 1e6,
+                             result.crack_initiation_stress / 1e6, result.crack_damage_stress / 1e6, result.steps,
+                             result.wall_seconds,
                              result.still_loading       ? "  (still loading at the strain cap: a lower bound)"
                              : result.post_peak_locking ? "  (fragments jammed after failure)"
                                                         : "");
@@ -422,24 +423,27 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     std::vector<double> levels_s3{0.0};
     levels_s3.insert(levels_s3.end(), confinements.begin(), confinements.end());
     for (double level : levels_s3) {
-        std::vector<double> peak, ci, cd, ci_ratio, cd_ratio, E, nu;
+        std::vector<double> peak, ci, cd, ci_ratio, cd_ratio, E, nu, stall, strain_at_peak;
         int still_loading = 0;
         for (const auto& r : runs) {
             if ((r.test != "ucs" && r.test != "biaxial") || r.confinement != level) continue;
             const auto& x = r.result;
             peak.push_back(x.peak_stress), E.push_back(x.E), nu.push_back(x.nu);
             still_loading += x.still_loading;
+            strain_at_peak.push_back(x.strain_at_peak);
+            if (x.first_stall_stress > 0) stall.push_back(x.first_stall_stress);
             if (x.crack_initiation_stress > 0) ci.push_back(x.crack_initiation_stress), ci_ratio.push_back(x.crack_initiation_stress / x.peak_stress);
             if (x.crack_damage_stress > 0) cd.push_back(x.crack_damage_stress), cd_ratio.push_back(x.crack_damage_stress / x.peak_stress);
         }
         levels.push_back({{"sigma3", level}, {"peak", stats(peak)}, {"sigma_ci", stats(ci)}, {"sigma_cd", stats(cd)},
                           {"sigma_ci_over_peak", stats(ci_ratio)}, {"sigma_cd_over_peak", stats(cd_ratio)},
-                          {"E", stats(E)}, {"nu", stats(nu)}, {"still_loading", still_loading}});
+                          {"E", stats(E)}, {"nu", stats(nu)}, {"still_loading", still_loading},
+                          {"strain_at_peak", stats(strain_at_peak)}, {"first_stall", stats(stall)}});
     }
     nlohmann::json per_run = nlohmann::json::array();
     std::ostringstream csv;
     csv << "test,sigma3_Pa,seed,peak_Pa,sigma_ci_Pa,sigma_cd_Pa,tensile_strength_Pa,E_Pa,nu,cracks_tensile,cracks_shear,"
-           "steps,post_peak_locking,still_loading\n";
+           "steps,post_peak_locking,still_loading,strain_at_peak,first_stall_Pa,reloads\n";
     csv.precision(10);
     for (const auto& r : runs) {
         const auto& x = r.result;
@@ -448,11 +452,14 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                            {"tensile_strength", x.tensile_strength}, {"E", x.E}, {"nu", x.nu},
                            {"cracks", {{"tensile", x.cracks_tensile}, {"shear", x.cracks_shear}}},
                            {"steps", x.steps}, {"wall_seconds", x.wall_seconds},
-                           {"post_peak_locking", x.post_peak_locking}, {"still_loading", x.still_loading}});
+                           {"post_peak_locking", x.post_peak_locking}, {"still_loading", x.still_loading},
+                           {"strain_at_peak", x.strain_at_peak}, {"first_stall", x.first_stall_stress},
+                           {"reloads", x.reloads}});
         csv << r.test << ',' << r.confinement << ',' << r.seed << ',' << x.peak_stress << ','
             << x.crack_initiation_stress << ',' << x.crack_damage_stress << ',' << x.tensile_strength << ',' << x.E
             << ',' << x.nu << ',' << x.cracks_tensile << ',' << x.cracks_shear << ',' << x.steps << ','
-            << x.post_peak_locking << ',' << x.still_loading << '\n';
+            << x.post_peak_locking << ',' << x.still_loading << ',' << x.strain_at_peak << ','
+            << x.first_stall_stress << ',' << x.reloads << '\n';
     }
     const auto ucs_stats = stats(ucs), t_stats = stats(strength_t);
     const double t_over_c = ucs_stats["mean"].get<double>() > 0

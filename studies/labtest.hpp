@@ -32,7 +32,10 @@
 // compression: fragments locked between the platens (post_peak_locking). Above
 // the peak with the bonds carrying the load, the "failure" was a local burst of
 // cracks, and loading goes on (unconfined tests; docs/calibration.md, After the
-// peak); under confinement the stall is the strength.
+// peak). Confined tests read the laboratory's peak: a stall is yielding (kept as
+// first_stall_stress), only a drop is failure, and a climb back above a dropped
+// peak is loading on (confined_peak_at_stall: the former rule, the first stall
+// is the strength; docs/calibration.md, The confined peak).
 #pragma once
 
 #include "core/model_spec.hpp"
