@@ -499,6 +499,21 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                                  "of the strength, and the fits with it (blocks jammed, or raise --strain-cap)\n",
                          still_loading, still_loading == 1 ? "" : "s", std::max(c.o.max_strain, c.o.strain_cap),
                          still_loading == 1 ? "its" : "their");
+        // Interlocking: a confined peak far above its first stall (the yield).
+        int hardened = 0, confined = 0;
+        for (const auto& r : runs) {
+            if (r.test != "biaxial") continue;
+            ++confined;
+            const auto& x = r.result;
+            hardened += x.first_stall_stress > 0.0 && x.peak_stress > 1.2 * x.first_stall_stress;
+        }
+        if (hardened > 0 && !c.o.confined_peak_at_stall)
+            std::fprintf(stderr, "warning: %d of %d confined tests hardened past their first stall (the yield) by more "
+                                 "than 20%%: broken blocks interlocking, and the fits mix them with the specimens that "
+                                 "failed. A residual friction below the joints' lets broken joints slide "
+                                 "(--residual-friction); --confined-peak first-stall reads the yield "
+                                 "(docs/calibration.md, The confined peak)\n",
+                         hardened, confined);
         if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
     }
     if (study) {
