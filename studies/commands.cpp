@@ -631,7 +631,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                 else if (r.loaded_past_max_strain)
                     std::fprintf(stderr, "  seed %llu: not failed at --max-strain %g: loaded on, failed at strain %.4g\n",
                                  static_cast<unsigned long long>(ok.seed), ok.max_strain, r.strain_at_peak);
-                if (ok.confinement > 0.0 && r.first_stall_stress > 0.0 && r.peak_stress > 1.2 * r.first_stall_stress)
+                if (ok.confinement > 0.0 && r.hardened_past_yield())
                     std::fprintf(stderr, "  seed %llu: yielded at %.2f MPa (the stress's first stall) and hardened to its "
                                          "peak, %.0f%% higher: broken blocks interlocking (a residual friction below "
                                          "the joints' lets them slide; docs/calibration.md, The confined peak)\n",

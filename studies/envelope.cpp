@@ -504,8 +504,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         for (const auto& r : runs) {
             if (r.test != "biaxial") continue;
             ++confined;
-            const auto& x = r.result;
-            hardened += x.first_stall_stress > 0.0 && x.peak_stress > 1.2 * x.first_stall_stress;
+            hardened += r.result.hardened_past_yield();
         }
         if (hardened > 0 && !c.o.confined_peak_at_stall)
             std::fprintf(stderr, "warning: %d of %d confined tests hardened past their first stall (the yield) by more "

@@ -587,9 +587,10 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
                 // Who carries the load now? Bonds still intact: the "failure" was a
                 // local burst of cracks in a specimen that had not failed (small
                 // specimens, a few blocks across), and loading goes on. Broken and
-                // new contacts: fragments jammed between the platens. Not under
-                // confinement: there the stall is the strength (a confined rock
-                // yields along shear bands with most bonds intact around them).
+                // new contacts: fragments jammed between the platens. Confined,
+                // the laboratory's peak: loading goes on (a hardening specimen
+                // shows itself by its peak against first_stall_stress); the
+                // first-stall rule stops here, its peak before the drop.
                 if (lab_peak) {
                     failed = false, records_above_peak = 0, ++r.reloads;
                 } else if (o.confinement <= 0.0 && unbonded_compression_share(s) < 0.5) {

@@ -101,7 +101,8 @@ struct LabTestOptions {
     double platen_friction = -1.0;
     double stop_fraction = 0.8;         ///< stop after the peak below this fraction of it
     /// A drop by this fraction from the peak marks failure: the peak is then the
-    /// strength, and the run stops if the stress climbs back above it.
+    /// strength, and the run stops if the stress climbs back above it (confined,
+    /// the laboratory's peak: loading goes on, LabTestResult::reloads).
     double failure_drop = 0.1;
     /// The strain at which a test stops, failed or not, unless it is still
     /// loading: a specimen that has not failed by then (no drop, no stall) loads
@@ -113,11 +114,11 @@ struct LabTestOptions {
     /// peak (Lac du Bonnet at σ3 = 71 MPa: 777 / 70 000 = 1.1%); a specimen still
     /// loading at 3% is jammed, not strong (LabTestResult::still_loading).
     double strain_cap = 0.03;
-    /// Confined tests (biaxial): stop this much axial strain past the peak once the
-    /// specimen has failed (0: go on to max_strain or stop_fraction). Exact for the
-    /// peak: under confinement a failed specimen's peak is final (a climb back
-    /// above it is the locking rule's stop). The envelope and calibration set
-    /// envelope_post_peak_strain.
+    /// Confined tests (biaxial): stop this much axial strain past the failure once
+    /// the specimen has failed (0: go on to max_strain or stop_fraction): past the
+    /// drop for the laboratory's peak (a climb back above it within the window is
+    /// loading on), past the peak for the first-stall rule (whose failed peak is
+    /// final). The envelope and calibration set envelope_post_peak_strain.
     double post_peak_strain = 0.0;
     /// Confined tests: how the strength is read from the curve.
     /// false (the laboratory's peak): the largest stress before a drop by
@@ -212,6 +213,9 @@ struct LabTestResult {
     /// first-stall rule reads): with peak_stress far above it, a confined specimen
     /// yielded there and then hardened — its broken blocks interlock.
     double first_stall_stress = 0.0;
+    /// A confined specimen whose peak stands more than 20% above its first stall:
+    /// it yielded and then hardened (broken blocks interlocking).
+    bool hardened_past_yield() const { return first_stall_stress > 0.0 && peak_stress > 1.2 * first_stall_stress; }
     /// The implicit elastic preload could not be solved (the confinement left a
     /// block held at one point, or a loose group): the loading was explicit from
     /// the start, and E comes from the explicit curve.
