@@ -344,6 +344,7 @@ nlohmann::json labtest_json(const LabTestResult& r) {
             {"steps", r.steps}, {"wall_seconds", r.wall_seconds}, {"peak_passed", r.peak_passed}, {"still_loading", r.still_loading},
             {"loaded_past_max_strain", r.loaded_past_max_strain},
             {"post_peak_locking", r.post_peak_locking}, {"reloads", r.reloads}, {"first_stall_stress", r.first_stall_stress}, {"preload_skipped", r.preload_skipped},
+            {"residual_stress", r.residual_stress}, {"residual_friction_angle", r.residual_friction_angle},
             {"joint_slip_stress", r.joint_slip_stress}, {"joint_slip_stress_half", r.joint_slip_stress_half},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
@@ -378,6 +379,8 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.loaded_past_max_strain = j.value("loaded_past_max_strain", false);
     r.reloads = j.value("reloads", 0);
     r.first_stall_stress = j.value("first_stall_stress", 0.0);
+    r.residual_stress = j.value("residual_stress", 0.0);
+    r.residual_friction_angle = j.value("residual_friction_angle", 0.0);
     r.joint_slip_stress = j["joint_slip_stress"], r.joint_slip_stress_half = j["joint_slip_stress_half"];
     r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
     const auto& o = j["crack_orientation"];
@@ -641,6 +644,17 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                     std::fprintf(stderr, "  seed %llu: the stress dropped by --failure-drop and climbed back above its "
                                          "peak %d time%s (bursts of cracks): loaded on to the peak that lasted\n",
                                  static_cast<unsigned long long>(ok.seed), r.reloads, r.reloads == 1 ? "" : "s");
+                if (r.residual_stress > 0.0) {
+                    std::fprintf(stderr, "  seed %llu: residual strength %.2f MPa (the last %.1f%% of axial strain, %.2g%% "
+                                         "to %.2g%%)",
+                                 static_cast<unsigned long long>(ok.seed), r.residual_stress / 1e6,
+                                 100.0 * residual_window_strain, 100.0 * (r.curve.back().axial_strain - residual_window_strain),
+                                 100.0 * r.curve.back().axial_strain);
+                    if (r.residual_friction_angle > 0.0)
+                        std::fprintf(stderr, "; with no cohesion left it mobilises a friction of %.1f degrees",
+                                     r.residual_friction_angle);
+                    std::fprintf(stderr, "\n");
+                }
                 if (r.post_peak_locking)
                     std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
                                          "jammed between the platens): stopped there; peak is the strength before failure\n",

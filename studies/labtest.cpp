@@ -662,12 +662,28 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     r.strain_at_peak = strain_at_peak;
     if (brazilian) r.tensile_strength = peak;
     if (!brazilian) measure_rock_mechanics(r, preload_points, o.kind == LabTestOptions::Kind::tension, peak_step);
+    if (failed && o.kind != LabTestOptions::Kind::tension && !brazilian) measure_residual_strength(r, o.confinement);
     record_new_cracks();
     r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
     r.cracks_shear = s.cracks(contact::JointState::broken_shear);
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (on_finish) on_finish(s, r);
     return r;
+}
+
+void measure_residual_strength(LabTestResult& r, double confinement) {
+    if (r.curve.empty()) return;
+    const double end = r.curve.back().axial_strain;
+    if (end - r.strain_at_peak < residual_run_strain) return;
+    double sum = 0.0;
+    int n = 0;
+    for (auto p = r.curve.rbegin(); p != r.curve.rend() && p->axial_strain >= end - residual_window_strain; ++p)
+        sum += p->axial_stress, ++n;
+    r.residual_stress = sum / n;
+    // σ1 / σ3 = (1 + sin φ) / (1 − sin φ) with no cohesion.
+    if (confinement > 0.0 && r.residual_stress > confinement)
+        r.residual_friction_angle =
+            std::asin((r.residual_stress - confinement) / (r.residual_stress + confinement)) * 180.0 / std::numbers::pi;
 }
 
 } // namespace bbm

@@ -52,6 +52,10 @@ namespace bbm {
 /// calibration's biaxial tests stop: the peak is final by then, and the tail shows
 /// the drop (the stall rule looks back 2e-4 of strain).
 inline constexpr double envelope_post_peak_strain = 2e-4;
+/// The residual strength (LabTestResult::residual_stress): averaged over the last
+/// residual_window_strain of a run that went on at least residual_run_strain past
+/// its peak.
+inline constexpr double residual_window_strain = 2e-3, residual_run_strain = 5e-3;
 
 struct LabTestOptions {
     enum class Kind { ucs, tension, biaxial, brazilian };
@@ -213,6 +217,14 @@ struct LabTestResult {
     /// first-stall rule reads): with peak_stress far above it, a confined specimen
     /// yielded there and then hardened — its broken blocks interlock.
     double first_stall_stress = 0.0;
+    /// The residual strength of a post-peak curve run far enough (compression,
+    /// failed, and on at least residual_run_strain past the peak: e.g. biaxial
+    /// --stop-fraction 0 --max-strain 0.02): the mean stress over its last
+    /// residual_window_strain of axial strain; 0 when not measured. Confined, the
+    /// macro friction it mobilises with no cohesion left, asin((σr − σ3)/(σr + σ3))
+    /// in degrees — the rubble's friction, to set beside broken rock's in the
+    /// laboratory (docs/calibration.md, "The residual strength").
+    double residual_stress = 0.0, residual_friction_angle = 0.0;
     /// A confined specimen whose peak stands more than 20% above its first stall:
     /// it yielded and then hardened (broken blocks interlocking).
     bool hardened_past_yield() const { return first_stall_stress > 0.0 && peak_stress > 1.2 * first_stall_stress; }
@@ -251,6 +263,11 @@ LabTestResult run_labtest(const LabTestOptions& o,
 /// where the crack volumetric strain leaves zero for good and σcd where the
 /// volumetric strain reverses.
 void measure_rock_mechanics(LabTestResult& r, std::size_t preload_points, bool tension, long peak_step);
+
+/// The residual strength of a finished compression curve (peak_stress and
+/// strain_at_peak set): LabTestResult::residual_stress, and with a confinement its
+/// residual_friction_angle. Left 0 for a curve that ends too soon after its peak.
+void measure_residual_strength(LabTestResult& r, double confinement);
 
 /// Least-squares slope of y on x.
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y);

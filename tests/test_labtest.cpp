@@ -375,3 +375,37 @@ TEST_CASE("a biaxial test whose confinement leaves a block the implicit preload 
         CHECK(last > first + 5e6);
     }
 }
+
+TEST_CASE("the residual strength: the mean stress over the curve's last 0.2% of strain and the friction it mobilises without cohesion") {
+    // A synthetic post-peak curve: peak 100 MPa at 0.3%, a fall to 70 MPa by 1%,
+    // then 70 ± 1 MPa to 1.6%. With σ3 = 10 MPa, σ1/σ3 = 7 = (1 + sin φ)/(1 − sin φ):
+    // sin φ = 60/80, φ = 48.59°.
+    LabTestResult r;
+    r.peak_stress = 100e6, r.strain_at_peak = 3e-3;
+    for (int k = 0; k <= 160; ++k) {
+        const double strain = 1e-4 * k;
+        double stress = strain <= 3e-3 ? 100e6 * strain / 3e-3
+                        : strain <= 1e-2 ? 100e6 - 30e6 * (strain - 3e-3) / 7e-3
+                                          : 70e6 + (k % 2 ? 1e6 : -1e6);
+        r.curve.push_back({k * 100L, strain, stress, 0.0, 0, 0, 0.0, 0.0});
+    }
+    measure_residual_strength(r, 10e6);
+    // The window, 1.4–1.6% of strain: 21 points, 11 at 69 MPa and 10 at 71 MPa.
+    CHECK(r.residual_stress == doctest::Approx((11 * 69e6 + 10 * 71e6) / 21).epsilon(1e-12));
+    const double s1 = r.residual_stress;
+    CHECK(r.residual_friction_angle == doctest::Approx(std::asin((s1 - 10e6) / (s1 + 10e6)) * 180 / std::numbers::pi));
+    CHECK(r.residual_friction_angle == doctest::Approx(48.59).epsilon(2e-3));
+    // Unconfined: the stress, no angle.
+    LabTestResult u = r;
+    u.residual_stress = u.residual_friction_angle = 0.0;
+    measure_residual_strength(u, 0.0);
+    CHECK(u.residual_stress == r.residual_stress);
+    CHECK(u.residual_friction_angle == 0.0);
+    // A curve that ends 0.4% past its peak has no residual yet.
+    LabTestResult early = r;
+    early.residual_stress = early.residual_friction_angle = 0.0;
+    early.curve.resize(71); // to 0.7%
+    measure_residual_strength(early, 10e6);
+    CHECK(early.residual_stress == 0.0);
+    CHECK(early.residual_friction_angle == 0.0);
+}
