@@ -662,7 +662,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     r.strain_at_peak = strain_at_peak;
     if (brazilian) r.tensile_strength = peak;
     if (!brazilian) measure_rock_mechanics(r, preload_points, o.kind == LabTestOptions::Kind::tension, peak_step);
-    if (failed && o.kind != LabTestOptions::Kind::tension && !brazilian) measure_residual_strength(r, o.confinement);
+    if (o.kind != LabTestOptions::Kind::tension && !brazilian) measure_residual_strength(r, o.confinement);
     record_new_cracks();
     r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
     r.cracks_shear = s.cracks(contact::JointState::broken_shear);

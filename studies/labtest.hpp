@@ -218,7 +218,7 @@ struct LabTestResult {
     /// yielded there and then hardened — its broken blocks interlock.
     double first_stall_stress = 0.0;
     /// The residual strength of a post-peak curve run far enough (compression,
-    /// failed, and on at least residual_run_strain past the peak: e.g. biaxial
+    /// on at least residual_run_strain past its peak, the largest stress: e.g. biaxial
     /// --stop-fraction 0 --max-strain 0.02): the mean stress over its last
     /// residual_window_strain of axial strain; 0 when not measured. Confined, the
     /// macro friction it mobilises with no cohesion left, asin((σr − σ3)/(σr + σ3))
