@@ -300,6 +300,24 @@ std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSampl
     return {log_c, friction};
 }
 
+double stiffness_ratio_step(double ratio, double nu, double prev_ratio, double prev_nu, double target_nu) {
+    // The hexagonal lattice's ν(r) gives the first step. Blocks are not the
+    // lattice: Voronoi blocks answer a change of r with about 1.5 times its
+    // slope of ν, trigon blocks with about 1.9 times (Lac du Bonnet, 2026-11-27:
+    // r swung 0.343 → 0.382 → 0.343 → 0.382 and ν 0.275 → 0.246 → 0.274 → 0.247
+    // about the target 0.26), so from the second iteration on the measured slope
+    // of the last two iterations takes over — when it is one the lattice would
+    // recognise (ν falling as r rises) and r has moved enough to measure it. The
+    // secant's step is kept within twice the lattice's.
+    const double lattice = lattice_ratio(target_nu) - lattice_ratio(std::clamp(nu, -0.9, 0.33));
+    if (prev_ratio < 0.0 || std::abs(ratio - prev_ratio) < 1e-3 * ratio || std::abs(nu - prev_nu) < 1e-4)
+        return lattice;
+    const double slope = (nu - prev_nu) / (ratio - prev_ratio);
+    if (!(slope < 0.0)) return lattice;
+    const double limit = 2.0 * std::max(std::abs(lattice), 0.01 * ratio);
+    return std::clamp((target_nu - nu) / slope, -limit, limit);
+}
+
 std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
                                             const std::function<void(const CalibrationIteration&)>& report) {
     std::vector<CalibrationIteration> out;
@@ -314,6 +332,7 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
     // σci/UCS by the strength heterogeneity h = 1/m.
     const bool with_ci = o.fit_ci && t.ci_ratio > 0;
     double prev_h = -1.0, prev_ci = 0.0;
+    double prev_ratio = -1.0, prev_nu = 0.0; // ks/kn and ν of the previous iteration
     for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
         CalibrationIteration it = measure_macro_properties(j, o, o.base.seed, sigma3);
         it.misfit = calibration_misfit(it, t, with_ci);
@@ -328,7 +347,8 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         if (it.converged) break;
         // Each unknown corrected by the measure it mainly controls.
         const double r = j.ks / j.kn;
-        const double r_new = std::clamp(r + lattice_ratio(t.nu) - lattice_ratio(std::clamp(it.nu, -0.9, 0.33)), 0.02, 1.5);
+        const double r_new = std::clamp(r + stiffness_ratio_step(r, it.nu, prev_ratio, prev_nu, t.nu), 0.02, 1.5);
+        prev_ratio = r, prev_nu = it.nu;
         // E ∝ kn (1 + r)/(3 + r) on the lattice: scale kn for the modulus and for the
         // change of r, which moves the modulus too.
         j.kn *= (t.E / it.E) * ((1.0 + r) / (3.0 + r)) / ((1.0 + r_new) / (3.0 + r_new));

@@ -16,7 +16,8 @@
 // implicit elastic solve of each specimen, as the initial slope and lateral strain
 // of a cracking specimen are too noisy to steer kn and ks/kn by) and corrects each
 // unknown by the quantity it mainly controls:
-//   kn ← kn × E*/E,   r: shifted by the lattice value of r at ν* minus that at ν,
+//   kn ← kn × E*/E,   r: shifted by the lattice value of r at ν* minus that at ν
+//                     (from the second iteration on, by the secant of the last two),
 //   σt ← σt × T*/T,   c ← c × UCS*/UCS,
 // and, with confined targets (the record's triaxial or biaxial strengths, or
 // points of its Hoek–Brown curve), c and φ together (next_cohesion_friction):
@@ -102,6 +103,11 @@ struct StrengthSample {
 std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
                                                  const std::vector<double>& sigma3,
                                                  const std::vector<double>& log_target);
+
+/// The step of the stiffness ratio r = ks/kn toward the target ν: the hexagonal
+/// lattice's at first (prev_ratio < 0), then the secant of the last two
+/// iterations when it shows ν falling as r rises, within twice the lattice's step.
+double stiffness_ratio_step(double ratio, double nu, double prev_ratio, double prev_nu, double target_nu);
 
 /// The next heterogeneity h = 1/m of the σci/UCS calibration from the last two
 /// iterations (h_prev < 0: none before): the secant when the two show σci/UCS

@@ -142,6 +142,31 @@ TEST_CASE("calibrate: the cohesion-friction step finds a synthetic rock's c and 
     CHECK_THROWS_AS(next_cohesion_friction({}, sigma3, {0, 0, 0}), std::logic_error);
 }
 
+TEST_CASE("calibrate: the stiffness-ratio step for nu, lattice first and then the measured secant") {
+    // First iteration: the hexagonal lattice, r(nu) = (1 - 3 nu)/(1 + nu).
+    const double lattice = (1 - 3 * 0.26) / 1.26 - (1 - 3 * 0.275) / 1.275;
+    CHECK(stiffness_ratio_step(0.3435, 0.275, -1.0, 0.0, 0.26) == doctest::Approx(lattice).epsilon(1e-12));
+    // Lac du Bonnet's trigon blocks: r 0.3435 -> nu 0.275, r 0.3818 -> nu 0.246. The
+    // lattice step from the second would go back to about 0.344 (the measured swing);
+    // the secant lands where the line through the two crosses 0.26.
+    const double slope = (0.246 - 0.275) / (0.3818 - 0.3435);
+    CHECK(stiffness_ratio_step(0.3818, 0.246, 0.3435, 0.275, 0.26) ==
+          doctest::Approx((0.26 - 0.246) / slope).epsilon(1e-12));
+    CHECK(0.3818 + stiffness_ratio_step(0.3818, 0.246, 0.3435, 0.275, 0.26) == doctest::Approx(0.3633).epsilon(1e-3));
+    // Exact on a linear response nu = 0.5 - 0.7 r: one secant step reaches the target.
+    auto nu_of = [](double r) { return 0.5 - 0.7 * r; };
+    const double r1 = 0.30, r2 = 0.36, target = 0.26;
+    CHECK(nu_of(r2 + stiffness_ratio_step(r2, nu_of(r2), r1, nu_of(r1), target)) == doctest::Approx(target).epsilon(1e-12));
+    // A slope of the wrong sign (scatter), or r that did not move: the lattice step.
+    CHECK(stiffness_ratio_step(0.36, 0.27, 0.30, 0.25, 0.26) ==
+          doctest::Approx((1 - 3 * 0.26) / 1.26 - (1 - 3 * 0.27) / 1.27).epsilon(1e-12));
+    CHECK(stiffness_ratio_step(0.36, 0.27, 0.36, 0.25, 0.26) ==
+          doctest::Approx((1 - 3 * 0.26) / 1.26 - (1 - 3 * 0.27) / 1.27).epsilon(1e-12));
+    // A shallow measured slope is held to twice the lattice's step.
+    const double small = stiffness_ratio_step(0.36, 0.2695, 0.30, 0.27, 0.20);
+    CHECK(std::abs(small) == doctest::Approx(2 * std::abs((1 - 3 * 0.20) / 1.20 - (1 - 3 * 0.2695) / 1.2695)).epsilon(1e-9));
+}
+
 TEST_CASE("calibrate: the heterogeneity step for sigma_ci/UCS") {
     // No slope known yet: 0.2 toward the target (more heterogeneity lowers sigma_ci/UCS).
     CHECK(next_heterogeneity(-1.0, 0.0, 0.0, 0.42, 0.30) == doctest::Approx(0.2));
