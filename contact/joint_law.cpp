@@ -28,6 +28,13 @@ void unbonded_update(JointHistory& h, double kn, double ks, double tan_phi, doub
 }
 } // namespace
 
+BondFriction::BondFriction(const JointPropertySpec& p) : tan_phi(tan_deg(p.friction)) {
+    if (p.law == JointPropertySpec::Law::softening && p.confined_friction >= 0.0) {
+        from = p.confined_friction_from;
+        extra_tan = tan_deg(p.confined_friction) - tan_phi;
+    }
+}
+
 SofteningCurve::SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0) {
     for (const auto& [alpha, beta] : points) {
         up_.push_back((alpha - beta) * u0);
@@ -72,7 +79,9 @@ double SofteningCurve::plastic_increment(double excess, double k, double peak, d
 
 CoulombLaw::CoulombLaw(const JointPropertySpec& p)
     : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
-      cohesion(p.cohesion), tensile(p.tensile) {}
+      cohesion(p.cohesion), tensile(p.tensile) {
+    friction.tan_phi = tan_phi;
+}
 
 void CoulombLaw::update_inelastic(JointHistory& h, double dus) const {
     if (h.bonded) {
@@ -81,7 +90,7 @@ void CoulombLaw::update_inelastic(JointHistory& h, double dus) const {
         if (-h.sn > tensile) {
             h.bonded = false;
             h.broken = JointState::broken_tension;
-        } else if (std::abs(h.tau) > cohesion + std::max(h.sn, 0.0) * tan_phi) {
+        } else if (std::abs(h.tau) > cohesion + friction(h.sn)) {
             h.bonded = false;
             h.broken = JointState::broken_shear;
         } else {
@@ -96,7 +105,7 @@ void CoulombLaw::update_inelastic(JointHistory& h, double dus) const {
 
 SofteningLaw::SofteningLaw(const JointPropertySpec& p)
     : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
-      cohesion(p.cohesion), tensile(p.tensile), tension(p.tension_softening, p.tensile / p.kn),
+      cohesion(p.cohesion), tensile(p.tensile), friction(p), tension(p.tension_softening, p.tensile / p.kn),
       shear(p.shear_softening, p.cohesion / p.ks) {}
 
 void SofteningLaw::update_inelastic(JointHistory& h, double dus) const {
@@ -118,13 +127,14 @@ void SofteningLaw::update_inelastic(JointHistory& h, double dus) const {
         h.sn = -t_after;
         sn_strength = tension(h.upn);
     }
-    // Coulomb cap with softened cohesion: |τ| <= c·min(Sn, Ss) + max(σn, 0) tan φ.
-    const double friction = std::max(h.sn, 0.0) * tan_phi;
-    const double cap_s = cohesion * std::min(sn_strength, ss_strength) + friction;
+    // Coulomb cap with softened cohesion: |τ| <= c·min(Sn, Ss) + max(σn, 0) tan φ
+    // (steepening above σ* with a confined friction).
+    const double friction_part = friction(h.sn);
+    const double cap_s = cohesion * std::min(sn_strength, ss_strength) + friction_part;
     const double a = std::abs(h.tau);
     h.slipping = a > cap_s;
     if (h.slipping) {
-        const double d = shear.plastic_increment(a, ks, cohesion, h.ups, sn_strength, friction);
+        const double d = shear.plastic_increment(a, ks, cohesion, h.ups, sn_strength, friction_part);
         const double a_after = a - ks * d;
         h.dissipated += 0.5 * (cap_s + a_after) * d;
         h.ups += d;
@@ -167,14 +177,15 @@ bool starts_bonded(const JointLaw& law) {
 }
 
 double elastic_limit(const JointLaw& law, const JointHistory& before, const JointHistory& trial, double cap) {
-    double tensile = INFINITY, cohesion = INFINITY, tan_phi = 0.0;
-    if (const auto* c = std::get_if<CoulombLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, tan_phi = c->tan_phi;
-    if (const auto* c = std::get_if<SofteningLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, tan_phi = c->tan_phi;
+    double tensile = INFINITY, cohesion = INFINITY;
+    BondFriction friction;
+    if (const auto* c = std::get_if<CoulombLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, friction = c->friction;
+    if (const auto* c = std::get_if<SofteningLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, friction = c->friction;
     if (!std::isfinite(tensile) || !before.bonded) return cap;
     auto within = [&](double lambda) {
         const double sn = before.sn + lambda * (trial.sn - before.sn);
         const double tau = before.tau + lambda * (trial.tau - before.tau);
-        return -sn <= tensile && std::abs(tau) <= cohesion + std::max(sn, 0.0) * tan_phi;
+        return -sn <= tensile && std::abs(tau) <= cohesion + friction(sn);
     };
     if (within(cap)) return cap;
     if (!within(0.0)) return 0.0;

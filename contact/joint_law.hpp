@@ -16,6 +16,8 @@
 //   tension cut-off −σn ≤ σt(1−D) and Coulomb cap |τ| ≤ c(1−D) + max(σn, 0) tan φ are
 //   enforced by an exact return on the piecewise-linear curves (so monotonic
 //   loading passes through the curve points whatever the step size).
+//   With `confined_friction` φ2 from σ* (joint_property.hpp) the bonded friction
+//   term is σn tan φ up to σ* and σ* tan φ + (σn − σ*) tan φ2 beyond it.
 //   At D = 1 the bond is broken: a crack, tensile if the tensile curve drove D to
 //   1, shear otherwise; from then on Coulomb friction with φr and no tension, the
 //   crack faces meeting again at their original position (upn reset to 0).
@@ -76,13 +78,25 @@ private:
     std::vector<double> s_{1.0};  ///< normalised strength at them
 };
 
+/// The frictional part of a bonded joint's Coulomb cap at normal stress σn
+/// (compression positive): σn tan φ, steepening to tan φ2 above σ* when the set
+/// has a confined friction. Without one σ* is +∞ and the second term 0.
+struct BondFriction {
+    double tan_phi = 0.0;
+    double from = INFINITY;  ///< σ*
+    double extra_tan = 0.0;  ///< tan φ2 − tan φ
+    BondFriction() = default;
+    explicit BondFriction(const JointPropertySpec& p);
+    double operator()(double sn) const { return std::max(sn, 0.0) * tan_phi + std::max(sn - from, 0.0) * extra_tan; }
+};
+
 /// The elastic step of an intact bond below both peaks, shared by the bonded laws:
 /// true (and the stresses committed) if neither the tension cut-off nor the
 /// Coulomb cap is reached; un, us already incremented.
 inline bool intact_elastic_update(JointHistory& h, double kn, double ks, double tensile, double cohesion,
-                                  double tan_phi, double dus) {
+                                  const BondFriction& friction, double dus) {
     const double sn = -kn * h.un, tau = h.tau + ks * dus;
-    if (-sn > tensile || std::abs(tau) > cohesion + std::max(sn, 0.0) * tan_phi) return false;
+    if (-sn > tensile || std::abs(tau) > cohesion + friction(sn)) return false;
     h.sn = sn, h.tau = tau, h.slipping = false;
     return true;
 }
@@ -104,11 +118,12 @@ struct ElasticLaw {
 /// vanish at the first failure).
 struct CoulombLaw {
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
+    BondFriction friction; ///< plain tan φ: the confined friction is the softening law's
     explicit CoulombLaw(const JointPropertySpec& p);
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
-        if (h.bonded && intact_elastic_update(h, kn, ks, tensile, cohesion, tan_phi, dus)) return;
+        if (h.bonded && intact_elastic_update(h, kn, ks, tensile, cohesion, friction, dus)) return;
         update_inelastic(h, dus);
     }
     /// Bond failure or frictional contact; un, us already incremented.
@@ -117,13 +132,14 @@ struct CoulombLaw {
 
 struct SofteningLaw {
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
+    BondFriction friction; ///< the bonded cap's frictional term, confined friction included
     SofteningCurve tension, shear;
     explicit SofteningLaw(const JointPropertySpec& p);
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
         if (h.bonded && h.upn == 0.0 && h.ups == 0.0 && // never softened
-            intact_elastic_update(h, kn, ks, tensile, cohesion, tan_phi, dus))
+            intact_elastic_update(h, kn, ks, tensile, cohesion, friction, dus))
             return;
         update_inelastic(h, dus);
     }

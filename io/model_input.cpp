@@ -531,8 +531,22 @@ void read_heterogeneity(const Ctx& c, const toml::table& t, const Path& p, Joint
         integer(c, t, p, "strength_seed", 0, std::numeric_limits<std::int64_t>::max()).value_or(1));
 }
 
+/// confined_friction and confined_friction_from: the bonds' friction steepening
+/// under high normal stress; the two go together.
+void read_confined_friction(const Ctx& c, const toml::table& t, const Path& p, JointPropertySpec& j) {
+    const auto phi2 = number(c, t, p, "confined_friction", below(0, 90, degrees));
+    const auto from = number(c, t, p, "confined_friction_from", above(0, pascals));
+    if (phi2.has_value() != from.has_value()) {
+        const char* given = phi2 ? "confined_friction" : "confined_friction_from";
+        c.fail(*t.get(given), p.key(given),
+               "confined_friction (the steeper friction angle, degrees) and confined_friction_from (the normal "
+               "stress it starts at, Pa) go together");
+    }
+    if (phi2) j.confined_friction = *phi2, j.confined_friction_from = *from;
+}
+
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 14> all_keys{"name",
+    static constexpr std::array<std::string_view, 16> all_keys{"name",
                                                                "law",
                                                                "kn",
                                                                "ks",
@@ -545,7 +559,9 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
                                                                "strength_classes",
                                                                "strength_seed",
                                                                "tension_softening",
-                                                               "shear_softening"};
+                                                               "shear_softening",
+                                                               "confined_friction",
+                                                               "confined_friction_from"};
     check_keys(c, t, p, all_keys);
     JointPropertySpec j;
     using Law = JointPropertySpec::Law;
@@ -570,6 +586,7 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
         j.tensile = peak(c, t, p, "tensile", "tension softening");
         j.tension_softening = read_curve(c, t, p, "tension_softening");
         j.shear_softening = read_curve(c, t, p, "shear_softening");
+        read_confined_friction(c, t, p, j);
     }
     read_heterogeneity(c, t, p, j);
     return j;

@@ -300,6 +300,15 @@ std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSampl
     return {log_c, friction};
 }
 
+double next_confined_friction(double friction, double phi2_prev, double misfit_prev, double phi2, double misfit) {
+    double slope = 0.05; // per degree, Lac du Bonnet's in-situ set (calibrate.hpp)
+    if (phi2_prev >= 0.0 && std::abs(phi2 - phi2_prev) > 1e-6) {
+        const double measured = (misfit - misfit_prev) / (phi2 - phi2_prev);
+        if (measured > 0.005) slope = measured;
+    }
+    return std::clamp(phi2 + std::clamp(-misfit / slope, -10.0, 10.0), friction, 75.0);
+}
+
 double stiffness_ratio_step(double ratio, double nu, double prev_ratio, double prev_nu, double target_nu) {
     // The hexagonal lattice's ν(r) gives the first step. Blocks are not the
     // lattice: Voronoi blocks answer a change of r with about 1.5 times its
@@ -322,6 +331,14 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
                                             const std::function<void(const CalibrationIteration&)>& report) {
     std::vector<CalibrationIteration> out;
     JointPropertySpec j = calibration_start(t, o);
+    double prev_phi2 = -1.0, prev_misfit = 0.0; // φ2 and its misfit at the previous iteration
+    if (o.fit_confined_friction) {
+        if (t.envelope.empty()) throw std::invalid_argument("a confined-friction calibration needs a confined target");
+        // Unless given: steepening from the normal stress of the UCS target (an
+        // unconfined test at its strength hardly reaches it), at 55° to start.
+        if (j.confined_friction < 0.0) j.confined_friction = std::max(55.0, j.friction);
+        if (!(j.confined_friction_from > 0.0)) j.confined_friction_from = t.ucs;
+    }
     const bool with_phi = !t.envelope.empty();
     std::vector<double> sigma3, sigma1_target;
     for (const auto& [s3, s1] : t.envelope) sigma3.push_back(s3), sigma1_target.push_back(s1);
@@ -354,7 +371,16 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         j.kn *= (t.E / it.E) * ((1.0 + r) / (3.0 + r)) / ((1.0 + r_new) / (3.0 + r_new));
         j.ks = r_new * j.kn;
         j.tensile *= t.tensile / it.tensile;
-        if (with_phi) {
+        if (o.fit_confined_friction) {
+            // φ and σ* held: the cohesion for the UCS, φ2 for the confined strengths.
+            j.cohesion *= t.ucs / it.ucs;
+            double misfit = 0.0;
+            for (std::size_t c = 0; c < sigma3.size(); ++c) misfit += std::log(it.confined[c] / sigma1_target[c]);
+            misfit /= double(sigma3.size());
+            const double phi2 = j.confined_friction;
+            j.confined_friction = next_confined_friction(j.friction, prev_phi2, prev_misfit, phi2, misfit);
+            prev_phi2 = phi2, prev_misfit = misfit;
+        } else if (with_phi) {
             const double loss = ucs_loss(heterogeneity_of(j));
             StrengthSample sample{std::log(j.cohesion * loss), j.friction, {std::log(it.ucs)}};
             for (double s1 : it.confined) sample.log_strength.push_back(std::log(s1));

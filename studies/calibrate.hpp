@@ -77,6 +77,11 @@ struct CalibrationOptions {
     /// heterogeneity, within tolerance_ci (absolute, on the ratio).
     bool fit_ci = false;
     double tolerance_ci = 0.05;
+    /// Calibrate the bonds' confined friction φ2 (JointPropertySpec::
+    /// confined_friction) on the confined targets, from a σ* held (the set's
+    /// confined_friction_from; none: the UCS target), the friction φ held and the
+    /// cohesion steered by the UCS alone.
+    bool fit_confined_friction = false;
 };
 
 /// One iteration's strengths against the bonds' cohesion and friction.
@@ -103,6 +108,15 @@ struct StrengthSample {
 std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
                                                  const std::vector<double>& sigma3,
                                                  const std::vector<double>& log_target);
+
+/// The next confined friction φ2 (degrees) of a confined-friction calibration,
+/// σ* held: from the signed misfit m = mean over the confined targets of
+/// ln(σ1 / target), measured at φ2 (and at φ2_prev before it; φ2_prev < 0: none).
+/// The secant of the last two iterations when it shows σ1 rising with φ2, else
+/// the slope measured on Lac du Bonnet's in-situ set (d m/dφ2 = 0.05 per degree:
+/// σ1 427 → 704 MPa at σ3 = 35.5 MPa for φ2 55° → 65°, σ* 74.6 MPa); steps
+/// within ±10°, φ2 within [φ, 75°].
+double next_confined_friction(double friction, double phi2_prev, double misfit_prev, double phi2, double misfit);
 
 /// The step of the stiffness ratio r = ks/kn toward the target ν: the hexagonal
 /// lattice's at first (prev_ratio < 0), then the secant of the last two

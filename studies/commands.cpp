@@ -234,6 +234,13 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
     sub->add_option("--residual-friction", o.joint.residual_friction, "Friction after failure (degrees; default: --friction)")
         ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--confined-friction", o.joint.confined_friction,
+                    "Bonds whose friction steepens under high normal stress: this friction angle (degrees) above "
+                    "--confined-friction-from (docs/input.md, confined_friction)")
+        ->check(cli::in_range(0.0, 89.9));
+    sub->add_option("--confined-friction-from", o.joint.confined_friction_from,
+                    "The joint normal stress (Pa) above which --confined-friction acts")
+        ->check(cli::positive());
     sub->add_option("--weibull-m", o.joint.weibull_modulus,
                     "Heterogeneous bonds: tensile strength and cohesion of each joint times a Weibull factor of "
                     "this modulus and mean 1 (small: heterogeneous; 0: every joint the same)")
@@ -476,6 +483,9 @@ void apply_softening_flags(LabTestCli& c) {
     };
     if (!c.tension_softening.empty()) c.o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
     if (!c.shear_softening.empty()) c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
+    if ((c.o.joint.confined_friction >= 0.0) != (c.o.joint.confined_friction_from > 0.0))
+        throw InputError(c.o.joint.confined_friction >= 0.0 ? "--confined-friction" : "--confined-friction-from", 0, "",
+                         "--confined-friction (degrees) and --confined-friction-from (Pa) go together");
 }
 
 std::string fmt_number(double v) {
@@ -764,6 +774,10 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     o.max_iterations = iterations;
     o.fit_ci = values.fit_ci;
+    o.fit_confined_friction = values.fit_confined_friction;
+    if (o.fit_confined_friction && targets.envelope.empty())
+        throw InputError("--fit-confined-friction", 0, "",
+                         "needs a confined target (--target-biaxial, --target-record or --target-mi) for phi2");
     if (o.fit_ci && !(targets.ci_ratio > 0))
         throw InputError("--fit-ci", 0, "", "needs the record's sigma_ci / UCS (--target-ci-ratio)");
     check_specimen_size(c);
@@ -786,7 +800,10 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
         if (with_phi) {
             std::fprintf(stderr, "and the confined strengths sigma1 at sigma3 (MPa):");
             for (const auto& [s3, s1] : targets.envelope) std::fprintf(stderr, " %.4g at %.4g,", s1 / 1e6, s3 / 1e6);
-            std::fprintf(stderr, " the friction angle calibrated too (phi and the sigma1 at the end of each row)\n");
+            std::fprintf(stderr, o.fit_confined_friction
+                                     ? " the confined friction phi2 calibrated (phi and sigma* held; sigma*, phi2 and the "
+                                       "sigma1 at the end of each row)\n"
+                                     : " the friction angle calibrated too (phi and the sigma1 at the end of each row)\n");
         }
         if (targets.ci_ratio > 0 && o.fit_ci)
             std::fprintf(stderr, "and sigma_ci/UCS %.3g (within %.2g), by the bonds' strength heterogeneity (Weibull "
@@ -813,6 +830,9 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
             std::fprintf(stderr, " ci/UCS %.2f", it.ci_ratio);
             if (o.fit_ci) std::fprintf(stderr, " (m %s)", it.joint.weibull_modulus > 0 ? fmt_number(it.joint.weibull_modulus).c_str() : "uniform");
             if (with_phi) {
+                if (o.fit_confined_friction)
+                    std::fprintf(stderr, "   sigma* %.4g MPa phi2 %5.2f", it.joint.confined_friction_from / 1e6,
+                                 it.joint.confined_friction);
                 std::fprintf(stderr, "   phi %5.2f  sigma1", it.joint.friction);
                 for (double s1 : it.confined) std::fprintf(stderr, " %7.2f", s1 / 1e6);
             }
@@ -827,6 +847,8 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                          {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
                          {"nu_std", it.nu_std}, {"ucs", it.ucs}, {"ucs_std", it.ucs_std}, {"tensile_strength", it.tensile},
                          {"tensile_strength_std", it.tensile_std}, {"friction", it.joint.friction},
+                         {"confined_friction", it.joint.confined_friction},
+                         {"confined_friction_from", it.joint.confined_friction_from},
                          {"confined_strength", confined_json(it.confined)},
                          {"confined_strength_std", confined_json(it.confined_std)}, {"ci_ratio", it.ci_ratio},
                          {"ci_ratio_std", it.ci_ratio_std}, {"weibull_modulus", it.joint.weibull_modulus},
@@ -883,6 +905,9 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
             "\nks = " + exact_number(j.ks) + "\ntensile = " + exact_number(j.tensile) + "\ncohesion = " +
             exact_number(j.cohesion) + "\nfriction = " + exact_number(j.friction) +
             (j.residual_friction >= 0.0 ? "\nresidual_friction = " + exact_number(j.residual_friction) : std::string()) +
+            (j.confined_friction >= 0.0 ? "\nconfined_friction = " + exact_number(j.confined_friction) +
+                                              "\nconfined_friction_from = " + exact_number(j.confined_friction_from)
+                                        : std::string()) +
             "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
     // The set's heterogeneity is part of it: without these lines the file would
     // describe a uniform rock the calibration never measured.
@@ -891,7 +916,8 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
                 "\nstrength_classes = " + std::to_string(j.strength_classes) + "\n";
     const nlohmann::json calibration{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
                                                           {"tensile", targets.tensile}, {"envelope", targets.envelope},
-                                                          {"ci_ratio", targets.ci_ratio}, {"fit_ci", o.fit_ci}}},
+                                                          {"ci_ratio", targets.ci_ratio}, {"fit_ci", o.fit_ci},
+                                                          {"fit_confined_friction", o.fit_confined_friction}}},
                                              {"pattern", c.pattern},
                                              {"size", o.base.size},
                                              {"size_measure", c.size_measure},
@@ -958,6 +984,10 @@ void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
     cmd->add_flag("--fit-ci", v.fit_ci,
                   "Calibrate sigma_ci/UCS (--target-ci-ratio) too, within 0.05, by the heterogeneity of the bond "
                   "strengths (their Weibull modulus m; --weibull-m is the start)");
+    cmd->add_flag("--fit-confined-friction", v.fit_confined_friction,
+                  "Calibrate the bonds' confined friction phi2 (docs/input.md, confined_friction) on the confined "
+                  "targets, the friction and sigma* held (--confined-friction-from; default --target-ucs) and the "
+                  "cohesion steered by the UCS alone (--confined-friction is the start; default 55)");
     cmd->add_option("--iterations", v.iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
 }
 

@@ -93,6 +93,7 @@ struct CalibrateCli {
     std::vector<double> mi_confinements;     ///< σ3 of the Hoek–Brown points, Pa (default UCS/6, UCS/3)
     int iterations = 6;
     bool fit_ci = false; ///< calibrate σci/UCS too (--fit-ci: by the bonds' strength heterogeneity)
+    bool fit_confined_friction = false; ///< --fit-confined-friction: σ*, φ2 on the confined targets
     /// Joint values given (they are the starting point rather than estimates).
     bool given_kn = false, given_ks = false, given_tensile = false, given_cohesion = false;
     CalibrateCli() { lab.realizations = 3; }

@@ -62,6 +62,7 @@ TEST_CASE("calibrate: the confined targets are checked before any run") {
     refused({"--target-mi", "10", "--target-biaxial", "40e6", "--target-confinement", "5e6"}, "one confined target");
     refused({"--target-mi-confinements", "5e6"}, "goes with --target-mi");
     refused({"--target-biaxial", "40e6"}, "go together");
+    refused({"--fit-confined-friction"}, "needs a confined target");
     std::filesystem::remove_all(dir);
 }
 
@@ -140,6 +141,20 @@ TEST_CASE("calibrate: the cohesion-friction step finds a synthetic rock's c and 
         CHECK(std::exp(log_c) == doctest::Approx(50e6).epsilon(0.03));
     }
     CHECK_THROWS_AS(next_cohesion_friction({}, sigma3, {0, 0, 0}), std::logic_error);
+}
+
+TEST_CASE("calibrate: the confined-friction step for phi2") {
+    // First step: the prior slope, 0.05 per degree; σ1 too low by e^−0.2 → +4°.
+    CHECK(next_confined_friction(5.0, -1.0, 0.0, 55.0, -0.2) == doctest::Approx(59.0));
+    // Then the secant: a synthetic rock with m = 0.02 (φ2 − 61) lands on 61°.
+    const double m1 = 0.02 * (55.0 - 61.0), m2 = 0.02 * (59.0 - 61.0);
+    CHECK(next_confined_friction(5.0, 55.0, m1, 59.0, m2) == doctest::Approx(61.0));
+    // A secant that shows σ1 falling with φ2 (noise) is not followed: the prior.
+    CHECK(next_confined_friction(5.0, 55.0, 0.1, 59.0, -0.1) == doctest::Approx(61.0));
+    // Steps within ±10°, φ2 within [φ, 75°].
+    CHECK(next_confined_friction(5.0, -1.0, 0.0, 50.0, -2.0) == doctest::Approx(60.0));
+    CHECK(next_confined_friction(5.0, -1.0, 0.0, 70.0, -0.4) == doctest::Approx(75.0));
+    CHECK(next_confined_friction(30.0, -1.0, 0.0, 35.0, 0.5) == doctest::Approx(30.0));
 }
 
 TEST_CASE("calibrate: the stiffness-ratio step for nu, lattice first and then the measured secant") {

@@ -891,6 +891,21 @@ TEST_CASE("joint property mistakes") {
                 "kn", "joint_property[0].kn", "must be > 0 Pa/m, got -1");
     check_error(with(std::string(bond) + "friction = 90\n"), "friction",
                 "joint_property[0].friction", "must be in [0, 90) degrees, got 90");
+    // The confined friction: both keys or neither, a stress > 0, softening law only.
+    {
+        const auto read = parse_model(with(std::string(bond) + "confined_friction = 45\nconfined_friction_from = 60e6\n"),
+                                      "t.toml");
+        CHECK(read.analysis.joint_properties[0].confined_friction == 45.0);
+        CHECK(read.analysis.joint_properties[0].confined_friction_from == 60e6);
+    }
+    check_error(with(std::string(bond) + "confined_friction = 45 # alone\n"), "# alone",
+                "joint_property[0].confined_friction", "go together");
+    check_error(with(std::string(bond) + "confined_friction = 45\nconfined_friction_from = 0 # zero\n"), "# zero",
+                "joint_property[0].confined_friction_from", "must be > 0 Pa, got 0");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"coulomb\"\nkn = 1\nks = 1\n"
+                     "confined_friction = 45\n"),
+                "confined_friction", "joint_property[0].confined_friction",
+                "key 'confined_friction' does not apply to a coulomb joint property");
     // A softening law needs both peaks; a curve only belongs to a softening law.
     std::string no_peak = with(bond);
     no_peak.replace(no_peak.find("tensile = 5e5"), 13, "tensile = 0  ");

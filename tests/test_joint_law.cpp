@@ -98,6 +98,59 @@ TEST_CASE("softening law, shear at sigma_n = 5 MPa: peak c + sn tan phi, residua
     CHECK(h.broken == JointState::broken_shear);
 }
 
+TEST_CASE("softening law with a confined friction: the bonded cap steepens above sigma_star and broken joints keep phi_r") {
+    auto p = paper_bond();
+    p.friction = 5.0, p.residual_friction = 35.0;
+    p.confined_friction = 45.0, p.confined_friction_from = 60e6;
+    const SofteningLaw law(p);
+    const double c = p.cohesion, sigma_star = 60e6;
+    // The peak shear stress at a held normal stress, sampled finely enough to
+    // read it within one increment.
+    auto shear_peak = [&](double sn, JointHistory* end) {
+        JointHistory h;
+        law.update(h, -sn / p.kn, 0.0);
+        const double du = (c + sn) / p.ks / 2000;
+        double peak = 0;
+        for (int k = 0; k < 20000 && h.bonded; ++k) {
+            law.update(h, 0.0, du);
+            peak = std::max(peak, h.tau);
+        }
+        for (int k = 0; k < 200; ++k) law.update(h, 0.0, du); // on, broken
+        if (end) *end = h;
+        return std::pair{peak, p.ks * du};
+    };
+    // Below σ*: c + σn tan φ, as without the key.
+    {
+        const auto [peak, step] = shear_peak(40e6, nullptr);
+        const double strength = c + 40e6 * tan_deg(5);
+        CHECK(peak <= strength * (1 + 1e-12));
+        CHECK(peak >= strength - step);
+    }
+    // Above σ*: c + σ* tan φ + (σn − σ*) tan φ2 (the cap continuous at σ*).
+    JointHistory broken;
+    {
+        const double sn = 150e6;
+        const auto [peak, step] = shear_peak(sn, &broken);
+        const double strength = c + sigma_star * tan_deg(5) + (sn - sigma_star) * tan_deg(45);
+        CHECK(strength == doctest::Approx(c + 95.25e6).epsilon(1e-3));
+        CHECK(peak <= strength * (1 + 1e-12));
+        CHECK(peak >= strength - step);
+    }
+    // Broken: friction φr at any normal stress, the confined friction gone.
+    CHECK(broken.broken == JointState::broken_shear);
+    CHECK(broken.tau == doctest::Approx(150e6 * tan_deg(35)).epsilon(1e-9));
+    // The elastic limit the lab tests preload by sees the same cap.
+    JointHistory before, trial;
+    before.sn = trial.sn = 100e6;
+    trial.tau = 2 * (c + sigma_star * tan_deg(5) + 40e6 * tan_deg(45));
+    CHECK(elastic_limit(JointLaw(law), before, trial, 1.0) == doctest::Approx(0.5).epsilon(1e-9));
+    // A Coulomb law ignores it: the key is the softening law's.
+    auto q = p;
+    q.law = JointPropertySpec::Law::coulomb;
+    const CoulombLaw coulomb(q);
+    CHECK(coulomb.friction(150e6) == doctest::Approx(150e6 * tan_deg(5)));
+}
+
 TEST_CASE("softening law: unloading is elastic with the initial stiffness, damage persists") {
     const auto p = paper_bond();
     const SofteningLaw law(p);
