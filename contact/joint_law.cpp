@@ -28,10 +28,11 @@ void unbonded_update(JointHistory& h, double kn, double ks, double tan_phi, doub
 }
 } // namespace
 
-BondFriction::BondFriction(const JointPropertySpec& p) : tan_phi(tan_deg(p.friction)) {
+BondFriction::BondFriction(const JointPropertySpec& p) : tan_phi(tan_deg(p.friction)), tan_lower(tan_phi) {
     if (p.law == JointPropertySpec::Law::softening && p.confined_friction >= 0.0) {
         from = p.confined_friction_from;
         extra_tan = tan_deg(p.confined_friction) - tan_phi;
+        tan_lower = std::min(tan_phi, tan_deg(p.confined_friction));
     }
 }
 
@@ -80,7 +81,7 @@ double SofteningCurve::plastic_increment(double excess, double k, double peak, d
 CoulombLaw::CoulombLaw(const JointPropertySpec& p)
     : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
       cohesion(p.cohesion), tensile(p.tensile) {
-    friction.tan_phi = tan_phi;
+    friction.tan_phi = friction.tan_lower = tan_phi;
 }
 
 void CoulombLaw::update_inelastic(JointHistory& h, double dus) const {

@@ -85,6 +85,9 @@ struct BondFriction {
     double tan_phi = 0.0;
     double from = INFINITY;  ///< σ*
     double extra_tan = 0.0;  ///< tan φ2 − tan φ
+    /// min(tan φ, tan φ2): max(σn, 0) times it is a lower bound of the term, the
+    /// elastic path's first test (one multiply, as without a confined friction).
+    double tan_lower = 0.0;
     BondFriction() = default;
     explicit BondFriction(const JointPropertySpec& p);
     double operator()(double sn) const { return std::max(sn, 0.0) * tan_phi + std::max(sn - from, 0.0) * extra_tan; }
@@ -96,7 +99,9 @@ struct BondFriction {
 inline bool intact_elastic_update(JointHistory& h, double kn, double ks, double tensile, double cohesion,
                                   const BondFriction& friction, double dus) {
     const double sn = -kn * h.un, tau = h.tau + ks * dus;
-    if (-sn > tensile || std::abs(tau) > cohesion + friction(sn)) return false;
+    if (-sn > tensile) return false;
+    const double a = std::abs(tau);
+    if (a > cohesion + std::max(sn, 0.0) * friction.tan_lower && a > cohesion + friction(sn)) return false;
     h.sn = sn, h.tau = tau, h.slipping = false;
     return true;
 }

@@ -144,6 +144,24 @@ TEST_CASE("softening law with a confined friction: the bonded cap steepens above
     before.sn = trial.sn = 100e6;
     trial.tau = 2 * (c + sigma_star * tan_deg(5) + 40e6 * tan_deg(45));
     CHECK(elastic_limit(JointLaw(law), before, trial, 1.0) == doctest::Approx(0.5).epsilon(1e-9));
+    // A friction that flattens instead (φ2 < φ) is read the same way: the peak at
+    // σn = 150 MPa is c + σ* tan 30° + (σn − σ*) tan 10°, not the lower bound
+    // σn tan 10° that the elastic path tests first.
+    {
+        auto f = p;
+        f.friction = 30.0, f.confined_friction = 10.0, f.confined_friction_from = 60e6;
+        const SofteningLaw flat(f);
+        JointHistory h;
+        flat.update(h, -150e6 / f.kn, 0.0);
+        const double strength = c + 60e6 * tan_deg(30) + 90e6 * tan_deg(10), du = strength / f.ks / 2000;
+        double peak = 0;
+        for (int k = 0; k < 4000 && h.bonded; ++k) {
+            flat.update(h, 0.0, du);
+            peak = std::max(peak, h.tau);
+        }
+        CHECK(peak <= strength * (1 + 1e-12));
+        CHECK(peak >= strength - f.ks * du);
+    }
     // A Coulomb law ignores it: the key is the softening law's.
     auto q = p;
     q.law = JointPropertySpec::Law::coulomb;
