@@ -4,12 +4,14 @@
 //   1. each region's domain = outline − holes − subtracted regions (CGAL Boolean
 //      operations, exact kernel), checked for self-intersection, holes outside the
 //      outline and overlap with other regions;
-//   2. the region is cut by its real discontinuities (explicit segments and joint
-//      sets) with a CGAL arrangement; every face of it is a "rock block";
+//   2. the region is cut by its real discontinuities (explicit segments, joint
+//      sets, fracture networks) in one exact computation (cutting.hpp): a CGAL
+//      arrangement on the exact kernel whose faces are the "rock blocks";
 //   3. the inner pattern is generated inside each rock block, so no inner block
-//      crosses a real joint; real joints that end inside a rock block (finite
-//      traces) split the inner blocks they cross along their line, the part beyond
-//      the trace tip being an ordinary inner joint (a rock bridge that can break);
+//      crosses a real joint, and its cells are cut to the rock block exactly; a
+//      real joint that ends inside an inner block (a finite trace) goes on along
+//      its line to that block's edge, the part beyond its tip an ordinary inner
+//      joint (a rock bridge that can break);
 //   4. short edges are collapsed (shared vertices move together, so the blocks
 //      still tile the region exactly);
 //   5. deformable blocks (regions with a mesh, SPEC §6): each block's edges are
@@ -117,12 +119,16 @@ struct GenerationStats {
     /// Edges still shorter than their region's minimum (e.g. a short edge of the
     /// outline itself); reported, never hidden.
     int short_edges_left = 0;
-    /// Blocks a trace ending inside them should have split along its line but that
-    /// were no simple polygon (dense fracture networks): the trace stops short there.
-    int unsplit_blocks = 0;
-    /// Sliver blocks (under 1e-8 of a block's area: where fractures cross nearly at
-    /// one point) merged into the neighbour they share most boundary with.
-    int merged_slivers = 0;
+    /// Cutting by real joints and fractures (meshing/cutting.hpp): blocks under 1e-8
+    /// of a block's area (`size`²: where traces cross nearly at one point) merged into
+    /// the neighbour they share most boundary with, and those that had none.
+    int merged_slivers = 0, slivers_left = 0;
+    /// Length of trace between merged slivers and their neighbours, which is no
+    /// joint any more (micrometres: where two traces run within micrometres).
+    double merged_trace_length = 0.0;
+    /// Traces ending inside a block carried on to its edge (rock bridges), and
+    /// vertical cuts that opened a block with a hole.
+    int rock_bridges = 0, hole_cuts = 0;
     /// Deformable blocks: triangles made, and the time spent subdividing and meshing.
     int zones = 0;
     double seconds_meshing = 0;

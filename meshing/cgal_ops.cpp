@@ -4,8 +4,6 @@
 #include "base/error.hpp"
 #include "meshing/detail.hpp"
 
-#include <CGAL/Arr_segment_traits_2.h>
-#include <CGAL/Arrangement_2.h>
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_triangulation_2.h>
@@ -272,108 +270,7 @@ std::vector<std::vector<Vec2>> split_holes(const PolygonWithHoles& p) {
     return out;
 }
 
-std::vector<std::vector<Vec2>> split_by_line(std::span<const Vec2> poly, Vec2 a, Vec2 b) {
-    Poly p = to_poly(poly);
-    if (p.is_clockwise_oriented()) p.reverse_orientation();
-    const double extent = extent_of(poly) + norm(a) + norm(b);
-    std::vector<std::vector<Vec2>> out;
-    for (bool left : {true, false}) {
-        std::vector<Pwh> res;
-        CGAL::intersection(p, half_plane(to_exact(a), to_exact(b), extent, left),
-                           std::back_inserter(res));
-        for (const auto& r : res) {
-            BBM_ASSERT(!r.has_holes(), "a simple polygon cut by a half-plane has no holes");
-            out.push_back(to_ring(r.outer_boundary()));
-        }
-    }
-    return out;
-}
-
-std::vector<PolygonWithHoles> split_by_line(const PolygonWithHoles& poly, Vec2 a, Vec2 b) {
-    const Pwh p = to_exact_pwh(poly);
-    const double extent = extent_of(poly.outer) + norm(a) + norm(b);
-    std::vector<PolygonWithHoles> out;
-    for (bool left : {true, false}) {
-        std::vector<Pwh> res;
-        CGAL::intersection(p, half_plane(to_exact(a), to_exact(b), extent, left), std::back_inserter(res));
-        for (const auto& r : res) out.push_back(to_pwh(r));
-    }
-    return out;
-}
-
 // ---------------------------------------------------------------------------
-namespace {
-using Traits = CGAL::Arr_segment_traits_2<EK>;
-using Arrangement = CGAL::Arrangement_2<Traits>;
-
-/// A point strictly inside a simple ring (with other rings' vertices as obstacles),
-/// by the classic rule: at the leftmost vertex v with neighbours a and b, use the
-/// centroid of triangle abv if no other vertex lies in it, else the midpoint of v
-/// and the vertex inside it farthest from line ab.
-Vec2 interior_point(const std::vector<Vec2>& ring, const std::vector<Vec2>& obstacles) {
-    const std::size_t n = ring.size();
-    std::size_t iv = 0;
-    for (std::size_t i = 1; i < n; ++i)
-        if (ring[i].x < ring[iv].x || (ring[i].x == ring[iv].x && ring[i].y < ring[iv].y)) iv = i;
-    const Vec2 v = ring[iv], a = ring[(iv + n - 1) % n], b = ring[(iv + 1) % n];
-    auto in_triangle = [&](Vec2 q) {
-        const double d1 = cross(v - a, q - a), d2 = cross(b - v, q - v), d3 = cross(a - b, q - b);
-        const bool neg = d1 < 0 || d2 < 0 || d3 < 0, pos = d1 > 0 || d2 > 0 || d3 > 0;
-        return !(neg && pos);
-    };
-    double best = -1.0;
-    Vec2 far{};
-    auto consider = [&](Vec2 q) {
-        if (q == v || q == a || q == b || !in_triangle(q)) return;
-        const double d = std::abs(cross(b - a, q - a));
-        if (d > best) best = d, far = q;
-    };
-    for (Vec2 q : ring) consider(q);
-    for (Vec2 q : obstacles) consider(q);
-    if (best < 0.0) return (a + b + v) / 3.0;
-    return 0.5 * (v + far);
-}
-
-/// The closed loops of one boundary walk (CCB) of an arrangement face, antennas
-/// (edges with the face on both sides: fractures ending inside it) left out.
-/// Where an antenna leads from the walk to a closed cycle of fractures (a block
-/// enclosed by fractures and tied to the rest by one more), the walk makes an
-/// excursion around that cycle; it is its own loop — a hole of the face — not part
-/// of the ring, whose corner it would otherwise cut. A loop goes on from an edge to
-/// the first later edge of the walk that starts where it ends.
-template <class Circ>
-std::vector<std::vector<Vec2>> loops_without_antennas(Circ first) {
-    using Halfedge = decltype(&*first);
-    std::vector<Halfedge> edges;
-    Circ c = first;
-    do {
-        if (c->twin()->face() != c->face()) edges.push_back(&*c);
-    } while (++c != first);
-    const std::size_t n = edges.size();
-    std::vector<char> used(n, 0);
-    std::vector<std::vector<Vec2>> loops;
-    for (std::size_t start = 0; start < n; ++start) {
-        if (used[start]) continue;
-        std::vector<Vec2> r;
-        for (std::size_t e = start; !used[e];) {
-            used[e] = 1;
-            // Two vertices closer than the rounding (crossings a hair apart in a
-            // dense fracture network) become one.
-            const Vec2 q = to_vec(edges[e]->source()->point());
-            if (r.empty() || !(r.back() == q)) r.push_back(q);
-            std::size_t next = (e + 1) % n;
-            for (std::size_t k = 1; k < n; ++k, next = (next + 1) % n)
-                if (edges[next]->source() == edges[e]->target()) break;
-            if (edges[next]->source() != edges[e]->target()) break; // not closed: rounding left a gap
-            e = next;
-        }
-        while (r.size() > 1 && r.front() == r.back()) r.pop_back();
-        if (r.size() >= 3) loops.push_back(std::move(r));
-    }
-    return loops;
-}
-} // namespace
-
 /// A closed walk that passes a vertex twice (a face pinched at a crossing: in a
 /// dense fracture network, two opposite corners of an X belong to one face that
 /// wraps around a small neighbour) split into simple loops at its repeated vertices.
@@ -394,89 +291,6 @@ std::vector<std::vector<Vec2>> split_at_repeats(const std::vector<Vec2>& ring) {
     return loops;
 }
 
-CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments) {
-    CutResult out;
-    if (segments.empty()) {
-        out.faces = d;
-        return out;
-    }
-    std::vector<Traits::Segment_2> curves;
-    for (const auto& p : d) {
-        auto add_ring = [&](const std::vector<Vec2>& r) {
-            for (std::size_t i = 0; i < r.size(); ++i)
-                curves.emplace_back(to_exact(r[i]), to_exact(r[(i + 1) % r.size()]));
-        };
-        add_ring(p.outer);
-        for (const auto& h : p.holes) add_ring(h);
-    }
-    for (const auto& s : segments)
-        if (!(s.a == s.b)) curves.emplace_back(to_exact(s.a), to_exact(s.b));
-    Arrangement arr;
-    CGAL::insert(arr, curves.begin(), curves.end());
-
-    std::vector<Arrangement::Face_const_handle> inside;
-    for (auto f = arr.faces_begin(); f != arr.faces_end(); ++f) {
-        if (f->is_unbounded() || !f->has_outer_ccb()) continue;
-        PolygonWithHoles face;
-        // The outer walk's loop of largest area is the ring; its other loops are
-        // fracture cycles tied to it by an antenna: holes, as those of inner walks.
-        auto outer_loops = loops_without_antennas(f->outer_ccb());
-        if (outer_loops.empty()) continue;
-        const auto ring = std::max_element(outer_loops.begin(), outer_loops.end(), [](const auto& p, const auto& q) {
-            return std::abs(signed_area(p)) < std::abs(signed_area(q));
-        });
-        face.outer = std::move(*ring);
-        outer_loops.erase(ring);
-        for (auto& loop : outer_loops) face.holes.push_back(std::move(loop));
-        for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h)
-            for (auto& loop : loops_without_antennas(*h)) face.holes.push_back(std::move(loop));
-        std::vector<Vec2> obstacles;
-        for (const auto& h : face.holes) obstacles.insert(obstacles.end(), h.begin(), h.end());
-        if (!detail::domain_contains(d, interior_point(face.outer, obstacles))) continue;
-        inside.push_back(f);
-        // A face pinched at a vertex: in a dense fracture network two opposite
-        // corners of an X crossing can belong to one face that wraps around a small
-        // neighbour block. Its walk splits there into one counter-clockwise loop,
-        // the ring, and clockwise loops around the neighbours: holes that touch the
-        // ring at a point, which the Boolean operations filling the face take.
-        if (auto loops = split_at_repeats(face.outer); loops.size() > 1) {
-            const auto ccw = std::count_if(loops.begin(), loops.end(), [](const auto& l) { return signed_area(l) > 0; });
-            if (ccw == 1 && std::all_of(loops.begin(), loops.end(), [](const auto& l) { return is_simple(l); }))
-                for (auto& l : loops) (signed_area(l) > 0 ? face.outer : face.holes.emplace_back()) = std::move(l);
-        }
-        // One that rounding made cross itself, or pinched otherwise, is no polygon
-        // the pattern can fill: say where, rather than fail inside CGAL (the
-        // caller's area check catches what slips through).
-        if (const auto loops = split_at_repeats(face.outer); loops.size() > 1 || !is_simple(face.outer)) {
-            Vec2 at = face.outer.front();
-            for (std::size_t i = 1; i < face.outer.size(); ++i)
-                if (std::find(face.outer.begin(), face.outer.begin() + long(i), face.outer[i]) !=
-                    face.outer.begin() + long(i))
-                    at = face.outer[i];
-            out.pinched.push_back(at);
-            continue;
-        }
-        if (signed_area(face.outer) < 0) std::reverse(face.outer.begin(), face.outer.end());
-        for (auto& h : face.holes)
-            if (signed_area(h) > 0) std::reverse(h.begin(), h.end());
-        out.faces.push_back(std::move(face));
-    }
-    auto is_inside = [&](Arrangement::Face_const_handle f) {
-        return std::find(inside.begin(), inside.end(), f) != inside.end();
-    };
-    for (auto e = arr.edges_begin(); e != arr.edges_end(); ++e) {
-        const auto f1 = e->face(), f2 = e->twin()->face();
-        const SegmentSpec s{to_vec(e->source()->point()), to_vec(e->target()->point())};
-        if (s.a == s.b) continue; // an edge shorter than the rounding (crossings a hair apart)
-        if (f1 == f2) {
-            if (is_inside(f1)) out.dangling.push_back(s);
-        } else if (is_inside(f1) && is_inside(f2)) {
-            out.separating.push_back(s);
-        }
-    }
-    return out;
-}
-
 // ---------------------------------------------------------------------------
 namespace {
 using IK = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -493,7 +307,12 @@ VoronoiCells voronoi(std::span<const Vec2> seeds, Box2 frame) {
     // Far ghost points keep every real seed off the convex hull (so its cell is
     // bounded) without taking area from it inside the frame.
     const Vec2 c = 0.5 * (frame.lo + frame.hi);
-    const double r = 4.0 * (frame.width() + frame.height()) + 1.0;
+    double r = 4.0 * (frame.width() + frame.height()) + 1.0;
+    // Seeds far outside a small frame (a lattice's margin about a small rock
+    // block): the ghosts go out beyond them, or those seeds would be on the hull.
+    double farthest = 0.0;
+    for (const Vec2 q : seeds) farthest = std::max(farthest, norm(q - c));
+    if (farthest > 0.25 * r) r = 4.0 * farthest + r;
     for (int k = 0; k < 16; ++k) {
         const double t = 2.0 * std::numbers::pi * k / 16.0;
         pts.push_back({{c.x + r * std::cos(t), c.y + r * std::sin(t)}, -1});

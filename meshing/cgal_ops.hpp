@@ -54,23 +54,6 @@ std::vector<std::vector<Vec2>> split_at_repeats(const std::vector<Vec2>& ring);
 /// Splits a polygon with holes into simple polygons (cuts through each hole).
 std::vector<std::vector<Vec2>> split_holes(const PolygonWithHoles& p);
 
-/// Splits a simple polygon by the infinite line through a and b (exact line).
-std::vector<std::vector<Vec2>> split_by_line(std::span<const Vec2> poly, Vec2 a, Vec2 b);
-/// The same for a polygon whose holes may touch its ring at a vertex (exact line;
-/// the pieces may keep such holes).
-std::vector<PolygonWithHoles> split_by_line(const PolygonWithHoles& poly, Vec2 a, Vec2 b);
-
-/// Result of cutting a domain by real joint segments (CGAL arrangement).
-struct CutResult {
-    Domain faces;                        ///< the rock blocks
-    std::vector<SegmentSpec> separating; ///< joint pieces with different faces on both sides
-    std::vector<SegmentSpec> dangling;   ///< joint pieces with the same face on both sides
-    /// Faces left out: pinched at a vertex (touching themselves) or not simple
-    /// after rounding; a point of each. Callers must refuse a cut with any.
-    std::vector<Vec2> pinched;
-};
-CutResult cut_by_segments(const Domain& d, std::span<const SegmentSpec> segments);
-
 /// Voronoi cells of `seeds` (bounded by far ghost points placed around `frame`):
 /// cell i lists indices into `vertices` counter-clockwise. Vertices are the
 /// circumcentres of Delaunay triangles, computed once each, so neighbouring cells

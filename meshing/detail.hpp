@@ -6,7 +6,9 @@
 #include "meshing/cgal_ops.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <random>
+#include <span>
 #include <vector>
 
 namespace bbm::meshing::detail {
@@ -60,7 +62,30 @@ struct FaceFill {
     std::vector<int> parent;  ///< local parent id (the Voronoi cell of a trigon triangle)
     int collapsed_edges = 0;
 };
+/// The blocks of a pattern filling a rock block that no trace cuts: its cells
+/// clipped to it (Boolean operations), short edges collapsed.
 FaceFill fill_face(const cgal::PolygonWithHoles& face, const PatternSpec& pattern, Random& rng);
+
+using Cells = std::vector<std::vector<Vec2>>;
+/// Clips cells to a rock block: pieces with the index of their cell as parent.
+using ClipCells = std::function<FaceFill(const Cells&)>;
+/// The cells a pattern lays over a rock block before they are cut to it: Voronoi
+/// cells of its seeds (relaxed with `clip` when it asks for Lloyd iterations),
+/// lattice hexagons or bricks, constrained Delaunay triangles; none for "single".
+/// `exact`: for an exact cut, every vertex a cell has on another's edge is a vertex
+/// of that one too (the corners of a running bond's next course).
+struct PatternCells {
+    Cells cells;
+    bool fitted = false; ///< Delaunay: the triangles already fill the face as it was sampled
+    bool fans = false;   ///< trigon: each clipped cell is then fanned into triangles
+};
+PatternCells pattern_cells(const cgal::PolygonWithHoles& face, const PatternSpec& pattern, Random& rng,
+                           const ClipCells& clip, bool exact = false);
+/// A point from which every edge of the polygon is seen (its kernel), preferring
+/// the centroid; false if the polygon is not star-shaped.
+bool star_center(const std::vector<Vec2>& poly, Vec2& center);
+/// The pattern's minimum edge: given, or a tenth of its size.
+double min_edge_of(const PatternSpec& p);
 
 /// The pattern the generators run with: `size` as the diameter of the mean area of
 /// their cells (SizeMeasure::area). A size given as a mean Feret diameter is

@@ -337,7 +337,7 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
         const DfnSetSpec& s = sets[k];
         set_first.push_back(int(net.fractures.size()));
         if (!s.traces.empty()) {
-            for (const auto& t : s.traces) net.fractures.push_back({t.a, t.b, k});
+            for (const auto& t : s.traces) net.fractures.push_back({t.a, t.b, k, t.a, t.b});
             continue;
         }
         if (kept_mass(s.length, diagonal) < 1e-3)
@@ -379,19 +379,22 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
         for (const Vec2 c : centre) {
             const double th = sample_angle(s.orientation, rng) * deg, l = sample_length(s.length, diagonal, rng);
             const Vec2 h = 0.5 * l * Vec2{std::cos(th), std::sin(th)};
-            net.fractures.push_back({c - h, c + h, k});
+            net.fractures.push_back({c - h, c + h, k, c - h, c + h});
         }
         // Termination at earlier sets: out from the centre along each half, the
         // crossings in order; at each, the fracture ends there with probability p.
         if (s.terminate_probability > 0.0 && !s.terminate_at.empty()) {
             std::vector<std::pair<Vec2, Vec2>> older;
+            std::vector<int> older_index; // each one's index in net.fractures
             for (int j : s.terminate_at)
-                for (int i = set_first[j]; i < set_first[j + 1]; ++i)
+                for (int i = set_first[j]; i < set_first[j + 1]; ++i) {
                     older.push_back({net.fractures[i].a, net.fractures[i].b});
+                    older_index.push_back(i);
+                }
             if (older.empty()) continue;
             const detail::SegmentGrid grid(std::move(older), std::max(mean, 1e-6 * diagonal));
             std::vector<int> near;
-            std::vector<double> ts;
+            std::vector<std::pair<double, int>> ts; // crossing parameter, the fracture crossed
             for (int i = set_first[k]; i < int(net.fractures.size()); ++i) {
                 Fracture& f = net.fractures[i];
                 Box2 fb;
@@ -404,14 +407,14 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
                 ts.clear();
                 for (int j : near) {
                     const auto& [p, q] = grid.segments()[j];
-                    if (const double t = crossing(f.a, f.b, p, q); t >= 0.0) ts.push_back(t);
+                    if (const double t = crossing(f.a, f.b, p, q); t >= 0.0) ts.push_back({t, older_index[j]});
                 }
                 std::sort(ts.begin(), ts.end());
                 double hi = 1.0, lo = 0.0;
-                for (double t : ts) // the half towards b, outwards from the centre
-                    if (t > 0.5 && rng.uniform() < s.terminate_probability) { hi = t; break; }
-                for (auto t = ts.rbegin(); t != ts.rend(); ++t) // the half towards a
-                    if (*t < 0.5 && rng.uniform() < s.terminate_probability) { lo = *t; break; }
+                for (const auto& [t, j] : ts) // the half towards b, outwards from the centre
+                    if (t > 0.5 && rng.uniform() < s.terminate_probability) { hi = t, f.b_at = j; break; }
+                for (auto it = ts.rbegin(); it != ts.rend(); ++it) // the half towards a
+                    if (it->first < 0.5 && rng.uniform() < s.terminate_probability) { lo = it->first, f.a_at = it->second; break; }
                 const Vec2 a = f.a, d = f.b - f.a;
                 f.a = a + lo * d, f.b = a + hi * d;
             }
@@ -420,7 +423,8 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
     set_first.push_back(int(net.fractures.size()));
     // Clip to the region; a fracture crossing no part of it leaves no trace.
     std::vector<std::vector<SegmentSpec>> per_set(sets.size());
-    for (const auto& f : net.fractures) {
+    for (int i = 0; i < int(net.fractures.size()); ++i) {
+        const Fracture& f = net.fractures[std::size_t(i)];
         Box2 fb;
         fb.add(f.a);
         fb.add(f.b);
@@ -428,6 +432,7 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
         for (const auto& piece : dfn::clip_to_domain(f.a, f.b, domain)) {
             net.traces.push_back(piece);
             net.trace_set.push_back(f.set);
+            net.trace_fracture.push_back(i);
             per_set[f.set].push_back(piece);
         }
     }

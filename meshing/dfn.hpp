@@ -47,15 +47,21 @@ struct FractureSetStats {
 };
 
 /// One fracture: its whole trace (after termination, before clipping) and set.
+/// An end where it stops at an earlier fracture is rounded; `a_at` (`b_at`) names
+/// that fracture, so that the cutting can put the end exactly on it (where the line
+/// through line_a and line_b, the fracture as drawn, crosses that fracture's line).
 struct Fracture {
     Vec2 a{}, b{};
     int set = 0;
+    Vec2 line_a{}, line_b{};
+    int a_at = -1, b_at = -1; ///< index in FractureNetwork::fractures, or −1: a free end
 };
 
 struct FractureNetwork {
     std::vector<Fracture> fractures;
     std::vector<SegmentSpec> traces; ///< clipped to the region
     std::vector<int> trace_set;      ///< per trace: index of its set in the region's list
+    std::vector<int> trace_fracture; ///< per trace: the fracture it is a piece of
     std::vector<FractureSetStats> stats;
 };
 

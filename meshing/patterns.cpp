@@ -60,55 +60,47 @@ std::vector<Vec2> random_seeds(const PolygonWithHoles& face, int n, Random& rng)
     return seeds;
 }
 
-/// Voronoi cells of the seeds clipped to the face; `parent` is the seed index.
-FaceFill clipped_voronoi(const PolygonWithHoles& face, const cgal::Clipper& clipper,
-                         std::span<const Vec2> seeds) {
-    const auto vor = cgal::voronoi(seeds, face_box(face));
-    FaceFill out;
-    std::vector<Vec2> poly;
-    for (int i = 0; i < int(vor.cells.size()); ++i) {
+/// Voronoi cells of the seeds (unclipped; a cell that is no polygon left empty).
+Cells voronoi_cells(std::span<const Vec2> seeds, const Box2& frame) {
+    const auto vor = cgal::voronoi(seeds, frame);
+    Cells cells(vor.cells.size());
+    for (std::size_t i = 0; i < vor.cells.size(); ++i) {
         if (vor.cells[i].size() < 3) continue;
-        poly.clear();
-        for (int v : vor.cells[i]) poly.push_back(vor.vertices[v]);
-        clip_into(clipper, poly, i, out);
+        for (int v : vor.cells[i]) cells[i].push_back(vor.vertices[v]);
     }
-    return out;
+    return cells;
 }
 
 /// Lloyd relaxation: each seed moves to the centroid of its clipped cell.
-void lloyd(const PolygonWithHoles& face, const cgal::Clipper& clipper, std::vector<Vec2>& seeds,
-           int iterations) {
+void lloyd(const PolygonWithHoles& face, const ClipCells& clip, std::vector<Vec2>& seeds, int iterations) {
     for (int it = 0; it < iterations; ++it) {
-        const FaceFill cells = clipped_voronoi(face, clipper, seeds);
+        const FaceFill cells = clip(voronoi_cells(seeds, face_box(face)));
         std::vector<double> area(seeds.size(), 0.0);
         std::vector<Vec2> moment(seeds.size());
         for (std::size_t k = 0; k < cells.polygons.size(); ++k) {
+            const std::size_t i = std::size_t(cells.parent[k]);
+            if (i >= seeds.size()) continue; // a piece of the block no cell covers
             const double a = signed_area(cells.polygons[k]);
-            area[cells.parent[k]] += a;
-            moment[cells.parent[k]] += a * centroid(cells.polygons[k]);
+            area[i] += a;
+            moment[i] += a * centroid(cells.polygons[k]);
         }
         for (std::size_t i = 0; i < seeds.size(); ++i)
             if (area[i] > 0) seeds[i] = moment[i] / area[i];
     }
 }
 
-double min_edge_of(const PatternSpec& p) { return p.min_edge >= 0 ? p.min_edge : 0.1 * p.size; }
-
 int cell_count(double area, double size) {
     return std::max(1, int(std::lround(area / (std::numbers::pi * size * size / 4.0))));
 }
 
-FaceFill fill_voronoi(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
-    const cgal::Clipper clipper(Domain{face});
+Cells voronoi_pattern(const PolygonWithHoles& face, const PatternSpec& p, Random& rng, const ClipCells& clip) {
     auto seeds = random_seeds(face, cell_count(face_area(face), p.size), rng);
-    lloyd(face, clipper, seeds, p.lloyd_iterations);
-    FaceFill out = clipped_voronoi(face, clipper, seeds);
-    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
-    return out;
+    lloyd(face, clip, seeds, p.lloyd_iterations);
+    return voronoi_cells(seeds, face_box(face));
 }
 
-/// A point from which every edge of the polygon is seen (its kernel), preferring
-/// the centroid; false if the polygon is not star-shaped.
+} // namespace
+
 bool star_center(const std::vector<Vec2>& poly, Vec2& center) {
     auto sees_all = [&](Vec2 c) {
         const double a = std::abs(signed_area(poly));
@@ -138,15 +130,20 @@ bool star_center(const std::vector<Vec2>& poly, Vec2& center) {
     return sees_all(center);
 }
 
-FaceFill fill_trigon(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
-    FaceFill cells = fill_voronoi(face, p, rng);
+double min_edge_of(const PatternSpec& p) { return p.min_edge >= 0 ? p.min_edge : 0.1 * p.size; }
+
+namespace {
+
+/// Trigon: each cell fanned from a point of its kernel into triangles (the cell is
+/// their parent); a cell that is not star-shaped (clipped by a strongly concave
+/// outline) is kept whole.
+FaceFill fan_cells(const FaceFill& cells) {
     FaceFill out;
     out.collapsed_edges = cells.collapsed_edges;
     for (int c = 0; c < int(cells.polygons.size()); ++c) {
         const auto& poly = cells.polygons[c];
         Vec2 center;
         if (!star_center(poly, center)) {
-            // Not star-shaped (a cell clipped by a strongly concave outline): kept whole.
             out.polygons.push_back(poly);
             out.parent.push_back(c);
             continue;
@@ -159,7 +156,7 @@ FaceFill fill_trigon(const PolygonWithHoles& face, const PatternSpec& p, Random&
     return out;
 }
 
-FaceFill fill_delaunay(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+Cells delaunay_pattern(const PolygonWithHoles& face, const PatternSpec& p, Random& rng, const ClipCells& clip) {
     // Triangles of mean area π d²/4; boundary sampled at the edge of an equilateral
     // triangle of that area, interior seeds kept apart (hard core) so that no
     // triangle edge is much shorter than the minimum.
@@ -186,9 +183,8 @@ FaceFill fill_delaunay(const PolygonWithHoles& face, const PatternSpec& p, Rando
     const int interior = std::max(0, (triangles - int(boundary_points) + 2) / 2);
     const double hard_core = std::max(min_edge_of(p), 0.5 * spacing);
 
-    const cgal::Clipper clipper(Domain{face});
     auto seeds = random_seeds(face, interior, rng);
-    lloyd(face, clipper, seeds, p.lloyd_iterations);
+    lloyd(face, clip, seeds, p.lloyd_iterations);
     // Keep seeds away from the boundary and from each other.
     const SegmentGrid boundary(face_edges(sampled), hard_core);
     const Box2 b = face_box(face);
@@ -210,12 +206,11 @@ FaceFill fill_delaunay(const PolygonWithHoles& face, const PatternSpec& p, Rando
         grid[gy(s.y) * nx + gx(s.x)].push_back(s);
         kept.push_back(s);
     }
-    FaceFill out;
+    Cells out;
     for (const auto& t : cgal::constrained_delaunay(Domain{sampled}, kept)) {
         std::vector<Vec2> tri(t.begin(), t.end());
         if (signed_area(tri) < 0) std::reverse(tri.begin(), tri.end());
-        out.polygons.push_back(std::move(tri));
-        out.parent.push_back(int(out.parent.size()));
+        out.push_back(std::move(tri));
     }
     return out;
 }
@@ -242,7 +237,7 @@ struct Lattice {
     }
 };
 
-FaceFill fill_hexagonal(const PolygonWithHoles& face, const PatternSpec& p) {
+Cells hexagonal_pattern(const PolygonWithHoles& face, const PatternSpec& p) {
     // Seeds on a triangular lattice of spacing s: their Voronoi cells are regular
     // hexagons of side s/√3.
     const Lattice lat(p);
@@ -253,34 +248,34 @@ FaceFill fill_hexagonal(const PolygonWithHoles& face, const PatternSpec& p) {
     for (long j = long(std::floor(bmin / row)) - 1; j <= long(std::ceil(bmax / row)) + 1; ++j)
         for (long i = long(std::floor(amin / s)) - 2; i <= long(std::ceil(amax / s)) + 1; ++i)
             seeds.push_back(lat.at((double(i) + 0.5 * double(j & 1)) * s, double(j) * row));
-    const cgal::Clipper clipper(Domain{face});
-    FaceFill out = clipped_voronoi(face, clipper, seeds);
-    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
-    return out;
+    return voronoi_cells(seeds, face_box(face));
 }
 
-FaceFill fill_brick(const PolygonWithHoles& face, const PatternSpec& p) {
+Cells brick_pattern(const PolygonWithHoles& face, const PatternSpec& p, bool t_vertices) {
     // Corners are computed from integer half-brick indices, so neighbouring bricks
-    // share bit-identical corners.
+    // share bit-identical corners. With `t_vertices` (running bond) each long edge
+    // also has the corner of the next course's bricks that meets it: on a rotated
+    // lattice that rounded corner is off the rounded edge by an ulp, and an exact
+    // cut would see slivers between them.
     const Lattice lat(p);
     const double h = p.size, half = 0.5 * p.aspect * p.size;
     double amin, amax, bmin, bmax;
     lat.range(face_box(face), amin, amax, bmin, bmax);
-    const cgal::Clipper clipper(Domain{face});
-    FaceFill out;
+    Cells out;
     for (long j = long(std::floor(bmin / h)) - 1; j <= long(std::ceil(bmax / h)); ++j) {
         const long shift = p.running_bond ? (j & 1) : 0;
         for (long m = long(std::floor(amin / half)) - 3; m <= long(std::ceil(amax / half)) + 1; ++m) {
             if (((m - shift) & 1) != 0) continue;
-            const std::vector<Vec2> brick{lat.at(double(m) * half, double(j) * h),
-                                          lat.at(double(m + 2) * half, double(j) * h),
-                                          lat.at(double(m + 2) * half, double(j + 1) * h),
-                                          lat.at(double(m) * half, double(j + 1) * h)};
-            clip_into(clipper, brick, int(out.polygons.size()), out);
+            if (t_vertices && p.running_bond) {
+                out.push_back({lat.at(double(m) * half, double(j) * h), lat.at(double(m + 1) * half, double(j) * h),
+                               lat.at(double(m + 2) * half, double(j) * h), lat.at(double(m + 2) * half, double(j + 1) * h),
+                               lat.at(double(m + 1) * half, double(j + 1) * h), lat.at(double(m) * half, double(j + 1) * h)});
+                continue;
+            }
+            out.push_back({lat.at(double(m) * half, double(j) * h), lat.at(double(m + 2) * half, double(j) * h),
+                           lat.at(double(m + 2) * half, double(j + 1) * h), lat.at(double(m) * half, double(j + 1) * h)});
         }
     }
-    for (std::size_t k = 0; k < out.parent.size(); ++k) out.parent[k] = int(k);
-    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
     return out;
 }
 
@@ -335,17 +330,42 @@ PatternSpec generator_pattern(const PatternSpec& p) {
     return q;
 }
 
-FaceFill fill_face(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+PatternCells pattern_cells(const PolygonWithHoles& face, const PatternSpec& p, Random& rng, const ClipCells& clip,
+                           bool exact) {
     using K = PatternSpec::Kind;
     switch (p.kind) {
-    case K::voronoi: return fill_voronoi(face, p, rng);
-    case K::trigon: return fill_trigon(face, p, rng);
-    case K::delaunay: return fill_delaunay(face, p, rng);
-    case K::hexagonal: return fill_hexagonal(face, p);
-    case K::brick: return fill_brick(face, p);
-    case K::single: return fill_single(face);
+    case K::voronoi: return {voronoi_pattern(face, p, rng, clip), false, false};
+    case K::trigon: return {voronoi_pattern(face, p, rng, clip), false, true};
+    case K::delaunay: return {delaunay_pattern(face, p, rng, clip), true, false};
+    case K::hexagonal: return {hexagonal_pattern(face, p), false, false};
+    case K::brick: return {brick_pattern(face, p, exact), false, false};
+    case K::single: return {};
     }
     return {};
+}
+
+FaceFill fill_face(const PolygonWithHoles& face, const PatternSpec& p, Random& rng) {
+    using K = PatternSpec::Kind;
+    if (p.kind == K::single) return fill_single(face);
+    const cgal::Clipper clipper(Domain{face});
+    const ClipCells clip = [&](const Cells& cells) {
+        FaceFill out;
+        for (std::size_t i = 0; i < cells.size(); ++i)
+            if (cells[i].size() >= 3) clip_into(clipper, cells[i], int(i), out);
+        return out;
+    };
+    PatternCells pc = pattern_cells(face, p, rng, clip);
+    FaceFill out;
+    if (pc.fitted) { // Delaunay: the triangles fill the sampled face
+        out.polygons = std::move(pc.cells);
+        for (std::size_t k = 0; k < out.polygons.size(); ++k) out.parent.push_back(int(k));
+        return out;
+    }
+    out = clip(pc.cells);
+    if (p.kind == K::brick)
+        for (std::size_t k = 0; k < out.parent.size(); ++k) out.parent[k] = int(k);
+    out.collapsed_edges = collapse_short_edges(out.polygons, face, min_edge_of(p));
+    return pc.fans ? fan_cells(out) : out;
 }
 
 } // namespace bbm::meshing::detail

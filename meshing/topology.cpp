@@ -97,8 +97,29 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
     std::unordered_map<std::uint64_t, int> uses;
     for (const auto& p : polys)
         for (std::size_t i = 0; i < p.size(); ++i) ++uses[edge_key(p[i], p[(i + 1) % p.size()])];
-    for (const auto& [key, n] : uses)
-        if (n == 1) cls[key >> 32] = cls[key & 0xffffffffu] = 1;
+    // An edge used once lies on the face's outline, or is one side of a T-junction
+    // (a brick's edge with the corners of the bricks of the next course on it): the
+    // ends of such an edge stay put, as moving them would open the tiling.
+    std::vector<std::pair<Vec2, Vec2>> rings;
+    Box2 box;
+    auto add_ring = [&](const std::vector<Vec2>& r) {
+        for (std::size_t i = 0; i < r.size(); ++i) rings.push_back({r[i], r[(i + 1) % r.size()]}), box.add(r[i]);
+    };
+    add_ring(face.outer);
+    for (const auto& h : face.holes) add_ring(h);
+    const double tol = 1e-9 * std::max(box.width(), box.height());
+    const SegmentGrid outline(rings, std::max(min_edge, tol));
+    std::unordered_set<std::uint64_t> t_junction;
+    for (const auto& [key, n] : uses) {
+        if (n != 1) continue;
+        const int u = int(key >> 32), v = int(key & 0xffffffffu);
+        if (outline.distance_within(0.5 * (pos[u] + pos[v]), tol) <= tol) {
+            cls[u] = std::max(cls[u], 1), cls[v] = std::max(cls[v], 1);
+        } else {
+            t_junction.insert(key);
+        }
+    }
+    for (std::uint64_t key : t_junction) cls[key >> 32] = cls[key & 0xffffffffu] = 2;
     auto mark_fixed = [&](const std::vector<Vec2>& ring) {
         for (Vec2 q : ring)
             if (auto it = index.find(q); it != index.end()) cls[it->second] = 2;
@@ -150,7 +171,7 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
         int u = root(c.u), v = root(c.v);
         if (u == v || norm(pos[u] - pos[v]) >= min_edge) continue;
         if (cls[u] < cls[v]) std::swap(u, v); // u keeps its place unless both are free
-        const bool on_outline = uses[edge_key(u, v)] == 1;
+        const bool on_outline = uses[edge_key(u, v)] == 1 && !t_junction.count(edge_key(u, v));
         if (cls[u] == 2 && cls[v] == 2) continue;
         if (cls[v] >= 1 && !on_outline) continue; // an outline vertex slides only along the outline
         const Vec2 target = (cls[u] == 0 && cls[v] == 0) || (cls[u] == 1 && cls[v] == 1)

@@ -100,8 +100,11 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
             {"min_edge_length", inner_blocks ? min_edge : 0.0},
             {"collapsed_edges", st.collapsed_edges},
             {"short_edges_left", st.short_edges_left},
-            {"unsplit_blocks", st.unsplit_blocks},
             {"merged_slivers", st.merged_slivers},
+            {"slivers_left", st.slivers_left},
+            {"merged_trace_length", st.merged_trace_length},
+            {"rock_bridges", st.rock_bridges},
+            {"hole_cuts", st.hole_cuts},
             {"regions", regions},
             {"fracture_sets", fracture_sets},
             {"seconds", {{"regions", st.seconds_regions},
@@ -151,10 +154,9 @@ int run_mesh(const MeshCommand& command, bool quiet, bool check_only) {
                         r["name"].get<std::string>().c_str(), r["pattern"].get<std::string>().c_str(),
                         r["blocks"].get<int>(), r["area"].get<double>(), r["mean_feret_diameter"].get<double>(),
                         r["equal_area_diameter"].get<double>());
-        if (stats.unsplit_blocks > 0)
-            std::printf("  warning: %d blocks that a trace ends in could not be split along it (not simple "
-                        "polygons): those traces stop short of their tips\n",
-                        stats.unsplit_blocks);
+        if (stats.slivers_left > 0)
+            std::printf("  warning: %d blocks under 1e-8 of a block's area had no neighbour to merge into\n",
+                        stats.slivers_left);
         for (const auto& f : summary["fracture_sets"]) {
             std::printf("  fracture set %-8s %6d fractures, P21 %.4g /m", f["name"].get<std::string>().c_str(),
                         f["fractures"].get<int>(), f["P21"].get<double>());
