@@ -4,6 +4,7 @@
 // ones, and the traces cut a bonded region into blocks along fracture joints with
 // rock bridges between them.
 #include "base/error.hpp"
+#include "cutting_checks.hpp"
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
 #include "meshing/dfn.hpp"
@@ -280,38 +281,6 @@ property = "bond"
     CHECK(bridges > 100);
 }
 
-TEST_CASE("a block with a pinched hole is split along a line, the hole kept where the line misses it") {
-    // In a dense network a block can wrap round a smaller fracture-bounded block
-    // that touches it at one point: a ring with a hole touching it. A trace ending
-    // in it splits it along the trace's line, as any other block (once it could
-    // not: not a simple polygon).
-    cgal::PolygonWithHoles block;
-    block.outer = {{0, 0}, {4, 0}, {4, 4}, {0, 4}};
-    block.holes = {{{0, 2}, {0.1, 2.05}, {0.1, 1.95}}}; // clockwise, touching the ring at (0, 2)
-    const double hole = 0.5 * 0.1 * 0.1;
-    auto area_of = [](const cgal::PolygonWithHoles& p) {
-        double a = signed_area(p.outer);
-        for (const auto& h : p.holes) a += signed_area(h);
-        return a;
-    };
-    // x = 0.3 misses the hole: a piece with the hole, 0.3 x 4 less it, and the rest.
-    auto pieces = cgal::split_by_line(block, {0.3, 1.0}, {0.3, 3.0});
-    REQUIRE(pieces.size() == 2);
-    std::sort(pieces.begin(), pieces.end(), [&](const auto& p, const auto& q) { return area_of(p) < area_of(q); });
-    CHECK(area_of(pieces[0]) == doctest::Approx(1.2 - hole).epsilon(1e-14));
-    CHECK(pieces[0].holes.size() == 1);
-    CHECK(area_of(pieces[1]) == doctest::Approx(16.0 - 1.2).epsilon(1e-14));
-    CHECK(pieces[1].holes.empty());
-    // x = 0.05 cuts through it: the hole opens, no piece keeps one, no area lost.
-    pieces = cgal::split_by_line(block, {0.05, 1.0}, {0.05, 3.0});
-    double total = 0.0;
-    for (const auto& p : pieces) {
-        total += area_of(p);
-        CHECK(p.holes.empty());
-    }
-    CHECK(total == doctest::Approx(16.0 - hole).epsilon(1e-14));
-}
-
 TEST_CASE("mapped joints from a DXF drawing cut the tunnel's bonded region, the curved fault as its chords") {
     const auto mf = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/dfn/tunnel_voronoi_mapped.toml");
     const auto& sets = mf.geometry.regions[1].dfn;
@@ -427,39 +396,28 @@ property = "bond"
     const std::string huge = error_of(model(set("J1", 20.0, 10'000'000, 4, "")));
     MESSAGE(huge);
     CHECK(huge.find("dfn[0]: fracture set 'J1' would draw about") == 0);
-    // 1,000 + 1,000 fractures (P21 0.66 /m each, 0.5 m blocks): once refused, the
-    // blocks covering 1,599.87 of 1,600 m², because a face whose walk made an
-    // excursion along a fracture to a closed cycle of fractures lost the cycle's
-    // corner; and faces pinched at crossings (a hole touching the ring at a point).
-    // Now cut: the blocks tile the region, the traces became fracture joints.
+    // 1,000 + 1,000 fractures (P21 0.66 /m each, 0.5 m blocks): once refused (a face
+    // whose walk made an excursion along a fracture to a closed cycle of fractures
+    // lost the cycle's corner), then cut with guards around a block-by-block split
+    // (29 tips left inside blocks, spikes counting trace twice). Cut exactly now:
+    // the blocks tile the region, every trace is fracture joints once, no tip is
+    // left inside a block (tests/cutting_checks.hpp).
     auto mf = io::parse_model(model(set("J1", 20.0, 1000, 4, "") +
                                     set("J2", 110.0, 1000, 5, "terminate = { at = [\"J1\"], probability = 0.5 }\n")),
                               "dense.toml");
-    GenerationStats st;
-    const auto a = generate_blocks(mf.geometry, &st);
-    double area = 0.0, traces = 0.0, joints = 0.0;
-    for (int b = 0; b < a.block_count(); ++b) area += a.area[b];
-    for (const auto& t : a.fracture_traces) traces += norm(t.b - t.a);
-    for (const auto& j : a.joints)
-        if (j.tag == JointTag::fracture) joints += j.length();
-    MESSAGE(a.block_count() << " blocks over " << area << " m²; traces " << traces << " m, fracture joints " << joints
-                            << " m; " << st.unsplit_blocks << " blocks not split at a trace's tip");
-    CHECK(area == doctest::Approx(1600.0).epsilon(1e-9));
-    CHECK(a.block_count() > 15000);
-    // Every trace became fracture joints, to its tip, each stretch once. Blocks
-    // whose boundary ran out along a fracture and back (a spike) once gave two
-    // joints there (2,080.6 m of fracture joints against 2,073.7 m of traces,
-    // +0.33%); traces ending in a block that was not a simple polygon (one with a
-    // pinched hole, or of two lobes touching at a point) stopped short there, 29
-    // of them (-0.13% with the spikes gone). Both are split now.
-    CHECK(st.unsplit_blocks == 0);
-    CHECK(joints == doctest::Approx(traces).epsilon(1e-6));
-    // Blocks that were nothing but a spike are gone, and slivers where fractures
-    // cross nearly at one point (2.7e-10 m² here) are merged into a neighbour:
-    // none is left under 1e-8 of a block's area (0.5 m blocks: 2.5e-9 m²).
+    const auto t = cutting_checks::measure(mf.geometry, 1600.0);
+    MESSAGE(t.blocks << " blocks over " << t.area << " m²; traces " << t.trace_length << " m, fracture joints "
+                     << t.fracture_joints << " m; " << t.stats.rock_bridges << " rock bridges, "
+                     << t.stats.merged_slivers << " slivers merged");
+    cutting_checks::check(t, "1,000 + 1,000 fractures");
+    CHECK(t.blocks > 15000);
+    // Slivers where fractures cross nearly at one point (2.7e-10 m² here) are
+    // merged into a neighbour: none is left under 1e-8 of a block's area.
+    const auto a = generate_blocks(mf.geometry);
     double smallest = 1e300;
     for (int b = 0; b < a.block_count(); ++b) smallest = std::min(smallest, a.area[b]);
-    MESSAGE("smallest block " << smallest << " m²; " << st.merged_slivers << " slivers merged");
-    CHECK(st.merged_slivers > 0);
+    MESSAGE("smallest block " << smallest << " m²");
+    CHECK(t.stats.merged_slivers > 0);
+    CHECK(t.stats.slivers_left == 0);
     CHECK(smallest >= 1e-8 * 0.5 * 0.5);
 }
