@@ -698,8 +698,13 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
             }
             remove_spikes(rb, tol);
         } else {
-            const double min_area = 1e-8 * reg.pattern.size * reg.pattern.size;
-            const detail::RegionCut cut(domain[r], cut_traces(segments, net), min_area, tol);
+            // Blocks under 1e-6 of a block's area (size²; a millimetre across in 0.5 m
+            // blocks, cut off where a pattern's edge passes near a trace's crossing or
+            // tip) run away in the first steps: merged across a pattern's edge, which
+            // loses no trace. A rock block bounded by traces alone is merged at 1e-8
+            // (where three traces cross nearly at one point), losing micrometres of trace.
+            const double size2 = reg.pattern.size * reg.pattern.size;
+            const detail::RegionCut cut(domain[r], cut_traces(segments, net), 1e-6 * size2, 1e-8 * size2, tol);
             const auto real = cut.real_segments();
             a.real_segments.insert(a.real_segments.end(), real.begin(), real.end());
             detail::CutStats cs;

@@ -423,8 +423,10 @@ public:
             // each on the supporting line of the trace it came from.
             curves.emplace_back(SegmentTraits::X_monotone_curve_2(h->curve()), Traits::Data_container(id));
         });
-        CGAL::insert_non_intersecting_curves(ov_.arr, curves.begin(), curves.end());
-        ov_.classify();
+        // Inserted with the cells, in one sweep (add_cells): a rock block with many
+        // holes (clusters of traces in sparse rock) inserted first and split by the
+        // cells afterwards would move every hole at every split.
+        boundary_curves_ = std::move(curves);
         double total = 0.0;
         for (const auto& [p, q] : edges) total += norm(q - p);
         boundary_ = std::make_unique<SegmentGrid>(std::move(edges), total / double(std::max<std::size_t>(1, edges.size())));
@@ -499,10 +501,15 @@ public:
                 o.to = tiled ? onto_boundary(q) : exact(q);
                 o.left = int(c);
                 o.right = back != owner.end() ? back->second : -1;
-                ov_.queue(std::move(o));
+                if (o.from == o.to) continue;
+                ov_.origins.push_back(std::move(o));
+                const Origin& added = ov_.origins.back();
+                boundary_curves_.emplace_back(SegmentTraits::X_monotone_curve_2(Segment(added.from, added.to)),
+                                              Traits::Data_container(int(ov_.origins.size()) - 1));
             }
         }
-        ov_.flush();
+        CGAL::insert(ov_.arr, boundary_curves_.begin(), boundary_curves_.end());
+        boundary_curves_.clear();
         ov_.classify();
         label_faces(cells, near);
     }
@@ -656,20 +663,30 @@ private:
 
     bool is_block(Face f) const { return !f->is_unbounded() && f->data().inside == 1 && f->data().block; }
 
-    /// Each face takes the cell on its side of a cell edge on its boundary; a face
-    /// with none lies inside one cell, found by a point of it. Faces where cells kept
-    /// whole lie are not blocks.
+    /// Each face takes the cell on its side of the cell edges on its boundary (the
+    /// one along most of their length: laid again after a collapse, two pieces'
+    /// edges can meet a rounding apart, leaving a face a stub of a third cell's edge);
+    /// a face with none lies inside one cell, found by a point of it. Faces where
+    /// cells kept whole lie are not blocks.
     void label_faces(const Cells& cells, const std::vector<char>& near) {
+        std::vector<std::pair<int, double>> votes;
         for (auto f = ov_.arr.faces_begin(); f != ov_.arr.faces_end(); ++f) {
             if (f->is_unbounded() || f->data().inside != 1) continue;
-            int cell = -1;
+            votes.clear();
             for_each_boundary(f, [&](Halfedge h) {
-                if (cell >= 0) return;
+                int side = -1;
                 ov_.each_origin(h, [&](const Origin& o) {
-                    if (cell >= 0 || o.kind != Kind::cell) return;
-                    cell = Overlay::same_direction(h, o) ? o.left : o.right;
+                    if (side < 0 && o.kind == Kind::cell) side = Overlay::same_direction(h, o) ? o.left : o.right;
                 });
+                if (side < 0) return;
+                const auto it = std::find_if(votes.begin(), votes.end(), [&](const auto& v) { return v.first == side; });
+                if (it == votes.end()) votes.push_back({side, approx_length(h)});
+                else it->second += approx_length(h);
             });
+            int cell = -1;
+            double longest = -1.0;
+            for (const auto& [c, length] : votes)
+                if (length > longest) cell = c, longest = length;
             if (cell < 0 && !cells.empty()) {
                 // No cell edge: the face lies in one cell near the block's edges.
                 const auto loops = loops_of(f->outer_ccb());
@@ -888,6 +905,7 @@ private:
     double min_area_, tol_;
     std::unique_ptr<SegmentGrid> boundary_;
     std::vector<std::pair<Point, Point>> boundary_exact_; ///< the grid's segments, exactly
+    std::vector<Traits::X_monotone_curve_2> boundary_curves_; ///< the rock block's, until add_cells inserts them
     const Cells* cells_ = nullptr;
     std::vector<char> whole_; ///< per cell: 1 kept whole inside, 2 wholly outside, 0 cut
     bool has_cells_ = false;
@@ -901,20 +919,20 @@ struct RegionCut::Impl {
     Overlay ov;
     std::vector<Face> faces;
     std::vector<cgal::PolygonWithHoles> rounded;
-    double min_area = 0, tol = 0;
+    double min_area = 0, min_face_area = 0, tol = 0;
     int merged = 0;
     double merged_trace = 0.0;
 
-    /// Rock blocks under min_area merged into the inside neighbour they share the
+    /// Rock blocks under min_face_area merged into the inside neighbour they share the
     /// most trace with (that stretch of trace is lost).
     void merge_small_faces() {
         std::vector<Face> work;
         for (auto f = ov.arr.faces_begin(); f != ov.arr.faces_end(); ++f)
-            if (f->data().inside == 1 && approx_area(f) < min_area) work.push_back(f);
+            if (f->data().inside == 1 && approx_area(f) < min_face_area) work.push_back(f);
         while (!work.empty()) {
             const Face f = work.back();
             work.pop_back();
-            if (f->data().inside != 1 || approx_area(f) >= min_area) continue;
+            if (f->data().inside != 1 || approx_area(f) >= min_face_area) continue;
             std::map<const void*, std::pair<double, Face>> shared;
             std::vector<const void*> seen;
             for_each_boundary(f, [&](Halfedge h) {
@@ -943,15 +961,17 @@ struct RegionCut::Impl {
             ++merged;
             // Faces merged away are no longer faces: drop them from the work list.
             std::erase_if(work, [&](Face g) { return g == f || g == into; });
-            if (approx_area(merged_face) < min_area) work.push_back(merged_face);
+            if (approx_area(merged_face) < min_face_area) work.push_back(merged_face);
         }
     }
 };
 
-RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> traces, double min_area, double tol)
+RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> traces, double min_area,
+                     double min_face_area, double tol)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.min_area = min_area;
+    m.min_face_area = min_face_area;
     m.tol = tol;
     Box2 box;
     auto ring = [&](std::vector<Vec2> r, bool outer) {
@@ -981,8 +1001,8 @@ RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> trace
     }
     const SegmentGrid boundary(edges, std::max(box.width(), box.height()) / 64.0);
     auto line_of = [&](const CutTrace& t) { return EK::Line_2(exact(t.line_a), exact(t.line_b)); };
-    auto meet = [](const EK::Line_2& l, const EK::Line_2& m) -> std::optional<Point> {
-        const auto x = CGAL::intersection(l, m);
+    auto meet = [](const EK::Line_2& l, const EK::Line_2& l2) -> std::optional<Point> {
+        const auto x = CGAL::intersection(l, l2);
         if (x)
             if (const Point* p = boost::get<Point>(&*x)) return *p;
         return std::nullopt;
@@ -1018,7 +1038,7 @@ RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> trace
     }
     m.ov.flush();
     m.ov.classify();
-    if (min_area > 0) m.merge_small_faces();
+    if (min_face_area > 0) m.merge_small_faces();
     for (auto f = m.ov.arr.faces_begin(); f != m.ov.arr.faces_end(); ++f)
         if (!f->is_unbounded() && f->data().inside == 1) {
             m.faces.push_back(f);

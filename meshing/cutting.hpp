@@ -9,7 +9,7 @@
 //      edge) and every trace, unclipped. Its faces inside the region are the rock
 //      blocks. A fracture that ends at an earlier one ends exactly on it (where
 //      their lines cross, not at a rounded point near it). A rock block under
-//      `min_area` (where traces cross nearly at one point) is merged into the
+//      `min_face_area` (where traces cross nearly at one point) is merged into the
 //      neighbour it shares most boundary with, losing that stretch of trace.
 //   2. Each rock block's arrangement: its exact boundary — traces that end inside
 //      it included, as edges with the block on both sides — and the edges of the
@@ -68,9 +68,12 @@ using Collapse = std::function<int(Cells&)>;
 
 class RegionCut {
 public:
-    /// The arrangement of `domain`'s boundary and `traces`; rock blocks under
-    /// `min_area` merged; `tol` is the rounding scale (1e-9 of the model).
-    RegionCut(const cgal::Domain& domain, std::span<const CutTrace> traces, double min_area, double tol);
+    /// The arrangement of `domain`'s boundary and `traces`; rock blocks (bounded by
+    /// traces alone) under `min_face_area` merged, losing the trace between them;
+    /// blocks under `min_area` merged across a cell edge, losing none; `tol` is the
+    /// rounding scale (1e-9 of the model).
+    RegionCut(const cgal::Domain& domain, std::span<const CutTrace> traces, double min_area, double min_face_area,
+              double tol);
     ~RegionCut();
     RegionCut(const RegionCut&) = delete;
     RegionCut& operator=(const RegionCut&) = delete;

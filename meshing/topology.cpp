@@ -126,6 +126,19 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
     };
     mark_fixed(face.outer);
     for (const auto& h : face.holes) mark_fixed(h);
+    // A vertex on the outline within the rounding of one of its corners (a cell's
+    // edge cut the outline there: the cut ends a rounding away from the corner) is
+    // that corner: sliding it along one edge of the outline would cut the corner off.
+    for (std::size_t v = 0; v < pos.size(); ++v) {
+        if (cls[v] != 1) continue;
+        Box2 b;
+        b.add(pos[v] - Vec2{tol, tol});
+        b.add(pos[v] + Vec2{tol, tol});
+        outline.for_each_near(b, [&](int s) {
+            const auto& [p, q] = outline.segments()[std::size_t(s)];
+            if (norm(p - pos[v]) <= tol || norm(q - pos[v]) <= tol) cls[v] = 2;
+        });
+    }
 
     std::vector<std::vector<int>> incident(pos.size());
     for (int k = 0; k < int(polys.size()); ++k)

@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const PatternSpec::Kind kinds[] = {PatternSpec::Kind::voronoi, PatternSpec::Kind::trigon,
                                        PatternSpec::Kind::delaunay, PatternSpec::Kind::hexagonal,
                                        PatternSpec::Kind::brick, PatternSpec::Kind::single};
-    reg.pattern.kind = kinds[data[0] % 6];
+    reg.pattern.kind = kinds[(data[0] & 0x7f) % 6];
     reg.pattern.size = reg.pattern.kind == PatternSpec::Kind::single ? 0.0 : 0.4;
     reg.pattern.seed = data[0];
     double area = 16.0;
