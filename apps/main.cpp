@@ -15,6 +15,7 @@
 // interrupted (SIGINT, SIGTERM or SIGUSR1; `bbm run` writes a checkpoint), 1 any
 // other failure. Earlier output in DIR is only replaced by
 // complete files.
+#include "bbm_version.hpp" // generated: cmake/write_version.cmake
 #include "base/error.hpp"
 #include "io/model_input.hpp"
 #include "studies/cli_checks.hpp"
@@ -44,6 +45,7 @@ int run_cli(int argc, char** argv) {
                  "Rigid or deformable blocks bonded by softening joints, one explicit loop.",
                  "bbm"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", "bbm " BBM_VERSION_TEXT, "Print bbm's version and the commit it was built from");
     // Any command's options can come from a TOML file: a table per command, keys
     // the long option names, e.g. [ucs] size = 0.3, pattern = "trigon" (docs/calibration.md).
     app.set_config("--config", "", "Read options from a TOML file ([ucs], [tension], [calibrate], ... tables; keys "

@@ -1,4 +1,4 @@
-// bbm apps: the model file — TOML text in, a checked model description out.
+// bbm io: the model file — TOML text in, a checked model description out.
 //
 // read_model() turns a model file (format and every key: docs/input.md) into the
 // plain-data ModelGeometrySpec that meshing/ consumes and the AnalysisSpec

@@ -370,14 +370,24 @@ double approx_area(Face f) {
 
 double approx_length(Halfedge h) { return norm(approx(h->target()->point()) - approx(h->source()->point())); }
 
-struct PointHash {
-    std::size_t operator()(Vec2 p) const {
-        std::uint64_t a, b;
-        std::memcpy(&a, &p.x, 8);
-        std::memcpy(&b, &p.y, 8);
-        return std::hash<std::uint64_t>{}(a * 0x9E3779B97F4A7C15ull ^ b);
-    }
-};
+/// The face across f's boundary that shares the most length with it, over the
+/// edges `accept` takes (first met on a tie); none if it takes none.
+template <class Accept> std::optional<Face> neighbour_sharing_most(Face f, Accept&& accept) {
+    std::vector<std::pair<Face, double>> shared; // few neighbours: a list
+    for_each_boundary(f, [&](Halfedge h) {
+        const Face g = h->twin()->face();
+        if (g == f || !accept(h)) return;
+        const auto it = std::find_if(shared.begin(), shared.end(), [&](const auto& s) { return s.first == g; });
+        if (it == shared.end()) shared.push_back({g, approx_length(h)});
+        else it->second += approx_length(h);
+    });
+    std::optional<Face> best;
+    double longest = 0.0;
+    for (const auto& [g, length] : shared)
+        if (!best || length > longest) best = g, longest = length;
+    return best;
+}
+
 struct EdgeHash {
     std::size_t operator()(const std::pair<Vec2, Vec2>& e) const {
         return PointHash{}(e.first) * 31 + PointHash{}(e.second);
@@ -841,26 +851,16 @@ private:
             const Face small = work.back();
             work.pop_back();
             if (!too_small(small)) continue;
-            std::map<const void*, std::pair<double, Face>> shared;
-            std::vector<const void*> seen;
-            for_each_boundary(small, [&](Halfedge h) {
-                const Face g = h->twin()->face();
-                if (g == small || !is_block(g) || !removable(h)) return;
-                auto [it, fresh] = shared.try_emplace(&*g, 0.0, g);
-                if (fresh) seen.push_back(&*g);
-                it->second.first += approx_length(h);
-            });
-            const void* best = nullptr;
-            for (const void* g : seen)
-                if (!best || shared[g].first > shared[best].first) best = g;
-            if (!best) {
+            const auto into_found = neighbour_sharing_most(
+                small, [&](Halfedge h) { return is_block(h->twin()->face()) && removable(h); });
+            if (!into_found) {
                 FaceData d = small->data();
                 d.stuck = true;
                 small->set_data(d);
                 ++stats.slivers_left;
                 continue;
             }
-            const Face into = shared[best].second;
+            const Face into = *into_found;
             const FaceData keep = into->data();
             std::vector<Halfedge> between;
             for_each_boundary(small, [&](Halfedge h) {
@@ -933,20 +933,10 @@ struct RegionCut::Impl {
             const Face f = work.back();
             work.pop_back();
             if (f->data().inside != 1 || approx_area(f) >= min_face_area) continue;
-            std::map<const void*, std::pair<double, Face>> shared;
-            std::vector<const void*> seen;
-            for_each_boundary(f, [&](Halfedge h) {
-                const Face g = h->twin()->face();
-                if (g == f || g->data().inside != 1) return;
-                auto [it, fresh] = shared.try_emplace(&*g, 0.0, g);
-                if (fresh) seen.push_back(&*g);
-                it->second.first += approx_length(h);
-            });
-            const void* best = nullptr;
-            for (const void* g : seen)
-                if (!best || shared[g].first > shared[best].first) best = g;
-            if (!best) continue; // the region itself is that small
-            const Face into = shared[best].second;
+            const auto into_found =
+                neighbour_sharing_most(f, [](Halfedge h) { return h->twin()->face()->data().inside == 1; });
+            if (!into_found) continue; // the region itself is that small
+            const Face into = *into_found;
             std::vector<Halfedge> between;
             for_each_boundary(f, [&](Halfedge h) {
                 if (h->twin()->face() == into) between.push_back(h);

@@ -6,6 +6,7 @@
 #include "meshing/cgal_ops.hpp"
 
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <span>
@@ -23,6 +24,17 @@ public:
 
 private:
     std::mt19937_64 engine_;
+};
+
+/// Hash of a point by its bits: bit-identical coordinates are one point (the
+/// cutting and clipping round each shared vertex once, so shared means identical).
+struct PointHash {
+    std::size_t operator()(Vec2 p) const {
+        std::uint64_t a, b;
+        std::memcpy(&a, &p.x, 8);
+        std::memcpy(&b, &p.y, 8);
+        return std::hash<std::uint64_t>{}(a * 0x9E3779B97F4A7C15ull ^ b);
+    }
 };
 
 /// Segments in a uniform grid, for "which segments are near this box" queries.

@@ -63,14 +63,6 @@ bool domain_contains(const cgal::Domain& d, Vec2 q) {
 // ---------------------------------------------------------------------------
 namespace {
 
-struct PointHash {
-    std::size_t operator()(Vec2 p) const {
-        std::uint64_t a, b;
-        std::memcpy(&a, &p.x, 8);
-        std::memcpy(&b, &p.y, 8);
-        return std::hash<std::uint64_t>{}(a * 0x9E3779B97F4A7C15ull ^ b);
-    }
-};
 
 std::uint64_t edge_key(int u, int v) {
     return (std::uint64_t(std::uint32_t(std::min(u, v))) << 32) | std::uint32_t(std::max(u, v));

@@ -1,5 +1,6 @@
 #include "studies/commands.hpp"
 
+#include "base/progress.hpp"
 #include "io/model_input.hpp"
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"
@@ -595,6 +596,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                      c.pattern.c_str(), o.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
                      n > 1 ? "s" : "", shown_threads, shown_threads > 1 ? "s" : "",
                      Ranks::size() > 1 ? (" per rank, " + std::to_string(Ranks::size()) + " ranks").c_str() : "");
+    Progress lines; // progress of a single realization; every realization's result
     auto realization = [&](int k) -> std::string {
         try {
             LabTestOptions ok = o;
@@ -603,14 +605,10 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
             // several side by side: one each.
             ok.threads = n == 1 || one_at_a_time ? threads_for_loop : 1;
             const fs::path dir = n > 1 ? out / ("realization_" + std::to_string(k + 1)) : out;
-            auto last = std::chrono::steady_clock::now();
             auto progress = [&](const StressStrainPoint& p) {
-                if (quiet || n > 1) return;
-                const auto now = std::chrono::steady_clock::now();
-                if (std::chrono::duration<double>(now - last).count() < 1.0) return;
-                last = now;
-                std::fprintf(stderr, "\r  step %8ld  strain %.3e  stress %7.2f MPa  cracks %5d T %5d S   ", p.step,
-                             p.axial_strain, p.axial_stress / 1e6, p.cracks_tensile, p.cracks_shear);
+                if (quiet || n > 1 || !lines.due()) return;
+                lines.line("  step %8ld  strain %.3e  stress %7.2f MPa  cracks %5d T %5d S", p.step, p.axial_strain,
+                           p.axial_stress / 1e6, p.cracks_tensile, p.cracks_shear);
             };
             std::vector<std::pair<double, std::string>> frames;
             using Finish = std::function<void(const Solver&, const LabTestResult&)>;
@@ -630,8 +628,8 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                                     : Frame());
             if (!quiet) {
                 std::lock_guard lock(print);
-                std::fprintf(stderr, "\r  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
-                                     "sigma_ci %.2f  sigma_cd %.2f MPa  cracks %d T %d S  %ld steps  %.1f s\n",
+                lines.result("  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
+                             "sigma_ci %.2f  sigma_cd %.2f MPa  cracks %d T %d S  %ld steps  %.1f s",
                              static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.E50 / 1e9, r.nu, r.peak_stress / 1e6,
                              r.strain_at_peak, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6,
                              r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);

@@ -1,4 +1,4 @@
-// bbm core: numerical laboratory tests for micro-property calibration (paper §4.2,
+// bbm studies: numerical laboratory tests for micro-property calibration (paper §4.2,
 // SPEC §8): uniaxial compression, direct tension, biaxial compression and the
 // Brazilian test on a bonded-block specimen.
 //

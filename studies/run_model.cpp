@@ -1,5 +1,6 @@
 #include "studies/run_model.hpp"
 
+#include "base/progress.hpp"
 #include "io/model_input.hpp"
 #include "io/picture.hpp"
 #include "io/binary_stream.hpp"
@@ -129,17 +130,16 @@ public:
         if (settings_.output_every > 0 && s.steps() % settings_.output_every == 0) snapshot(s);
         if (s.steps() % 100 == 0) check_run_health(s);
         if (options_.quiet) return;
+        if (!progress_.due()) return;
         const auto now = std::chrono::steady_clock::now();
-        if (std::chrono::duration<double>(now - last_print_).count() < 1.0) return;
         if (stage_name_ != st.name) stage_name_ = st.name, stage_t0_ = now, stage_k0_ = k;
-        last_print_ = now;
         const double el = std::chrono::duration<double>(now - stage_t0_).count();
         const double rate = el > 0 ? (k - stage_k0_) / el : 0.0;
         const long total = st.kind == StageSpec::Kind::cycle ? st.steps
                          : st.kind == StageSpec::Kind::excavate ? st.steps : st.max_steps;
-        std::fprintf(stderr, "\r  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s  ",
+        progress_.line("  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s",
                      st.name.c_str(), k, total, s.unbalanced_ratio(), s.cracks(contact::JointState::broken_tension),
-                     s.cracks(contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
+                        s.cracks(contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
     }
     void at(const Solver& s, const StageCursor& c) override {
         cursor_ = c;
@@ -165,9 +165,8 @@ public:
         const char* end = r.converged || r.kind != "solve" ? ""
                         : r.verdict.at_rest()               ? "  (rock at rest)"
                                                             : "  (step limit reached)";
-        std::fprintf(stderr, "\r  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s%s\n", r.name.c_str(),
-                     r.kind.c_str(), r.steps, r.ratio, r.seconds, end, r.method.empty() ? "" : ("  " + r.method).c_str(),
-                     std::string(50, ' ').c_str());
+        progress_.result("  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s", r.name.c_str(), r.kind.c_str(), r.steps,
+                         r.ratio, r.seconds, end, r.method.empty() ? "" : ("  " + r.method).c_str());
         if (r.verdict.kind != Verdict::Kind::none) std::fprintf(stderr, "  %-12s %s\n", "", describe(r.verdict).c_str());
     }
     bool stop_requested() override { return interrupted.load() != 0; }
@@ -317,7 +316,8 @@ private:
     StageCursor cursor_;
     std::string stage_name_;
     long stage_k0_ = 0;
-    std::chrono::steady_clock::time_point stage_t0_ = std::chrono::steady_clock::now(), last_print_ = stage_t0_;
+    std::chrono::steady_clock::time_point stage_t0_ = std::chrono::steady_clock::now();
+    Progress progress_;
 };
 
 /// history.png: the unbalanced ratio and the crack counts against the step.

@@ -1,6 +1,7 @@
 #include "studies/shear.hpp"
 
 #include "base/error.hpp"
+#include "base/progress.hpp"
 #include "core/solver.hpp"
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"
@@ -450,6 +451,7 @@ int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
                      v.normal_stresses.size() > 1 ? "es" : "", per, per > 1 ? "s" : "",
                      v.o.normal_stiffness > 0 ? "constant normal stiffness" : "constant normal load");
     std::mutex print;
+    Progress lines; // progress of a single run; every run's result
     auto run = [&](int k) -> std::string {
         ShearTestOptions o = v.o;
         o.normal_stress = v.normal_stresses[k / per];
@@ -457,16 +459,12 @@ int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
         o.threads = n == 1 ? available : 1;
         const auto dir = n == 1 ? out : out / run_name(o.normal_stress, o.seed);
         std::vector<std::pair<double, std::string>> frames;
-        auto last = std::chrono::steady_clock::now();
         const ShearTestResult r = run_shear_test(
             o,
             [&](const ShearPoint& p) {
-                if (quiet || n > 1) return;
-                const auto now = std::chrono::steady_clock::now();
-                if (std::chrono::duration<double>(now - last).count() < 1.0) return;
-                last = now;
-                std::fprintf(stderr, "\r  step %8ld  u %.3e m  tau %7.3f MPa  sigma_n %7.3f MPa  cracks %d   ", p.step,
-                             p.displacement, p.shear_stress / 1e6, p.normal_stress / 1e6, p.cracks_tensile + p.cracks_shear);
+                if (quiet || n > 1 || !lines.due()) return;
+                lines.line("  step %8ld  u %.3e m  tau %7.3f MPa  sigma_n %7.3f MPa  cracks %d", p.step, p.displacement,
+                           p.shear_stress / 1e6, p.normal_stress / 1e6, p.cracks_tensile + p.cracks_shear);
             },
             [&](const Solver& s, const ShearTestResult& res) {
                 if (write) write_run_files(res, s, dir, frames);
@@ -481,8 +479,8 @@ int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
             });
         if (!quiet) {
             std::lock_guard lock(print);
-            std::fprintf(stderr, "\r  sigma_n %6.2f MPa seed %llu: peak %.3f MPa at %.3g mm, residual %.3f MPa, "
-                                 "dilation %.3g mm (%.1f deg), cracks %d, %ld steps, %.1f s\n",
+            lines.result("  sigma_n %6.2f MPa seed %llu: peak %.3f MPa at %.3g mm, residual %.3f MPa, "
+                         "dilation %.3g mm (%.1f deg), cracks %d, %ld steps, %.1f s",
                          o.normal_stress / 1e6, static_cast<unsigned long long>(o.seed), r.peak_shear_stress / 1e6,
                          1e3 * r.displacement_at_peak, r.residual_shear_stress / 1e6, 1e3 * r.final_dilation,
                          r.peak_dilation_angle, r.cracks_tensile + r.cracks_shear, r.steps, r.wall_seconds);

@@ -66,47 +66,6 @@ TEST_CASE("calibrate: the confined targets are checked before any run") {
     std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("calibrate to a steep envelope (Hoek-Brown mi 25): the joints' friction angle rises") {
-    // A 3 m x 6 m specimen, one realization, two iterations: the paper's joints give
-    // a macro friction angle of about 33 degrees (mi about 8); mi 25 asks for about
-    // 49. The first correction must raise phi from 25 degrees, and the second
-    // iteration's envelope must be steeper than the first's.
-    const std::string json = run_calibrate_args({"--width", "3", "--height", "6", "--realizations", "1",
-                                                 "--iterations", "2", "--threads", "2", "--target-ucs", "22e6",
-                                                 "--target-tensile", "2e6", "--target-mi", "25"},
-                                                true);
-    const auto c = nlohmann::json::parse(json);
-    const auto& its = c["iterations"];
-    REQUIRE(its.size() == 2);
-    REQUIRE(c["targets"]["envelope"].size() == 2);
-    const double phi1 = its[0]["friction"], phi2 = its[1]["friction"];
-    auto slope = [](const nlohmann::json& it, const nlohmann::json& targets) {
-        double num = 0, den = 0;
-        for (std::size_t k = 0; k < 2; ++k) {
-            const double s3 = targets["envelope"][k][0], s1 = it["confined_strength"][k];
-            num += s3 * (s1 - it["ucs"].get<double>()), den += s3 * s3;
-        }
-        return num / den;
-    };
-    const double k1 = slope(its[0], c["targets"]), k2 = slope(its[1], c["targets"]);
-    MESSAGE("phi " << phi1 << " -> " << phi2 << " degrees, envelope slope " << k1 << " -> " << k2);
-    CHECK(phi1 == doctest::Approx(25.0));
-    CHECK(phi2 > phi1 + 5.0);
-    CHECK(k2 > k1);
-    // The set written is the best one; its misfit is the largest relative miss.
-    const int chosen = c["calibrated_iteration"];
-    CHECK(its[chosen - 1]["misfit"].get<double>() <= std::min(its[0]["misfit"].get<double>(), its[1]["misfit"].get<double>()));
-    // joint_property.toml holds the set exactly (JSON numbers round-trip): a set
-    // rounded to 6 digits is another rock for a brittle specimen (docs/calibration.md).
-    const std::string toml = c["joint_property_toml"];
-    for (const char* key : {"kn", "ks", "tensile", "cohesion", "friction"}) {
-        const auto at = toml.find(std::string("\n") + key + " = ");
-        REQUIRE(at != std::string::npos);
-        CAPTURE(key);
-        CHECK(std::strtod(toml.c_str() + at + std::strlen(key) + 4, nullptr) == its[chosen - 1][key].get<double>());
-    }
-}
-
 TEST_CASE("calibrate: the cohesion-friction step finds a synthetic rock's c and phi, Coulomb and steeper") {
     // Strengths of a rock with bond cohesion c and friction phi: UCS = 2 c sqrt(N)
     // times exp(extra (phi - 30 deg)), sigma1 = UCS + N sigma3. extra = 0: Coulomb;
@@ -198,27 +157,3 @@ TEST_CASE("calibrate: the heterogeneity step for sigma_ci/UCS") {
     CHECK(next_heterogeneity(0.8, 0.40, 0.9, 0.38, 0.10) == 1.0);
 }
 
-TEST_CASE("calibrate --fit-ci: the paper's rock to a granite-like sigma_ci/UCS of 0.30 by heterogeneous bonds") {
-    // Uniform bonds give the paper's rock sigma_ci/UCS of about 0.40 on this 3 m x
-    // 6 m specimen (0.42 at 8 x 16 m). The calibration must add heterogeneity (a
-    // finite Weibull modulus), converge with sigma_ci/UCS within 0.05 of 0.30, and
-    // hold that on seeds it has not seen. Measured 2026-11-26: converged at
-    // iteration 6, m 1.73, sigma_ci/UCS 0.33; fresh seeds 0.34 (their UCS +13%:
-    // strongly heterogeneous small specimens scatter, std 2 MPa).
-    const std::string json = run_calibrate_args({"--width", "3", "--height", "6", "--realizations", "2", "--iterations",
-                                                 "8", "--threads", "2", "--target-ucs", "22e6", "--target-tensile",
-                                                 "1.9e6", "--target-ci-ratio", "0.30", "--fit-ci"},
-                                                true);
-    const auto c = nlohmann::json::parse(json);
-    const auto& its = c["iterations"];
-    const auto& best = its[c["calibrated_iteration"].get<int>() - 1];
-    MESSAGE("iterations " << its.size() << ", m " << best["weibull_modulus"].get<double>() << ", sigma_ci/UCS "
-                          << best["ci_ratio"].get<double>() << ", fresh seeds " << c["fresh_seeds"]["ci_ratio"].get<double>());
-    CHECK(its[0]["ci_ratio"].get<double>() > 0.0);
-    CHECK(c["converged"].get<bool>());
-    CHECK(best["weibull_modulus"].get<double>() > 0.0);
-    CHECK(best["weibull_modulus"].get<double>() < 5.0);
-    CHECK(std::abs(best["ci_ratio"].get<double>() - 0.30) <= 0.05);
-    CHECK(std::abs(c["fresh_seeds"]["ci_ratio"].get<double>() - 0.30) <= 0.05);
-    CHECK(c["joint_property_toml"].get<std::string>().find("weibull_modulus = ") != std::string::npos);
-}
