@@ -712,6 +712,13 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
                 auto fill = cut_face(cut, k, pattern, rng, cs);
                 add(fill);
             }
+            // A sliver the exact cut kept (thinner than the rounding, with no cell
+            // edge to merge across) can round to a polygon of no area: no block.
+            std::vector<char> flat(rb.polygons.size(), 0);
+            for (std::size_t k = 0; k < rb.polygons.size(); ++k)
+                flat[k] = rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol;
+            cs.slivers_left += int(std::count(flat.begin(), flat.end(), char(1)));
+            drop_blocks(rb, flat);
             st.merged_slivers += cut.merged_faces() + cs.merged_slivers;
             st.merged_trace_length += cut.merged_trace_length();
             st.slivers_left += cs.slivers_left;

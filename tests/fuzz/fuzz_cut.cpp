@@ -8,7 +8,7 @@
 // region's edge or through a pattern's vertices. Seeds: dense networks
 // (tests/fuzz/seeds/cut, written by make_cut_seeds.py). Every network must be cut
 // without an error — the region is valid whatever the traces — into blocks that
-// tile it. Anything else is a bug: an exception, an area off by more than the
+// tile it, each of positive area. Anything else is a bug: an exception, an area off by more than the
 // rounding, a crash, a sanitizer report or (built without NDEBUG, as .ci/fuzz
 // builds it) a failed CGAL precondition or assertion.
 #include "meshing/blocks.hpp"
@@ -54,7 +54,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     spec.regions.push_back(reg);
     const BlockAssembly a = generate_blocks(spec); // any exception escapes: a finding
     double covered = 0.0;
-    for (int b = 0; b < a.block_count(); ++b) covered += a.area[std::size_t(b)];
+    for (int b = 0; b < a.block_count(); ++b) {
+        if (!(a.area[std::size_t(b)] > 0.0)) {
+            std::fprintf(stderr, "block %d has area %.17g\n", b, a.area[std::size_t(b)]);
+            std::abort();
+        }
+        covered += a.area[std::size_t(b)];
+    }
     if (!(std::abs(covered - area) <= 1e-9 * area)) {
         std::fprintf(stderr, "blocks cover %.17g m² of %.17g m²\n", covered, area);
         std::abort();
