@@ -6,6 +6,7 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
+#include "studies/labtest.hpp"
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <cstdint>
+#include <cstring>
+#include <utility>
 #include <initializer_list>
 #include <filesystem>
 #include <string>
@@ -144,6 +147,74 @@ inline int check_examples_on(std::initializer_list<int> threads) {
         ++compared;
     }
     return compared;
+}
+
+/// The trigon tunnel run to its end on each of `threads`, against the state
+/// recorded on 1 thread (past its first 900 cracks: its failure stage in full).
+inline void check_trigon_tunnel_on(std::initializer_list<int> threads) {
+    const auto model = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/tunnel_trigon.toml");
+    const auto blocks = meshing::generate_blocks(model.geometry);
+    RecordedStates recorded;
+    for (int n : threads_to_run(threads)) {
+        const Outcome o = run_model(model, blocks, n);
+        INFO(n << " threads: " << outcome_text(o));
+        CHECK(o.tensile + o.shear > 900); // 952 (461 / 491) with face shear on the far field's interface
+        recorded.check("examples/tunnel_trigon.toml, to its end", outcome_json(o));
+    }
+}
+
+/// A lab test's outcome, its curve point by point folded into one hash.
+inline nlohmann::json labtest_json(const LabTestResult& r) {
+    std::uint64_t curve = 1469598103934665603ull; // FNV-1a over the bits of every point
+    auto fold = [&](double v) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &v, 8);
+        for (int b = 0; b < 8; ++b) curve = (curve ^ ((bits >> (8 * b)) & 0xff)) * 1099511628211ull;
+    };
+    for (const auto& p : r.curve) fold(p.axial_stress), fold(p.axial_strain), fold(p.lateral_strain);
+    return {{"steps", r.steps},
+            {"peak_stress", r.peak_stress},
+            {"E", r.E},
+            {"cracks_tensile", r.cracks_tensile},
+            {"cracks_shear", r.cracks_shear},
+            {"curve_points", r.curve.size()},
+            {"curve_hash", curve}};
+}
+
+/// Small (2 m x 4 m) lab tests of every kind, deformable and trigon blocks, each
+/// run to its end on each of `threads` against the curve and cracks recorded on 1.
+inline void check_lab_tests_on(std::initializer_list<int> threads) {
+    using Kind = LabTestOptions::Kind;
+    auto small = [](Kind kind) {
+        auto o = LabTestOptions::paper_ucs();
+        o.kind = kind;
+        o.width = 2.0, o.height = 4.0;
+        if (kind == Kind::biaxial) o.confinement = 2e6;
+        o.frame_every = 0;
+        return o;
+    };
+    std::vector<std::pair<std::string, LabTestOptions>> tests = {
+        {"ucs", small(Kind::ucs)},     {"tension", small(Kind::tension)},
+        {"biaxial", small(Kind::biaxial)}, {"brazilian", small(Kind::brazilian)}};
+    auto deformable = small(Kind::ucs);
+    deformable.deformable_fraction = 0.5;
+    tests.push_back({"ucs, deformable blocks f = 0.5", deformable});
+    auto trigon = small(Kind::ucs);
+    trigon.pattern = meshing::PatternSpec::Kind::trigon;
+    trigon.joint.kn = 162e9, trigon.joint.ks = 68e9;
+    tests.push_back({"ucs, trigon", trigon});
+    RecordedStates recorded;
+    for (auto& test_case : tests)
+        for (int n : threads_to_run(threads)) {
+            // Not a structured binding: clang 14 cannot capture one in INFO's lambda.
+            const std::string& name = test_case.first;
+            LabTestOptions& options = test_case.second;
+            options.threads = n;
+            const LabTestResult r = run_labtest(options);
+            INFO(name << " on " << n << " threads");
+            CHECK(r.cracks_tensile + r.cracks_shear > 0);
+            recorded.check("lab test: " + name, labtest_json(r));
+        }
 }
 
 } // namespace bbm::test

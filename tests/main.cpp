@@ -1,3 +1,52 @@
 // The doctest main of the bbm test suite (tests are discovered by CTest).
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+//
+// Test cases are of two kinds: unit tests (a closed form, an invariant, a small
+// model, seconds) and validations (a lab test, a tunnel or a restart of one run to
+// its answer, tens of seconds in Release), tagged `* doctest::test_suite("validation")`.
+// The checking build (.ci/sanitize: sanitizers and assertions, 5-10 times slower)
+// runs the unit tests: it sets BBM_SKIP_TEST_SUITES=validation, and a test case of
+// a skipped suite exits with 77, which CTest reports as "Skipped" (SKIP_RETURN_CODE),
+// not as passed.
+#define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
+
+#include <cstdlib>
+
+namespace {
+
+/// How many test cases the run selected (after the suite filter).
+unsigned selected_test_cases = 0;
+
+struct SelectedCount : doctest::IReporter {
+    explicit SelectedCount(const doctest::ContextOptions&) {}
+    void report_query(const doctest::QueryData&) override {}
+    void test_run_start() override {}
+    void test_run_end(const doctest::TestRunStats& stats) override {
+        selected_test_cases = stats.numTestCasesPassingFilters;
+    }
+    void test_case_start(const doctest::TestCaseData&) override {}
+    void test_case_reenter(const doctest::TestCaseData&) override {}
+    void test_case_end(const doctest::CurrentTestCaseStats&) override {}
+    void test_case_exception(const doctest::TestCaseException&) override {}
+    void subcase_start(const doctest::SubcaseSignature&) override {}
+    void subcase_end() override {}
+    void log_assert(const doctest::AssertData&) override {}
+    void log_message(const doctest::MessageData&) override {}
+    void test_case_skipped(const doctest::TestCaseData&) override {}
+};
+REGISTER_LISTENER("selected_count", 1, SelectedCount);
+
+} // namespace
+
+int main(int argc, char** argv) {
+    doctest::Context context;
+    const char* skipped_suites = std::getenv("BBM_SKIP_TEST_SUITES");
+    const bool skipping = skipped_suites != nullptr && *skipped_suites != '\0';
+    if (skipping) context.addFilter("test-suite-exclude", skipped_suites);
+    context.applyCommandLine(argc, argv);
+    const int result = context.run();
+    if (context.shouldExit()) return result;
+    constexpr int skipped = 77; // CTest's SKIP_RETURN_CODE for these tests
+    if (skipping && result == 0 && selected_test_cases == 0) return skipped;
+    return result;
+}

@@ -14,6 +14,7 @@
 #include "meshing/blocks.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
 #include <cmath>
 #include <random>
@@ -82,12 +83,12 @@ double real_joint_length(const ModelGeometrySpec& spec, GenerationStats& st, int
 
 } // namespace
 
-TEST_CASE("random networks 1-50 are cut exactly: the blocks tile the region, every trace is joints, no tip inside a block") {
+TEST_CASE("random networks 1-50 are cut exactly: the blocks tile the region, every trace is joints, no tip inside a block" * validation) {
     random_networks(1, 50);
 }
-TEST_CASE("random networks 51-100 are cut exactly") { random_networks(51, 50); }
-TEST_CASE("random networks 101-150 are cut exactly") { random_networks(101, 50); }
-TEST_CASE("random networks 151-200 are cut exactly") { random_networks(151, 50); }
+TEST_CASE("random networks 51-100 are cut exactly" * validation) { random_networks(51, 50); }
+TEST_CASE("random networks 101-150 are cut exactly" * validation) { random_networks(101, 50); }
+TEST_CASE("random networks 151-200 are cut exactly" * validation) { random_networks(151, 50); }
 
 TEST_CASE("traces on a coarse grid: shared ends, T-junctions, overlaps and traces along the edge are cut exactly") {
     // Coordinates on a 0.25 m grid make every degeneracy happen: traces that share

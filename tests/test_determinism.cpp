@@ -63,75 +63,20 @@ TEST_CASE("the contact pass's shares: every work item to one thread, in order, a
 }
 
 // The state each ends in on 1 thread is recorded (tests/recorded_states.json):
-// here 2 threads are checked against it, in the long suite 1 and 3 (an odd split
-// of every batch; test_determinism_long.cpp). Running 1, 2 and 3 threads here was
-// 321 s of the default suite.
+// here the examples and the trigon tunnel are checked on 2 threads and the lab
+// tests on 3 (an odd split of every batch), in the long suite all of them on 1 and
+// 3 (test_determinism_long.cpp). Running 1, 2 and 3 threads here was 321 s of the
+// default suite.
 TEST_CASE("every shipped example ends in the recorded state on 2 threads") {
     CHECK(test::check_examples_on({2}) >= 20);
 }
 
-TEST_CASE("the trigon tunnel, past its first 900 cracks, ends in the recorded state on 2 and 3 threads") {
-    const auto model = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/tunnel_trigon.toml");
-    const auto blocks = meshing::generate_blocks(model.geometry);
-    test::RecordedStates recorded;
-    for (int threads : test::threads_to_run({2, 3})) {
-        const Outcome o = run_model(model, blocks, threads);
-        INFO(threads << " threads: " << outcome_text(o));
-        CHECK(o.tensile + o.shear > 900); // 952 (461 / 491) with face shear on the far field's interface
-        recorded.check("examples/tunnel_trigon.toml, to its end", test::outcome_json(o));
-    }
+TEST_CASE("the trigon tunnel, past its first 900 cracks, ends in the recorded state on 2 threads") {
+    test::check_trigon_tunnel_on({2});
 }
 
-/// A lab test's outcome, its curve point by point folded into one hash.
-nlohmann::json labtest_json(const LabTestResult& r) {
-    std::uint64_t curve = 1469598103934665603ull; // FNV-1a over the bits of every point
-    auto fold = [&](double v) {
-        std::uint64_t bits;
-        std::memcpy(&bits, &v, 8);
-        for (int b = 0; b < 8; ++b) curve = (curve ^ ((bits >> (8 * b)) & 0xff)) * 1099511628211ull;
-    };
-    for (const auto& p : r.curve) fold(p.axial_stress), fold(p.axial_strain), fold(p.lateral_strain);
-    return {{"steps", r.steps},
-            {"peak_stress", r.peak_stress},
-            {"E", r.E},
-            {"cracks_tensile", r.cracks_tensile},
-            {"cracks_shear", r.cracks_shear},
-            {"curve_points", r.curve.size()},
-            {"curve_hash", curve}};
-}
-
-TEST_CASE("lab tests end in the recorded curve and cracks on 2 and 3 threads") {
-    using Kind = LabTestOptions::Kind;
-    auto small = [](Kind kind) {
-        auto o = LabTestOptions::paper_ucs();
-        o.kind = kind;
-        o.width = 2.0, o.height = 4.0;
-        if (kind == Kind::brazilian) o.width = 2.0;
-        if (kind == Kind::biaxial) o.confinement = 2e6;
-        o.frame_every = 0;
-        return o;
-    };
-    std::vector<std::pair<std::string, LabTestOptions>> tests = {
-        {"ucs", small(Kind::ucs)},     {"tension", small(Kind::tension)},
-        {"biaxial", small(Kind::biaxial)}, {"brazilian", small(Kind::brazilian)}};
-    auto deformable = small(Kind::ucs);
-    deformable.deformable_fraction = 0.5;
-    tests.push_back({"ucs, deformable blocks f = 0.5", deformable});
-    auto trigon = small(Kind::ucs);
-    trigon.pattern = meshing::PatternSpec::Kind::trigon;
-    trigon.joint.kn = 162e9, trigon.joint.ks = 68e9;
-    tests.push_back({"ucs, trigon", trigon});
-    test::RecordedStates recorded;
-    for (auto& test_case : tests)
-        for (int threads : test::threads_to_run({2, 3})) {
-            const std::string& name = test_case.first;
-            LabTestOptions& options = test_case.second;
-            options.threads = threads;
-            const LabTestResult r = run_labtest(options);
-            INFO(name << " on " << threads << " threads");
-            CHECK(r.cracks_tensile + r.cracks_shear > 0);
-            recorded.check("lab test: " + name, labtest_json(r));
-        }
+TEST_CASE("lab tests end in the recorded curve and cracks on 3 threads") {
+    test::check_lab_tests_on({3});
 }
 
 // Exact restart on another thread count (issue 27; tests/restart.hpp): stopped on

@@ -11,6 +11,7 @@
 #include "studies/sweep.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -72,7 +73,7 @@ void angles_and_lengths(const FractureNetwork& net, int k, double mean, std::vec
 
 } // namespace
 
-TEST_CASE("a fracture set has the asked P21, and its angles and lengths follow the asked laws") {
+TEST_CASE("a fracture set has the asked P21, and its angles and lengths follow the asked laws" * validation) {
     // 200 m × 200 m, P21 = 1 /m: about 17,000 fractures centred inside. The
     // sampling error of P21 is about CV(L)/√N ≈ 1%; the test asks 3%.
     const auto domain = square(200.0);

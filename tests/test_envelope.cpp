@@ -6,6 +6,7 @@
 #include "studies/model_rock.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -115,7 +116,7 @@ TEST_CASE("envelope: a strength record is read in MPa with its header, and a bad
     CHECK_THROWS_WITH(read_strength_record((dir / "bad.csv").string()), doctest::Contains("bad.csv:3"));
 }
 
-TEST_CASE("envelope of a small Voronoi specimen: strength rises with confinement, the fits and ratios are reported") {
+TEST_CASE("envelope of a small Voronoi specimen: strength rises with confinement, the fits and ratios are reported" * validation) {
     EnvelopeStudy study = run_envelope_args(
         {"--width", "2", "--height", "4", "--confinements", "2e6,5e6", "--threads", "1", "--realizations", "1"}, true);
     const auto& runs = study.runs;
@@ -202,7 +203,7 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
     }
 }
 
-TEST_CASE("compare --envelope and envelope --model measure a model's rock exactly as bbm envelope does on the same specimen") {
+TEST_CASE("compare --envelope and envelope --model measure a model's rock exactly as bbm envelope does on the same specimen" * validation) {
     const std::string model = std::string(BBM_SOURCE_DIR) + "/examples/compare_rigid_deformable/rigid.toml";
     const auto out = std::filesystem::temp_directory_path() / "bbm_test_compare_envelope";
     std::filesystem::remove_all(out);

@@ -10,6 +10,7 @@
 #include "meshing/fe_mesh.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
 #include <vtkCellData.h>
 #include <vtkNew.h>
@@ -337,7 +338,7 @@ type = "elastic"
     CHECK_THROWS_WITH_AS(s.solve_elastic(), doctest::Contains("floats"), std::runtime_error);
 }
 
-TEST_CASE("fem: the interface of a bonded-block region with the elastic far field carries a uniform stress") {
+TEST_CASE("fem: the interface of a bonded-block region with the elastic far field carries a uniform stress" * validation) {
     // Issue 24: the paper's tunnel model without its opening (a 8 m x 16 m region
     // of 0.3 m rigid Voronoi blocks with the calibrated joints inside gmsh
     // triangles), in a uniform field sxx = -10, syy = -15, sxy = 0 MPa, no gravity.

@@ -10,6 +10,7 @@
 #include "studies/labtest.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
 #include <cmath>
 #include <map>
@@ -68,7 +69,7 @@ TEST_CASE("heterogeneous strengths: joints fall evenly into the classes, the sam
     CHECK(chi2 < 24.3); // chi-square, 7 degrees of freedom, 0.1%
 }
 
-TEST_CASE("heterogeneous strengths: a weaker rock that cracks earlier (4 x 8 m, seed 1)") {
+TEST_CASE("heterogeneous strengths: a weaker rock that cracks earlier (4 x 8 m, seed 1)" * validation) {
     LabTestOptions o = LabTestOptions::paper_ucs();
     o.width = 4.0, o.height = 8.0;
     o.threads = 2;

@@ -6,6 +6,7 @@
 #include "studies/shear.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -30,7 +31,7 @@ ShearTestOptions shear_specimen(meshing::PatternSpec::Kind pattern, double size)
 
 } // namespace
 
-TEST_CASE("direct shear: a planar unbonded joint slides at its Coulomb strength, sigma_n tan(phi)") {
+TEST_CASE("direct shear: a planar unbonded joint slides at its Coulomb strength, sigma_n tan(phi)" * validation) {
     // Rigid halves (one block each): one contact, exact to the servo's error.
     for (double sn : {1e6, 5e6, 10e6}) {
         auto o = shear_specimen(meshing::PatternSpec::Kind::single, 0.1);
@@ -112,7 +113,7 @@ TEST_CASE("direct shear: bad options name their flag") {
     CHECK(key_of({"--normal-stress", "-1e6"}) == "shear");
 }
 
-TEST_CASE("direct shear: rock bridges make a joint stronger, the more of them the stronger") {
+TEST_CASE("direct shear: rock bridges make a joint stronger, the more of them the stronger" * validation) {
     // Persistence 1, 0.5 and 0 (intact) at 5 MPa, two patterns (seeds). Measured
     // (0.2 m blocks, 6 mm): seed 1 2.89 / 6.68 / 7.70 MPa, seed 2 2.89 / 8.09 / 9.69 MPa.
     for (std::uint64_t seed : {1, 2}) {

@@ -8,6 +8,7 @@
 #include "tests/restart.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -63,7 +64,7 @@ TEST_CASE("tunnel: Kirsch reference values of SPEC §8") {
     CHECK(kirsch_hoop(6.0, false) == doctest::Approx(10.3).epsilon(0.005));
 }
 
-TEST_CASE("tunnel: elastic Voronoi model — hoop stress within 15% of Kirsch at 5, 6 and 8 m") {
+TEST_CASE("tunnel: elastic Voronoi model — hoop stress within 15% of Kirsch at 5, 6 and 8 m" * validation) {
     const auto file = read_example("tunnel_elastic.toml");
     const auto blocks = meshing::generate_blocks(file.geometry);
     Solver s(blocks, file.analysis);
@@ -106,7 +107,7 @@ TEST_CASE("tunnel: a run resumed from a checkpoint ends in the same state as an 
     CHECK_THROWS_WITH_AS(wrong.load_state(checkpoint), doctest::Contains("different model"), std::runtime_error);
 }
 
-TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown") {
+TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown" * validation) {
     const auto r = run_tunnel("tunnel_trigon.toml", 8000); // the failure is well developed by then
     const auto& m = r.opening;
     MESSAGE("cracks " << r.tensile << " tensile, " << r.shear << " shear; springline sector " << m.cracks_springline_sector
@@ -121,7 +122,7 @@ TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown") 
     CHECK(r.verdict.crack_rate > 0.0);
 }
 
-TEST_CASE("tunnel: Voronoi blocks with joints calibrated in bbm (macro friction 25°) fail at the side walls") {
+TEST_CASE("tunnel: Voronoi blocks with joints calibrated in bbm (macro friction 25°) fail at the side walls" * validation) {
     // The joint set bbm calibrate found for the paper's rock including its
     // confined strength (examples/tunnel_voronoi_calibrated.toml); with the
     // paper's UDEC values the Voronoi wall barely breaks (docs/calibration.md).
@@ -243,7 +244,7 @@ TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and ex
     CHECK(std::abs(through.region_edge_point.y) < 6.0 + through.cell);
 }
 
-TEST_CASE("field: the Mine-by model carries its inclined in-situ stress round the tunnel as Kirsch's solution") {
+TEST_CASE("field: the Mine-by model carries its inclined in-situ stress round the tunnel as Kirsch's solution" * validation) {
     // examples/field/mineby.toml (docs/field.md): 60 and 11 MPa, the largest
     // plunging 14 degrees, on all four sides and as the initial state, and a 3.5 m
     // tunnel excavated. Up to the excavation (its 3,000 relaxation steps), the
