@@ -43,6 +43,7 @@
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
 #include "core/model_spec.hpp"
+#include "core/state_fields.hpp"
 #include "core/verdict.hpp"
 #include "fem/cst.hpp"
 #include "meshing/blocks.hpp"
@@ -116,7 +117,7 @@ public:
     void move_bodies(const std::vector<Vec2>& block_displacement, const std::vector<double>& block_rotation,
                      const std::vector<Vec2>& node_displacement);
 
-    // --- checkpoints (core/checkpoint.cpp) -----------------------------------
+    // --- checkpoints (core/state.cpp) -----------------------------------
     /// Writes the evolving state (binary). A solver built from the same model
     /// file and given this state continues exactly as the saved one would.
     void save_state(std::ostream& out) const;
@@ -201,7 +202,12 @@ public:
     const std::vector<std::string>& region_names() const { return region_names_; }
     /// Block lists by boundary name.
     const std::vector<std::pair<std::string, std::vector<int>>>& boundary_blocks() const { return boundary_blocks_; }
+    /// Hash of every field of the state list marked hashed (core/state_fields.hpp):
+    /// equal hashes, the same evolving state bit for bit.
     std::uint64_t state_hash() const;
+    /// Every field of the state list, by name, over its bytes in place (Python's
+    /// Model.state, the tests). Writing through it changes the solver's state.
+    std::vector<StateField> state_fields();
     /// Bytes the solver holds (capacity of its arrays), by what they are indexed by.
     struct Memory {
         std::size_t blocks = 0, vertices = 0, nodes = 0, zones = 0, contacts = 0, other = 0;
@@ -232,9 +238,12 @@ private:
     /// Boundary reactions (boundary_force) from the forces of the last evaluation.
     void sum_boundary_forces();
     void release_relaxation();
+    /// The one list of the state (core/state.cpp): visit(FieldInfo, field&) per field.
     template <class Self, class Visit>
-    static void visit_state(Self& self, Visit&& visit); ///< core/checkpoint.cpp
-    std::uint64_t compute_model_fingerprint() const;    ///< core/checkpoint.cpp
+    static void for_each_field(Self& self, Visit&& visit);
+    std::uint64_t compute_model_fingerprint() const; ///< core/state.cpp
+    /// Per hashed field, its name and the hash of its bytes (load_state's check).
+    std::vector<std::pair<std::string, std::uint64_t>> field_hashes() const;
     void integrate();
     // Bolts (core/bolts.cpp).
     void bolt_pass();                       ///< segment and grout forces, reactions on the rock

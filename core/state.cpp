@@ -1,23 +1,28 @@
-// Checkpoints: the solver's evolving state as a flat binary dump.
+// The solver's state as one list (core/state_fields.hpp), and what walks it:
+// checkpoints, the state hash, the model fingerprint, the memory report and the
+// generic views.
 //
-// What is saved is everything a step reads that the model file does not
+// A checkpoint saves everything a step reads that the model file does not
 // determine: block and node kinematics and (scaled) masses, contacts in their
 // order with their full histories (detection adds and removes them), the count of
 // contacts created since the last renumbering (it decides when the next one
 // happens, and the numbering fixes the order of every sum), zone stresses,
 // relaxation and detection bookkeeping, loads and support velocities that a study
 // may have changed (a lab test's servo, a confinement ramp), time and counters,
-// and the stage monitor's samples (core/verdict.hpp) that the verdict is taken from.
-// Geometry, property sets and the initial boundary conditions are rebuilt from
-// the model file, which generates the same assembly every time; a checkpoint
-// carries its format version, the fingerprint of the model it belongs to, the
-// number of blocks, nodes and zones and the state hash at save time, and refuses
-// to load into a solver built from another model or into another format.
-// Not saved, on purpose: the broad-phase grid of detection (a conservative
-// superset of the pairs within the tolerance, rebuilt on load: which pairs it
-// offers never changes which contacts form) and per-step scratch.
+// installed supports, and the stage monitor's samples (core/verdict.hpp) that the
+// verdict is taken from. Geometry, property sets and the initial boundary
+// conditions are rebuilt from the model file, which generates the same assembly
+// every time; a checkpoint carries its format version, the fingerprint of the
+// model it belongs to, the number of blocks, nodes and zones and the state hash
+// at save time, and refuses to load into a solver built from another model or
+// into another format. Not saved, on purpose: the broad-phase grid of detection
+// (a conservative superset of the pairs within the tolerance, rebuilt on load:
+// which pairs it offers never changes which contacts form) and the fields marked
+// `rebuilt` (indices and per-step scratch).
 #include "core/solver.hpp"
+#include "core/state_fields.hpp"
 
+#include <cstring>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
@@ -29,9 +34,11 @@ namespace {
 // "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
 // count (a resumed run renumbered its contacts at another step: issue 27); 3 the
 // stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners; 5 a
-// constant support pressure (excavate's `pressure`).
+// constant support pressure (excavate's `pressure`); 6 the same fields with a
+// hash of the bolts' and liners' kinematics; 7 the state hash over every saved
+// field (the state-field list).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '6';
+constexpr std::uint64_t format = '7';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -60,78 +67,292 @@ void get(std::istream& i, std::vector<T>& v) {
     i.read(reinterpret_cast<char*>(v.data()), std::streamsize(n * sizeof(T)));
     if (!i) throw std::runtime_error("checkpoint is truncated");
 }
+
+
+/// A field's bytes, for the hash and the fingerprint (a scalar, or a vector's elements).
+template <class T>
+std::span<const std::byte> bytes_of(const T& x) {
+    return std::as_bytes(std::span(&x, 1));
+}
+template <class T>
+std::span<const std::byte> bytes_of(const std::vector<T>& v) {
+    return std::as_bytes(std::span(v.data(), v.size()));
+}
+template <class T>
+struct Element {
+    using type = T;
+};
+template <class T>
+struct Element<std::vector<T>> {
+    using type = T;
+};
+/// The element type of a field (a scalar field is its own element).
+template <class Field>
+using element_t = typename Element<std::remove_cvref_t<Field>>::type;
+
+/// FNV-1a, 64 bits.
+struct Fnv {
+    std::uint64_t h = 1469598103934665603ull;
+    void mix(std::span<const std::byte> bytes) {
+        for (std::byte c : bytes) h = (h ^ std::uint64_t(c)) * 1099511628211ull;
+    }
+    template <class T>
+    void mix_value(const T& v) {
+        mix(std::as_bytes(std::span(&v, 1)));
+    }
+};
 } // namespace
+
+// Records saved and hashed as raw bytes: each fills its size exactly.
+template <>
+struct ElementTraits<contact::JointHistory> : PackedRecordTraits<contact::JointHistory> {};
+static_assert(sizeof(contact::JointHistory) == 7 * 8 + 4 + 4);
+template <>
+struct ElementTraits<BoltHost> : PackedRecordTraits<BoltHost> {};
+static_assert(sizeof(BoltHost) == 2 * sizeof(int) + sizeof(Vec2) + 3 * sizeof(double));
+template <>
+struct ElementTraits<contact::DetectionResult> : PackedRecordTraits<contact::DetectionResult> {};
+static_assert(sizeof(contact::DetectionResult) == 5 * sizeof(int));
+template <>
+struct ElementTraits<fem::Elasticity> : PackedRecordTraits<fem::Elasticity> {};
+static_assert(sizeof(fem::Elasticity) == 2 * sizeof(double));
+template <>
+struct ElementTraits<MonitorSample> : PackedRecordTraits<MonitorSample> {};
+
+/// The one list of the solver's state (core/state_fields.hpp): every array and
+/// scalar it holds, with what it is indexed by and what it is used for. Saved
+/// fields are written in this order (the checkpoint format: change the order or
+/// the saved set and raise `format` above).
+template <class Self, class Visit>
+void Solver::for_each_field(Self& s, Visit&& v) {
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, M = field_use::model, R = field_use::rebuilt;
+    auto& b = s.b_;
+    auto& n = s.n_;
+    auto& z = s.z_;
+    auto& c = s.c_;
+    // Blocks: kinematics and (scaled) masses, then what the model file fixes.
+    v({"blocks.centroid", G::blocks, E}, b.centroid), v({"blocks.velocity", G::blocks, E}, b.velocity);
+    v({"blocks.theta", G::blocks, E}, b.theta), v({"blocks.omega", G::blocks, E}, b.omega);
+    v({"blocks.mass", G::blocks, E}, b.mass), v({"blocks.inertia", G::blocks, E}, b.inertia);
+    v({"blocks.removed", G::blocks, E}, b.removed);
+    // Recomputed from the vertices at the start of every step (deformable blocks)
+    // and by load_state: a value saved after a step's integration is stale.
+    v({"blocks.inv_edge_length", G::vertices, R}, b.inv_edge_length);
+    v({"blocks.local", G::vertices, M}, b.local), v({"blocks.centroid0", G::blocks, M}, b.centroid0);
+    v({"blocks.real_mass", G::blocks, M}, b.real_mass), v({"blocks.fixed", G::blocks, M}, b.fixed);
+    v({"blocks.real_inertia", G::blocks, R}, b.real_inertia), v({"blocks.area", G::blocks, R}, b.area);
+    v({"blocks.deformable", G::blocks, R}, b.deformable), v({"blocks.region", G::blocks, R}, b.region);
+    v({"blocks.material", G::blocks, R}, b.material), v({"blocks.first", G::blocks, R}, b.first);
+    v({"blocks.vertex", G::vertices, R}, b.vertex), v({"blocks.vertex_node", G::vertices, R}, b.vertex_node);
+    v({"blocks.force", G::blocks, R}, b.force), v({"blocks.moment", G::blocks, R}, b.moment);
+    // FE nodes and zones.
+    v({"nodes.position", G::nodes, E}, n.position), v({"nodes.velocity", G::nodes, E}, n.velocity);
+    v({"nodes.mass", G::nodes, E}, n.mass);
+    v({"nodes.position0", G::nodes, M}, n.position0), v({"nodes.real_mass", G::nodes, M}, n.real_mass);
+    v({"nodes.fixed", G::nodes, M}, n.fixed);
+    v({"nodes.block", G::nodes, R}, n.block), v({"nodes.force", G::nodes, R}, n.force);
+    v({"zones.stress", G::zones, E}, z.stress), v({"zones.strain", G::zones, E}, z.strain);
+    v({"zones.elasticity", G::zones, M}, z.elasticity);
+    v({"zones.node", G::zones, R}, z.node), v({"zones.block", G::zones, R}, z.block);
+    v({"zones.density", G::zones, R}, z.density), v({"zones.node_first", G::nodes, R}, z.node_first);
+    v({"zones.node_entry", G::zones, R}, z.node_entry), v({"zones.nodal_force", G::zones, R}, z.nodal_force);
+    v({"zones.partial_sum", G::zones, R}, z.partial_sum);
+    // Contacts in their order, with their histories; then their index and scratch.
+    v({"contacts.vertex_block", G::contacts, E}, c.vertex_block), v({"contacts.vertex_id", G::contacts, E}, c.vertex_id);
+    v({"contacts.edge_block", G::contacts, E}, c.edge_block), v({"contacts.edge_id", G::contacts, E}, c.edge_id);
+    v({"contacts.edge_end", G::contacts, E}, c.edge_end), v({"contacts.length", G::contacts, E}, c.length);
+    v({"contacts.property", G::contacts, E}, c.property), v({"contacts.history", G::contacts, E}, c.history);
+    v({"contacts.normal", G::contacts, R}, c.normal), v({"contacts.force", G::contacts, R}, c.force);
+    v({"contacts.block_first", G::blocks, R}, c.block_first), v({"contacts.block_entry", G::contacts, R}, c.block_entry);
+    v({"contacts.node_first", G::nodes, R}, c.node_first), v({"contacts.node_entry", G::contacts, R}, c.node_entry);
+    v({"contacts.fill", G::contacts, R}, c.fill_), v({"contacts.partial_sum", G::contacts, R}, c.partial_sum);
+    v({"contacts.work", G::contacts, R}, c.work), v({"contacts.work_cost_before", G::contacts, R}, c.work_cost_before);
+    v({"contacts.team_split", G::other, R}, c.team_split);
+    v({"contacts.face_group", G::contacts, R}, c.face_group), v({"contacts.face_first", G::contacts, R}, c.face_first);
+    v({"contacts.face_entry", G::contacts, R}, c.face_entry), v({"contacts.face_du_s", G::contacts, R}, c.face_du_s);
+    v({"contacts.face_scratch", G::contacts, R}, c.face_scratch);
+    // Excavation: support forces being relaxed, and a constant support pressure.
+    v({"relax.block_force", G::blocks, E}, s.relax_block_force_);
+    v({"relax.block_moment", G::blocks, E}, s.relax_block_moment_);
+    v({"relax.node_force", G::nodes, E}, s.relax_node_force_);
+    v({"relax.total_steps", G::other, E}, s.relax_total_), v({"relax.steps_left", G::other, E}, s.relax_left_);
+    v({"relax.keep", G::other, E}, s.relax_keep_);
+    v({"pressure.block_force", G::blocks, E}, s.pressure_block_force_);
+    v({"pressure.block_moment", G::blocks, E}, s.pressure_block_moment_);
+    v({"pressure.node_force", G::nodes, E}, s.pressure_node_force_);
+    // Time and counters.
+    v({"solver.timestep", G::other, E}, s.dt_), v({"solver.time", G::other, E}, s.time_);
+    v({"solver.ratio", G::other, E}, s.ratio_), v({"solver.work", G::other, E}, s.work_);
+    v({"solver.steps", G::other, E}, s.steps_);
+    v({"boundaries.force", G::other, E}, s.boundary_force_);
+    // Detection: where each body was at its last pass, which bodies moved since.
+    v({"detection.detected_at", G::blocks, E}, s.detected_at_);
+    v({"detection.detected_theta", G::blocks, E}, s.detected_theta_);
+    v({"detection.detected_vertex", G::vertices, E}, s.detected_vertex_);
+    v({"detection.active", G::blocks, E}, s.active_);
+    v({"detection.totals", G::other, E}, s.detection_totals_);
+    v({"detection.unsorted_contacts", G::other, E}, s.unsorted_contacts_);
+    v({"solver.first_timestep", G::other, E}, s.first_dt_);
+    v({"detection.radius", G::blocks, R}, s.radius_), v({"detection.junctions", G::other, R}, s.junctions_);
+    // Loads and support velocities: constant in a model file's stages, moved by
+    // lab tests (the servo's platen speed, the confinement ramp).
+    v({"blocks.fixed_velocity", G::blocks, E | M}, b.fixed_velocity);
+    v({"blocks.fixed_omega", G::blocks, E}, b.fixed_omega);
+    v({"blocks.applied", G::blocks, E | M}, b.applied), v({"blocks.applied_moment", G::blocks, E}, b.applied_moment);
+    v({"nodes.fixed_velocity", G::nodes, E}, n.fixed_velocity), v({"nodes.applied", G::nodes, E | M}, n.applied);
+    v({"properties.face_shear", G::other, M}, s.face_shear_);
+    // Installed bolts (core/bolts.hpp): nodes, their ties to the rock, segments.
+    auto& B = s.bolts_;
+    v({"bolts.installed", G::other, E}, B.installed), v({"bolts.position", G::other, E}, B.position);
+    v({"bolts.velocity", G::other, E}, B.velocity), v({"bolts.applied", G::other, E}, B.applied);
+    v({"bolts.mass", G::other, E}, B.mass), v({"bolts.length", G::other, E}, B.length);
+    v({"bolts.slip", G::other, E}, B.slip), v({"bolts.bond", G::other, E}, B.bond), v({"bolts.host", G::other, E}, B.host);
+    v({"bolts.tied", G::other, E}, B.tied), v({"bolts.node_set", G::other, E}, B.node_set);
+    v({"bolts.segment_node", G::other, E}, B.segment_node), v({"bolts.rest", G::other, E}, B.rest);
+    v({"bolts.plastic", G::other, E}, B.plastic), v({"bolts.axial", G::other, E}, B.axial);
+    v({"bolts.state", G::other, E}, B.state), v({"bolts.first", G::other, E}, B.first);
+    v({"bolts.bolt_set", G::other, E}, B.bolt_set);
+    v({"bolts.force", G::other, R}, B.force), v({"bolts.reaction", G::other, R}, B.reaction);
+    v({"bolts.reaction_moment", G::other, R}, B.reaction_moment);
+    // Installed liners (core/liners.hpp).
+    auto& L = s.liners_;
+    v({"liners.installed", G::other, E}, L.installed), v({"liners.position", G::other, E}, L.position);
+    v({"liners.velocity", G::other, E}, L.velocity), v({"liners.theta", G::other, E}, L.theta);
+    v({"liners.omega", G::other, E}, L.omega), v({"liners.mass", G::other, E}, L.mass);
+    v({"liners.inertia", G::other, E}, L.inertia), v({"liners.length", G::other, E}, L.length);
+    v({"liners.shear_slip", G::other, E}, L.shear_slip), v({"liners.host", G::other, E}, L.host);
+    v({"liners.separated", G::other, E}, L.separated), v({"liners.normal_stress", G::other, E}, L.normal_stress);
+    v({"liners.node_set", G::other, E}, L.node_set), v({"liners.held", G::other, E}, L.held);
+    v({"liners.element_node", G::other, E}, L.element_node), v({"liners.rest", G::other, E}, L.rest);
+    v({"liners.chord0", G::other, E}, L.chord0), v({"liners.thrust", G::other, E}, L.thrust);
+    v({"liners.moment_a", G::other, E}, L.moment_a), v({"liners.moment_b", G::other, E}, L.moment_b);
+    v({"liners.plastic_strain", G::other, E}, L.plastic_strain);
+    v({"liners.plastic_rotation_a", G::other, E}, L.plastic_rotation_a);
+    v({"liners.plastic_rotation_b", G::other, E}, L.plastic_rotation_b);
+    v({"liners.yielded", G::other, E}, L.yielded), v({"liners.first", G::other, E}, L.first);
+    v({"liners.liner_set", G::other, E}, L.liner_set), v({"liners.closed", G::other, E}, L.closed);
+    v({"liners.force", G::other, R}, L.force), v({"liners.moment", G::other, R}, L.moment);
+    v({"liners.reaction", G::other, R}, L.reaction), v({"liners.reaction_moment", G::other, R}, L.reaction_moment);
+    // Supports' ties to the rock and their stiffness (index_bolt_hosts, update_timestep).
+    v({"supports.bolt_stiffness", G::other, R}, s.bolt_stiffness_);
+    v({"supports.liner_stiffness", G::other, R}, s.liner_stiffness_);
+    v({"supports.liner_rotation_stiffness", G::other, R}, s.liner_rotation_stiffness_);
+    v({"supports.block_first", G::other, R}, s.bolt_block_first_), v({"supports.block_tie", G::other, R}, s.bolt_block_tie_);
+    v({"supports.node_first", G::other, R}, s.bolt_node_first_), v({"supports.node_tie", G::other, R}, s.bolt_node_tie_);
+    // The step's scratch: packed body state, stiffness, partial sums, thread balance.
+    v({"step.body", G::blocks, R}, s.body_), v({"step.chunk_sums", G::other, R}, s.chunk_sums_);
+    v({"step.block_stiffness", G::blocks, R}, s.stiffness_scratch_.block);
+    v({"step.rotation_stiffness", G::blocks, R}, s.stiffness_scratch_.rotation);
+    v({"step.node_stiffness", G::nodes, R}, s.stiffness_scratch_.node);
+    v({"step.block_cost_before", G::blocks, R}, s.block_cost_before_);
+    v({"step.place_cost_before", G::blocks, R}, s.place_cost_before_);
+    v({"step.chunk_cost_before", G::other, R}, s.chunk_cost_before_);
+    v({"step.pass_time", G::other, R}, s.pass_time_), v({"step.balance_scratch", G::other, R}, s.balance_scratch_);
+    // What the stage did so far, for its verdict (not physics: not in the state hash).
+    v({"monitor.samples", G::other, field_use::saved}, s.monitor_.samples_);
+}
 
 std::uint64_t Solver::compute_model_fingerprint() const {
     // What the model file fixes: initial geometry, masses (materials), supports,
     // loads and property sets. Taken when the solver is built, before a study
     // changes loads or support velocities.
-    std::uint64_t h = 1469598103934665603ull;
-    auto mix = [&](const void* p, std::size_t n) {
-        const auto* c = static_cast<const unsigned char*>(p);
-        for (std::size_t k = 0; k < n; ++k) h = (h ^ c[k]) * 1099511628211ull;
-    };
-    auto vec = [&](const auto& v) { mix(v.data(), v.size() * sizeof(v[0])); };
-    vec(b_.local), vec(b_.centroid0), vec(b_.real_mass), vec(b_.fixed), vec(b_.fixed_velocity), vec(b_.applied);
-    vec(n_.position0), vec(n_.real_mass), vec(n_.fixed), vec(n_.applied), vec(z_.elasticity), vec(face_shear_);
+    Fnv h;
+    for_each_field(*this, [&](const FieldInfo& f, const auto& x) {
+        if constexpr (ElementTraits<element_t<decltype(x)>>::padding_free) {
+            if (f.uses & field_use::model) h.mix(bytes_of(x));
+        } else {
+            if (f.uses & field_use::model) throw std::logic_error(std::string("unhashable field ") + f.name);
+        }
+    });
     for (const auto& set : bolts_.sets) {
         const double p[9] = {set.ea, set.yield_force, set.rupture_strain, set.bond_stiffness, set.bond_strength,
                              set.normal_stiffness, set.line_mass, set.spacing, double(set.cable)};
-        mix(p, sizeof p);
+        h.mix_value(p);
     }
     for (const auto& set : liners_.sets) {
         const double p[13] = {set.ea, set.ei, set.line_mass, set.line_inertia, set.kn, set.ks, set.tensile,
                               set.cohesion, set.tan_friction, set.thrust_capacity, set.tension_capacity,
                               set.moment_capacity, double(set.symmetric_ends)};
-        mix(p, sizeof p);
+        h.mix_value(p);
     }
     for (const auto& law : laws_) {
         const double k[2] = {contact::normal_stiffness(law), contact::shear_stiffness(law)};
-        mix(k, sizeof k);
+        h.mix_value(k);
     }
-    return h;
+    return h.h;
 }
 
-/// Every evolving array and scalar, in checkpoint order: save and load walk the
-/// same list, so they cannot drift apart.
-template <class Self, class Visit>
-void Solver::visit_state(Self& s, Visit&& v) {
-    v(s.b_.centroid), v(s.b_.velocity), v(s.b_.theta), v(s.b_.omega);
-    v(s.b_.mass), v(s.b_.inertia), v(s.b_.removed), v(s.b_.inv_edge_length);
-    v(s.n_.position), v(s.n_.velocity), v(s.n_.mass);
-    v(s.z_.stress), v(s.z_.strain);
-    v(s.c_.vertex_block), v(s.c_.vertex_id), v(s.c_.edge_block), v(s.c_.edge_id), v(s.c_.edge_end);
-    v(s.c_.length), v(s.c_.property), v(s.c_.history);
-    v(s.relax_block_force_), v(s.relax_block_moment_), v(s.relax_node_force_), v(s.relax_total_), v(s.relax_left_), v(s.relax_keep_);
-    v(s.pressure_block_force_), v(s.pressure_block_moment_), v(s.pressure_node_force_);
-    v(s.dt_), v(s.time_), v(s.ratio_), v(s.work_), v(s.steps_);
-    v(s.boundary_force_);
-    v(s.detected_at_), v(s.detected_theta_), v(s.detected_vertex_), v(s.active_);
-    v(s.detection_totals_), v(s.unsorted_contacts_), v(s.first_dt_);
-    // Loads and support velocities: constant in a model file's stages, moved by
-    // lab tests (the servo's platen speed, the confinement ramp).
-    v(s.b_.fixed_velocity), v(s.b_.fixed_omega), v(s.b_.applied), v(s.b_.applied_moment);
-    v(s.n_.fixed_velocity), v(s.n_.applied);
-    // Installed bolts (core/bolts.hpp): nodes, their ties to the rock, segments.
-    auto& B = s.bolts_;
-    v(B.installed), v(B.position), v(B.velocity), v(B.applied), v(B.mass), v(B.length), v(B.slip), v(B.bond), v(B.host);
-    v(B.tied), v(B.node_set), v(B.segment_node), v(B.rest), v(B.plastic), v(B.axial), v(B.state);
-    v(B.first), v(B.bolt_set);
-    auto& L = s.liners_;
-    v(L.installed), v(L.position), v(L.velocity), v(L.theta), v(L.omega), v(L.mass), v(L.inertia), v(L.length);
-    v(L.shear_slip), v(L.host), v(L.separated), v(L.normal_stress), v(L.node_set), v(L.held);
-    v(L.element_node), v(L.rest), v(L.chord0), v(L.thrust), v(L.moment_a), v(L.moment_b);
-    v(L.plastic_strain), v(L.plastic_rotation_a), v(L.plastic_rotation_b), v(L.yielded);
-    v(L.first), v(L.liner_set), v(L.closed);
-    // What the stage did so far, for its verdict (not physics: not in the state hash).
-    v(s.monitor_.samples_);
+std::uint64_t Solver::state_hash() const {
+    // Every hashed field, its length and then its bytes (no padding in any: the
+    // static_assert below), in list order.
+    Fnv h;
+    for_each_field(*this, [&](const FieldInfo& f, const auto& x) {
+        using T = element_t<decltype(x)>;
+        if constexpr (ElementTraits<T>::padding_free) {
+            if (f.uses & field_use::hashed) {
+                h.mix_value(std::uint64_t(bytes_of(x).size()));
+                h.mix(bytes_of(x));
+            }
+        } else {
+            // A field whose elements have padding bytes cannot be hashed (their
+            // value is not defined): only rebuilt and unhashed fields may be such.
+            if (f.uses & field_use::hashed) throw std::logic_error(std::string("unhashable field ") + f.name);
+        }
+    });
+    return h.h;
+}
+
+Solver::Memory Solver::memory() const {
+    Memory m;
+    auto group = [&](MemoryGroup g) -> std::size_t& {
+        switch (g) {
+        case MemoryGroup::blocks: return m.blocks;
+        case MemoryGroup::vertices: return m.vertices;
+        case MemoryGroup::nodes: return m.nodes;
+        case MemoryGroup::zones: return m.zones;
+        case MemoryGroup::contacts: return m.contacts;
+        case MemoryGroup::other: break;
+        }
+        return m.other;
+    };
+    for_each_field(*this, [&](const FieldInfo& f, const auto& x) {
+        if constexpr (requires { x.capacity(); }) group(f.group) += x.capacity() * sizeof(x[0]);
+    });
+    for (const auto& batch : c_.batches) m.contacts += batch.capacity() * sizeof(int);
+    return m;
+}
+
+std::vector<StateField> Solver::state_fields() {
+    std::vector<StateField> fields;
+    for_each_field(*this, [&](const FieldInfo& f, auto& x) {
+        using T = element_t<decltype(x)>;
+        StateField out;
+        out.name = f.name, out.group = f.group, out.uses = f.uses;
+        out.type = ElementTraits<T>::type, out.components = ElementTraits<T>::components;
+        out.element_size = sizeof(T);
+        if constexpr (requires { x.capacity(); }) {
+            out.bytes = std::as_writable_bytes(std::span(x.data(), x.size()));
+            out.capacity_bytes = x.capacity() * sizeof(T);
+        } else {
+            out.bytes = std::as_writable_bytes(std::span(&x, 1));
+        }
+        fields.push_back(std::move(out));
+    });
+    return fields;
 }
 
 void Solver::save_state(std::ostream& o) const {
     put(o, magic);
     put(o, std::int64_t(b_.count())), put(o, std::int64_t(n_.count())), put(o, std::int64_t(z_.size()));
     put(o, fingerprint_);
-    visit_state(*this, [&](const auto& x) { put(o, x); });
+    for_each_field(*this, [&](const FieldInfo& f, const auto& x) {
+        if constexpr (std::is_trivially_copyable_v<element_t<decltype(x)>>) {
+            if (f.uses & field_use::saved) put(o, x);
+        } else {
+            if (f.uses & field_use::saved) throw std::logic_error(std::string("unsavable field ") + f.name);
+        }
+    });
     put(o, state_hash());
     if (!o) throw std::runtime_error("cannot write the checkpoint");
 }
@@ -156,9 +377,15 @@ void Solver::load_state(std::istream& i) {
     if (fingerprint != fingerprint_)
         throw std::runtime_error("checkpoint is of a different model (same counts, but the geometry, materials, "
                                  "joint properties or boundaries differ: was the model file edited?)");
-    visit_state(*this, [&](auto& x) { get(i, x); });
+    for_each_field(*this, [&](const FieldInfo& f, auto& x) {
+        if constexpr (std::is_trivially_copyable_v<element_t<decltype(x)>>) {
+            if (f.uses & field_use::saved) get(i, x);
+        }
+    });
     std::uint64_t hash = 0;
     get(i, hash);
+    if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
+    const auto loaded = field_hashes();
     c_.normal.resize(c_.size());
     bolts_.force.assign(bolts_.position.size(), {});
     liners_.force.assign(liners_.position.size(), {});
@@ -170,7 +397,27 @@ void Solver::load_state(std::istream& i) {
     update_vertices(); // the faces of assign_face_groups are read off the current geometry
     rebuild_contact_index();
     detector_.invalidate();
-    if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
+    // What was loaded must not be recomputed: a field that is (an index, a value
+    // derived from the vertices) belongs in the list as `rebuilt`.
+    const auto now = field_hashes();
+    for (std::size_t k = 0; k < now.size(); ++k)
+        if (now[k].second != loaded[k].second)
+            throw std::logic_error("the state list marks " + now[k].first +
+                                   " as saved and hashed, but loading a checkpoint recomputes it");
+}
+
+std::vector<std::pair<std::string, std::uint64_t>> Solver::field_hashes() const {
+    std::vector<std::pair<std::string, std::uint64_t>> out;
+    for_each_field(*this, [&](const FieldInfo& f, const auto& x) {
+        if constexpr (ElementTraits<element_t<decltype(x)>>::padding_free) {
+            if (f.uses & field_use::hashed) {
+                Fnv h;
+                h.mix(bytes_of(x));
+                out.emplace_back(f.name, h.h);
+            }
+        }
+    });
+    return out;
 }
 
 } // namespace bbm

@@ -98,7 +98,7 @@ public:
     bool at_rest(double target_ratio, long quiet_steps) const;
 
 private:
-    friend class Solver; // the samples are part of its checkpoint (core/checkpoint.cpp)
+    friend class Solver; // the samples are part of its checkpoint (core/state.cpp)
     std::vector<MonitorSample> samples_;
 };
 

@@ -27,6 +27,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <cstring>
 #include <mutex>
 #include <optional>
 
@@ -142,6 +143,41 @@ py::dict frame_snapshot(const Solver& s, const StressStrainPoint& p, int realiza
                                                   "block_pair", "length", "normal", "position", "edge_parameter"});
     d["property_names"] = s.property_names();
     return d;
+}
+
+/// A field of the solver's state list (core/state_fields.hpp) as a numpy copy:
+/// shape (count,) or (count, components); records as their bytes (uint8).
+py::array state_field_array(const StateField& f) {
+    auto dtype = [&]() -> py::dtype {
+        switch (f.type) {
+        case ScalarType::f64: return py::dtype::of<double>();
+        case ScalarType::f32: return py::dtype::of<float>();
+        case ScalarType::i32: return py::dtype::of<std::int32_t>();
+        case ScalarType::i64: return py::dtype::of<std::int64_t>();
+        case ScalarType::u32: return py::dtype::of<std::uint32_t>();
+        case ScalarType::u64: return py::dtype::of<std::uint64_t>();
+        case ScalarType::u8:
+        case ScalarType::record: break;
+        }
+        return py::dtype::of<std::uint8_t>();
+    }();
+    std::vector<py::ssize_t> shape{py::ssize_t(f.size())};
+    if (f.components > 1) shape.push_back(f.components);
+    py::array out(dtype, shape);
+    if (!f.bytes.empty()) std::memcpy(out.mutable_data(), f.bytes.data(), f.bytes.size());
+    return out;
+}
+
+const char* group_name(MemoryGroup g) {
+    switch (g) {
+    case MemoryGroup::blocks: return "blocks";
+    case MemoryGroup::vertices: return "vertices";
+    case MemoryGroup::nodes: return "nodes";
+    case MemoryGroup::zones: return "zones";
+    case MemoryGroup::contacts: return "contacts";
+    case MemoryGroup::other: break;
+    }
+    return "other";
 }
 
 } // namespace
@@ -465,6 +501,24 @@ PYBIND11_MODULE(_bbm, mod) {
         .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
         .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
         .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })
+        .def("state_fields", [](Model& m) {
+                 py::list out;
+                 for (const auto& f : m.solver().state_fields()) {
+                     py::dict d;
+                     d["name"] = f.name, d["indexed_by"] = group_name(f.group), d["count"] = f.size();
+                     d["saved"] = bool(f.uses & field_use::saved), d["hashed"] = bool(f.uses & field_use::hashed);
+                     d["model"] = bool(f.uses & field_use::model), d["bytes"] = f.capacity_bytes;
+                     out.append(d);
+                 }
+                 return out;
+             },
+             "Every field of the solver's state list, as the checkpoint, state hash and memory report see it: "
+             "name, what it is indexed by, count, whether saved / hashed / fixed by the model file, bytes held.")
+        .def("state", [](Model& m, const std::string& name) {
+                 for (const auto& f : m.solver().state_fields())
+                     if (f.name == name) return state_field_array(f);
+                 throw py::key_error("no state field '" + name + "' (Model.state_fields() lists them)");
+             }, py::arg("name"), "A copy of one field of the state list (Model.state_fields()) as a numpy array.")
         .def_property_readonly("state_hash", [](const Model& m) { return std::to_string(m.solver().state_hash()); },
                                "The hash summary.json reports: equal hashes, equal states")
         .def_property_readonly("cracks", [](const Model& m) {

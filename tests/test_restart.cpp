@@ -9,7 +9,12 @@
 #include "tests/restart.hpp"
 
 #include <doctest/doctest.h>
+#include "tests/validation.hpp"
 
+#include <algorithm>
+#include <array>
+#include <set>
+#include <sstream>
 #include <string>
 
 using namespace bbm;
@@ -25,7 +30,7 @@ test::RestartModel example(const std::string& name, long max_steps) {
 
 } // namespace
 
-TEST_CASE("restart: the trigon tunnel stopped at 6 steps of its excavation and failure resumes exactly") {
+TEST_CASE("restart: the trigon tunnel stopped at 6 steps of its excavation and failure resumes exactly" * validation) {
     // Excavation: steps 1-3000; failure from 3001, cut at 9000 (contacts are
     // renumbered at step 5969 on the way: the step a run resumed from 1413 used
     // to part from the uninterrupted one).
@@ -40,9 +45,88 @@ TEST_CASE("restart: a lab test stopped before, at and after its peak resumes exa
     test::check_exact_restart(test::labtest_model(o, 13000), {4500, 8500, 9800, 10500, 12000}, {1});
 }
 
-TEST_CASE("restart: a deformable lab test (f = 0.95, 2 x 4 m) stopped in failure resumes exactly") {
+TEST_CASE("restart: a deformable lab test (f = 0.95, 2 x 4 m) stopped in failure resumes exactly" * validation) {
     // Peak near step 7,000 (about 29 MPa); contacts form from about 10,000.
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.deformable_fraction = 0.95;
     test::check_exact_restart(test::labtest_model(o, 13000), {3500, 7000, 10500, 12000}, {1});
+}
+
+// The state-field list (core/state_fields.hpp): one list that the checkpoint, the
+// state hash and the memory report walk. Every evolving field, perturbed by one
+// bit, changes the hash and the checkpoint's bytes, and a checkpoint loaded into a
+// new solver restores it; every field's bytes are in the memory report's group.
+// A field added to the list with the wrong use, or added to one walker and not
+// the list, fails here. Model: bolts, a liner, an elastic far field of FE nodes
+// and zones, mid-relaxation (every kind of state non-empty).
+TEST_CASE("every field of the state list is saved, hashed and counted") {
+    auto m = example("support/tunnel_trigon_bolted_shotcrete.toml", 200);
+    Solver solver(m.blocks, m.analysis);
+    struct Quiet : StageObserver {} quiet;
+    run_stages(solver, m.analysis.stages, quiet);
+    REQUIRE(solver.bolts().node_count() > 0);
+    REQUIRE(solver.liners().node_count() > 0);
+    REQUIRE(solver.nodes().count() > 0);
+
+    auto fields = solver.state_fields();
+    std::set<std::string> names;
+    for (const auto& f : fields) CHECK_MESSAGE(names.insert(f.name).second, "field listed twice: " << f.name);
+    auto field = [&](const std::string& name) -> StateField& {
+        for (auto& f : fields)
+            if (f.name == name) return f;
+        FAIL("no field " << name);
+        return fields.front();
+    };
+    // What each walker is known to need is in the list with that use.
+    for (const char* name : {"blocks.centroid", "contacts.history", "nodes.velocity", "zones.stress", "bolts.axial",
+                             "liners.thrust", "relax.block_force", "solver.steps", "detection.unsorted_contacts"})
+        CHECK_MESSAGE((field(name).uses & field_use::evolving) == field_use::evolving, name);
+    CHECK(field("monitor.samples").uses == field_use::saved); // the verdict's: saved, not physics
+    CHECK(field("relax.block_force").size() > 0);
+
+    auto save = [&](const Solver& s) {
+        std::ostringstream o(std::ios::binary);
+        s.save_state(o);
+        return o.str();
+    };
+    const std::uint64_t hash = solver.state_hash();
+    const std::string checkpoint = save(solver);
+    int perturbed = 0;
+    for (auto& f : fields) {
+        if (f.bytes.empty() || !(f.uses & (field_use::saved | field_use::hashed))) continue;
+        INFO(f.name);
+        std::byte& last = f.bytes[f.bytes.size() - 1 - (f.element_size - 1) / 2]; // inside the last element
+        last ^= std::byte{1};
+        CHECK((solver.state_hash() != hash) == bool(f.uses & field_use::hashed));
+        if (f.uses & field_use::saved) CHECK(save(solver) != checkpoint);
+        last ^= std::byte{1};
+        ++perturbed;
+    }
+    CHECK(perturbed > 80); // 91 in this model
+    CHECK(solver.state_hash() == hash);
+
+    // Loaded into a new solver of the same model, every saved field is restored.
+    Solver resumed(m.blocks, m.analysis);
+    std::istringstream in(checkpoint, std::ios::binary);
+    resumed.load_state(in);
+    CHECK(resumed.state_hash() == hash);
+    const auto restored = resumed.state_fields();
+    REQUIRE(restored.size() == fields.size());
+    for (std::size_t k = 0; k < fields.size(); ++k)
+        if (fields[k].uses & field_use::saved) {
+            INFO(fields[k].name);
+            CHECK(std::equal(fields[k].bytes.begin(), fields[k].bytes.end(), restored[k].bytes.begin(),
+                             restored[k].bytes.end()));
+        }
+
+    // The memory report is the list's capacities by group (and the contact batches).
+    std::array<std::size_t, 6> by_group{};
+    for (const auto& f : fields) by_group[std::size_t(f.group)] += f.capacity_bytes;
+    const auto memory = solver.memory();
+    CHECK(memory.blocks == by_group[std::size_t(MemoryGroup::blocks)]);
+    CHECK(memory.vertices == by_group[std::size_t(MemoryGroup::vertices)]);
+    CHECK(memory.nodes == by_group[std::size_t(MemoryGroup::nodes)]);
+    CHECK(memory.zones == by_group[std::size_t(MemoryGroup::zones)]);
+    CHECK(memory.other == by_group[std::size_t(MemoryGroup::other)]);
+    CHECK(memory.contacts >= by_group[std::size_t(MemoryGroup::contacts)]);
 }

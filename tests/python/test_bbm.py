@@ -189,6 +189,23 @@ def test_checkpoint_of_an_older_format_is_refused(tmp_path):
         bbm.Model.resume(str(old))
 
 
+def test_state_fields_are_the_solvers_list():
+    """Model.state_fields() is the list the checkpoint, hash and memory report walk."""
+    m = bbm.Model(str(HYBRID))
+    m.step(10)
+    fields = {f["name"]: f for f in m.state_fields()}
+    assert fields["blocks.centroid"]["saved"] and fields["blocks.centroid"]["hashed"]
+    assert fields["contacts.history"]["hashed"] and not fields["contacts.normal"]["saved"]
+    assert fields["monitor.samples"]["saved"] and not fields["monitor.samples"]["hashed"]
+    assert fields["blocks.local"]["model"]
+    np.testing.assert_array_equal(m.state("blocks.centroid"), m.blocks.centroid)
+    np.testing.assert_array_equal(m.state("nodes.velocity"), m.nodes.velocity)
+    assert m.state("contacts.history").shape == (m.contacts.count, 64)  # a record: its bytes
+    assert m.state("solver.steps").tolist() == [10]
+    with pytest.raises(KeyError, match="state_fields"):
+        m.state("blocks.nothing")
+
+
 def test_bolt_arrays_of_the_bolted_tunnel():
     m = bbm.Model(str(SOURCE / "examples/support/tunnel_voronoi_bolted.toml"), threads=2)
     assert m.bolts.node_count == 0  # installed by a stage
