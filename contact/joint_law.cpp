@@ -1,6 +1,7 @@
 #include "contact/joint_law.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -156,12 +157,12 @@ void SofteningLaw::update_inelastic(JointHistory& h, double dus) const {
 }
 
 JointLaw make_law(const JointPropertySpec& p) {
-    switch (p.law) {
-    case JointPropertySpec::Law::elastic: return ElasticLaw(p);
-    case JointPropertySpec::Law::coulomb: return CoulombLaw(p);
-    case JointPropertySpec::Law::softening: return SofteningLaw(p);
-    }
-    return ElasticLaw(p);
+    // By index: the alternative of JointLaw that JointPropertySpec::Law names.
+    constexpr auto makers = []<std::size_t... I>(std::index_sequence<I...>) {
+        return std::array<JointLaw (*)(const JointPropertySpec&), sizeof...(I)>{
+            [](const JointPropertySpec& q) -> JointLaw { return std::variant_alternative_t<I, JointLaw>(q); }...};
+    }(std::make_index_sequence<std::variant_size_v<JointLaw>>{});
+    return makers[static_cast<std::size_t>(p.law)](p);
 }
 
 double normal_stiffness(const JointLaw& law) {
@@ -172,17 +173,16 @@ double shear_stiffness(const JointLaw& law) {
 }
 
 bool starts_bonded(const JointLaw& law) {
-    if (std::holds_alternative<ElasticLaw>(law)) return true;
-    if (const auto* c = std::get_if<CoulombLaw>(&law)) return c->tensile > 0 || c->cohesion > 0;
-    return true;
+    return std::visit([](const auto& l) { return l.starts_bonded(); }, law);
 }
 
 double elastic_limit(const JointLaw& law, const JointHistory& before, const JointHistory& trial, double cap) {
-    double tensile = INFINITY, cohesion = INFINITY;
-    BondFriction friction;
-    if (const auto* c = std::get_if<CoulombLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, friction = c->friction;
-    if (const auto* c = std::get_if<SofteningLaw>(&law)) tensile = c->tensile, cohesion = c->cohesion, friction = c->friction;
-    if (!std::isfinite(tensile) || !before.bonded) return cap;
+    return std::visit([&](const auto& l) { return l.elastic_limit(before, trial, cap); }, law);
+}
+
+double bond_elastic_limit(double tensile, double cohesion, const BondFriction& friction, const JointHistory& before,
+                          const JointHistory& trial, double cap) {
+    if (!before.bonded) return cap;
     auto within = [&](double lambda) {
         const double sn = before.sn + lambda * (trial.sn - before.sn);
         const double tau = before.tau + lambda * (trial.tau - before.tau);

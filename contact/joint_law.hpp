@@ -24,37 +24,22 @@
 //   Unloading is elastic with the initial stiffness.
 #pragma once
 
+#include "contact/barton_bandis.hpp"
+#include "contact/joint_history.hpp"
 #include "contact/joint_property.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
 namespace bbm::contact {
 
-/// Contact state as output (ParaView `state` cell data).
-enum class JointState : std::uint8_t { intact, softening, broken_tension, broken_shear, sliding };
-
-/// Persistent history of one contact, one 64-byte cache line. Stresses in Pa,
-/// displacements in m.
-struct alignas(64) JointHistory {
-    double sn = 0.0;  ///< normal stress, compression positive
-    double tau = 0.0; ///< shear stress
-    double un = 0.0;  ///< normal displacement since bonding, opening positive
-    double us = 0.0;  ///< shear displacement
-    double upn = 0.0; ///< plastic (irreversible) opening
-    double ups = 0.0; ///< accumulated plastic shear displacement (magnitude)
-    double dissipated = 0.0; ///< plastic work per unit area, J/m²
-    float damage = 0.0f;     ///< D of SPEC §4 (output only: the law recomputes it)
-    bool bonded = true;      ///< false once broken, or for contacts formed unbonded
-    bool slipping = false;   ///< plastic shear in the last update
-    JointState broken = JointState::intact; ///< broken_tension / broken_shear once broken
-    bool counted = false; ///< its crack has been recorded (statistics at formation)
-};
-static_assert(sizeof(JointHistory) == 64);
 
 /// Piecewise-linear normalised strength S(up) over plastic displacement up:
 /// S(0) = 1, linear between breakpoints, 0 beyond the last. No breakpoint after 0
@@ -93,6 +78,11 @@ struct BondFriction {
     double operator()(double sn) const { return std::max(sn, 0.0) * tan_phi + std::max(sn - from, 0.0) * extra_tan; }
 };
 
+/// The largest λ in [0, cap] for which before + λ (trial − before) stays within an
+/// intact bond's tension cut-off and Coulomb cap (cap if it was not bonded).
+double bond_elastic_limit(double tensile, double cohesion, const BondFriction& friction, const JointHistory& before,
+                          const JointHistory& trial, double cap);
+
 /// The elastic step of an intact bond below both peaks, shared by the bonded laws:
 /// true (and the stresses committed) if neither the tension cut-off nor the
 /// Coulomb cap is reached; un, us already incremented.
@@ -109,8 +99,12 @@ inline bool intact_elastic_update(JointHistory& h, double kn, double ks, double 
 // Each law's update() is inline for the elastic path every contact takes most of
 // the time; plastic returns and failures go out of line.
 struct ElasticLaw {
+    static constexpr std::string_view name = "elastic";
     double kn, ks;
     explicit ElasticLaw(const JointPropertySpec& p) : kn(p.kn), ks(p.ks) {}
+    bool starts_bonded() const { return true; }
+    /// Never yields: any load is within its strength.
+    double elastic_limit(const JointHistory&, const JointHistory&, double cap) const { return cap; }
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
@@ -122,9 +116,15 @@ struct ElasticLaw {
 /// Coulomb slip with an optional brittle bond (tensile strength and cohesion that
 /// vanish at the first failure).
 struct CoulombLaw {
+    static constexpr std::string_view name = "coulomb";
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     BondFriction friction; ///< plain tan φ: the confined friction is the softening law's
     explicit CoulombLaw(const JointPropertySpec& p);
+    /// Bonded only with a (brittle) bond to break.
+    bool starts_bonded() const { return tensile > 0 || cohesion > 0; }
+    double elastic_limit(const JointHistory& before, const JointHistory& trial, double cap) const {
+        return bond_elastic_limit(tensile, cohesion, friction, before, trial, cap);
+    }
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
@@ -136,10 +136,15 @@ struct CoulombLaw {
 };
 
 struct SofteningLaw {
+    static constexpr std::string_view name = "softening";
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     BondFriction friction; ///< the bonded cap's frictional term, confined friction included
     SofteningCurve tension, shear;
     explicit SofteningLaw(const JointPropertySpec& p);
+    bool starts_bonded() const { return true; }
+    double elastic_limit(const JointHistory& before, const JointHistory& trial, double cap) const {
+        return bond_elastic_limit(tensile, cohesion, friction, before, trial, cap);
+    }
     void update(JointHistory& h, double dun, double dus) const {
         h.un += dun;
         h.us += dus;
@@ -152,7 +157,17 @@ struct SofteningLaw {
     void update_inelastic(JointHistory& h, double dus) const;
 };
 
-using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw>;
+/// Every joint law, one alternative each, in the order of JointPropertySpec::Law.
+/// A law is a type with its `name` (the model file's `law`), kn and ks, update(),
+/// starts_bonded() and elastic_limit(); the contact pass dispatches once per batch
+/// of contacts that share a property set (no virtual call per contact).
+using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw, BartonBandisLaw>;
+static_assert(std::variant_size_v<JointLaw> == std::size_t(JointPropertySpec::Law::barton_bandis) + 1);
+
+/// The laws' names, in the order of JointPropertySpec::Law (the model file's `law`).
+inline constexpr auto law_names = []<std::size_t... I>(std::index_sequence<I...>) {
+    return std::array<std::string_view, sizeof...(I)>{std::variant_alternative_t<I, JointLaw>::name...};
+}(std::make_index_sequence<std::variant_size_v<JointLaw>>{});
 
 JointLaw make_law(const JointPropertySpec& p);
 double normal_stiffness(const JointLaw& law);

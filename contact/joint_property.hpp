@@ -12,7 +12,8 @@ namespace bbm {
 
 /// One joint property set (SPEC §4). Which law is used follows `law`.
 struct JointPropertySpec {
-    enum class Law { elastic, coulomb, softening };
+    /// In the order of the alternatives of contact::JointLaw (joint_law.hpp checks).
+    enum class Law { elastic, coulomb, softening, barton_bandis };
     std::string name;
     Law law = Law::softening;
     double kn = 0.0;              ///< normal stiffness, Pa/m (> 0)
@@ -32,6 +33,13 @@ struct JointPropertySpec {
     double confined_friction = -1;           ///< φ2, degrees
     double confined_friction_from = 0.0;     ///< σ*, Pa (> 0 with confined_friction)
     double cohesion = 0.0;        ///< c, Pa (coulomb: brittle bond; softening: peak cohesion)
+    /// Barton–Bandis (contact/barton_bandis.hpp; `friction` is its φr): the joint
+    /// roughness coefficient, the joint wall compressive strength (Pa) and the
+    /// joint length (m) that sets the peak shear displacement (≤ 0: none, the
+    /// strength stays at its peak).
+    double jrc = 0.0;
+    double jcs = 0.0;
+    double joint_length = -1.0;
     double tensile = 0.0;         ///< σt, Pa
     /// Post-peak points (α, β) of the softening curves, normalised as in SPEC §4
     /// (α: displacement over the elastic displacement at peak, β: stress over peak),

@@ -9,6 +9,8 @@
 #define TOML_IMPLEMENTATION
 #include "io/reader.hpp"
 
+#include "contact/joint_law.hpp"
+
 #include "core/verdict.hpp"
 
 #include <algorithm>
@@ -379,7 +381,6 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 // In the order of the enums of core/model_spec.hpp and meshing::JointTag.
 constexpr std::array<std::string_view, 2> solver_modes{"quasi_static", "dynamic"};
 constexpr std::array<std::string_view, 2> contact_lengths{"edge", "overlap"};
-constexpr std::array<std::string_view, 3> laws{"elastic", "coulomb", "softening"};
 constexpr std::array<std::string_view, 6> joint_tags{"inner", "radial", "peripheral", "real_joint",
                                                      "interface", "fracture"};
 constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
@@ -545,38 +546,48 @@ void read_confined_friction(const Ctx& c, const toml::table& t, const Path& p, J
     if (phi2) j.confined_friction = *phi2, j.confined_friction_from = *from;
 }
 
+/// The keys of each law's [[joint_property]] (in the order of JointPropertySpec::Law).
+constexpr std::array<std::string_view, 5> elastic_keys{"name", "law", "kn", "ks", "face_shear"};
+constexpr std::array<std::string_view, 12> coulomb_keys{
+    "name", "law", "kn", "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
+    "weibull_modulus", "strength_classes", "strength_seed"};
+constexpr std::array<std::string_view, 16> softening_keys{
+    "name", "law", "kn", "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
+    "weibull_modulus", "strength_classes", "strength_seed", "tension_softening", "shear_softening",
+    "confined_friction", "confined_friction_from"};
+constexpr std::array<std::string_view, 9> barton_bandis_keys{"name", "law",  "kn",  "ks",          "face_shear",
+                                                             "friction", "jrc", "jcs", "joint_length"};
+constexpr std::array<Keys, 4> law_keys{elastic_keys, coulomb_keys, softening_keys, barton_bandis_keys};
+static_assert(law_keys.size() == contact::law_names.size());
+constexpr std::array<std::string_view, 19> all_joint_keys{
+    "name", "law", "kn", "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
+    "weibull_modulus", "strength_classes", "strength_seed", "tension_softening", "shear_softening",
+    "confined_friction", "confined_friction_from", "jrc", "jcs", "joint_length"};
+
+/// jrc, jcs and joint_length of a Barton-Bandis joint (`friction` is its φr).
+void read_barton_bandis(const Ctx& c, const toml::table& t, const Path& p, JointPropertySpec& j) {
+    j.jrc = required_number(c, t, p, "jrc", between(0, 20, ""));
+    j.jcs = required_number(c, t, p, "jcs", above(0, pascals));
+    j.joint_length = number(c, t, p, "joint_length", above(0, metres)).value_or(-1.0);
+}
+
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 16> all_keys{"name",
-                                                               "law",
-                                                               "kn",
-                                                               "ks",
-                                                               "face_shear",
-                                                               "friction",
-                                                               "residual_friction",
-                                                               "cohesion",
-                                                               "tensile",
-                                                               "weibull_modulus",
-                                                               "strength_classes",
-                                                               "strength_seed",
-                                                               "tension_softening",
-                                                               "shear_softening",
-                                                               "confined_friction",
-                                                               "confined_friction_from"};
-    check_keys(c, t, p, all_keys);
+    check_keys(c, t, p, all_joint_keys);
     JointPropertySpec j;
     using Law = JointPropertySpec::Law;
     j.name = read_name(c, t, p, names);
-    j.law = static_cast<Law>(choice(c, t, p, "law", laws, "joint law"));
-    const Keys keys = j.law == Law::elastic   ? Keys(all_keys).first(5)
-                      : j.law == Law::coulomb ? Keys(all_keys).first(12)
-                                              : Keys(all_keys);
-    check_keys(c, t, p, keys, all_keys,
-               article(laws[static_cast<std::size_t>(j.law)]) + " joint property");
+    j.law = static_cast<Law>(choice(c, t, p, "law", contact::law_names, "joint law"));
+    const auto law = static_cast<std::size_t>(j.law);
+    check_keys(c, t, p, law_keys[law], all_joint_keys, article(contact::law_names[law]) + " joint property");
     j.kn = required_number(c, t, p, "kn", above(0, pascals_per_metre));
     j.ks = required_number(c, t, p, "ks", above(0, pascals_per_metre));
     j.face_shear = boolean(c, t, p, "face_shear").value_or(false);
     if (j.law == Law::elastic) return j;
     j.friction = number(c, t, p, "friction", below(0, 90, degrees)).value_or(j.friction);
+    if (j.law == Law::barton_bandis) {
+        read_barton_bandis(c, t, p, j);
+        return j;
+    }
     j.residual_friction = number(c, t, p, "residual_friction", below(0, 90, degrees)).value_or(-1);
     if (j.law == Law::coulomb) {
         j.cohesion = number(c, t, p, "cohesion", at_least(0, pascals)).value_or(0.0);

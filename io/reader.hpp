@@ -269,6 +269,9 @@ inline Range at_least(double lo, std::string_view unit) {
 inline Range below(double lo, double hi, std::string_view unit) {
     return {.lo = lo, .hi = hi, .hi_open = true, .unit = unit};
 }
+inline Range between(double lo, double hi, std::string_view unit) {
+    return {.lo = lo, .hi = hi, .unit = unit};
+}
 
 constexpr std::string_view metres = " m";
 constexpr std::string_view degrees = " degrees";

@@ -159,7 +159,10 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
     const double rows = o.pattern == meshing::PatternSpec::Kind::single ? 0.0 : o.height / o.size;
     const double plane_kn = o.persistence * o.plane.kn + (1.0 - o.persistence) * o.rock.kn;
     const double stiffness = w / (rows / o.rock.kn + 1.0 / plane_kn);
-    const double servo_cap = 1e-3 * o.normal_stress * w / stiffness; // largest box speed, m per step
+    // Largest box speed, m per step: a thousandth of σn's elastic displacement, or
+    // the shear rate itself (a joint dilating at up to 45°, Barton-Bandis's rough
+    // joints at low σn, lifts the box about that fast: a slower box let σn run away).
+    const double servo_cap = std::max(1e-3 * o.normal_stress * w / stiffness, o.shear_rate);
     double dilation_origin = 0.0;
     auto target = [&](double dilation) {
         return w * std::max(0.0, o.normal_stress + o.normal_stiffness * dilation);
@@ -282,8 +285,17 @@ void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--joint-law", v.joint_law,
                     "The plane's joint: coulomb (unbonded friction; with --joint-cohesion or --joint-tensile a brittle "
-                    "weak bond) or softening (a bond softening like the rock's)")
-        ->check(CLI::IsMember({"coulomb", "softening"}))->capture_default_str();
+                    "weak bond), softening (a bond softening like the rock's) or barton_bandis (a rough joint: "
+                    "--joint-jrc, --joint-jcs, --joint-length; --joint-friction is its residual friction)")
+        ->check(CLI::IsMember({"coulomb", "softening", "barton_bandis"}))->capture_default_str();
+    sub->add_option("--joint-jrc", o.plane.jrc, "Barton-Bandis: the plane's joint roughness coefficient JRC")
+        ->check(cli::in_range(0.0, 20.0));
+    sub->add_option("--joint-jcs", o.plane.jcs, "Barton-Bandis: the plane's joint wall compressive strength JCS (Pa)")
+        ->check(cli::positive());
+    sub->add_option("--joint-length", o.plane.joint_length,
+                    "Barton-Bandis: joint length L (m) of the peak shear displacement (L/500)(JRC/L)^0.33 and the "
+                    "post-peak fall of JRC (default: none, the strength stays at its peak)")
+        ->check(cli::positive());
     sub->add_option("--joint-friction", o.plane.friction, "The plane's friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
     sub->add_option("--joint-residual-friction", o.plane.residual_friction, "The plane's friction after its bond fails (degrees; default --joint-friction)")
         ->check(cli::in_range(0.0, 89.9));
@@ -384,7 +396,12 @@ void check_shear_options(ShearCli& v) {
     o.pattern = lo.pattern, o.size_measure = lo.size_measure, o.size = lo.size;
     o.width = lo.width, o.height = lo.height, o.lloyd = lo.lloyd, o.seed = lo.seed;
     o.rock = lo.joint, o.density = lo.density, o.max_elements = lo.max_elements;
-    o.plane.law = v.joint_law == "softening" ? JointPropertySpec::Law::softening : JointPropertySpec::Law::coulomb;
+    o.plane.law = static_cast<JointPropertySpec::Law>(std::ranges::find(contact::law_names, v.joint_law) -
+                                                      contact::law_names.begin());
+    const bool barton_bandis = o.plane.law == JointPropertySpec::Law::barton_bandis;
+    if (barton_bandis != (o.plane.jrc > 0 || o.plane.jcs > 0 || o.plane.joint_length > 0) || (barton_bandis && !(o.plane.jcs > 0)))
+        throw InputError(barton_bandis ? "--joint-jcs" : "--joint-jrc", 0, "",
+                         "--joint-jrc, --joint-jcs (> 0 Pa, needed) and --joint-length go with --joint-law barton_bandis");
     o.plane.kn = v.joint_kn > 0 ? v.joint_kn : o.rock.kn;
     o.plane.ks = v.joint_ks > 0 ? v.joint_ks : o.rock.ks;
     if (o.plane.law == JointPropertySpec::Law::softening) {
@@ -494,6 +511,13 @@ int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
     } catch (const GeometryError& e) {
         throw InputError("--size", 0, "", e.what());
     }
+    for (const auto& r : results)
+        if (r.normal_stress_error > 0.05 && Ranks::root())
+            std::fprintf(stderr,
+                         "bbm shear: warning: at sigma_n %g MPa the servo missed the normal stress by up to %.0f%% "
+                         "(normal_stress_error in summary.json): the peak is at another normal stress than asked; "
+                         "lower --shear-rate or raise --servo-gain\n",
+                         r.normal_stress / 1e6, 100.0 * r.normal_stress_error);
     // The Coulomb lines over the normal stresses (at the peak: σn there, which CNS moves).
     std::vector<double> sn_peak, tau_peak, sn_res, tau_res;
     nlohmann::json runs = nlohmann::json::array();

@@ -883,7 +883,7 @@ TEST_CASE("joint property mistakes") {
     unknown_law.replace(unknown_law.find("\"softening\""), 11, "\"softning\"");
     check_error(unknown_law, "softning", "joint_property[0].law",
                 "unknown joint law 'softning' (did you mean 'softening'?); expected one of: "
-                "elastic, coulomb, softening");
+                "elastic, coulomb, softening, barton_bandis");
     check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"elastic\"\nks = 1e9\n"),
                 "[[joint_property]]", "joint_property[0].kn",
                 "joint property 'j': missing required key 'kn': expected a number > 0 Pa/m");
@@ -925,6 +925,29 @@ TEST_CASE("joint property mistakes") {
                      "friction = 30\n"),
                 "friction", "joint_property[0].friction",
                 "key 'friction' does not apply to an elastic joint property");
+    // Barton-Bandis: JRC in [0, 20], JCS > 0 required, a length > 0; no bond keys.
+    {
+        const auto read = parse_model(with("[[joint_property]]\nname = \"rough\"\nlaw = \"barton_bandis\"\n"
+                                           "kn = 1e10\nks = 1e10\nfriction = 28\njrc = 12\njcs = 80e6\n"
+                                           "joint_length = 0.5\n"),
+                                      "t.toml");
+        const auto& j = read.analysis.joint_properties[0];
+        CHECK(j.law == bbm::JointPropertySpec::Law::barton_bandis);
+        CHECK(j.friction == 28.0);
+        CHECK(j.jrc == 12.0);
+        CHECK(j.jcs == 80e6);
+        CHECK(j.joint_length == 0.5);
+    }
+    const std::string rough = "[[joint_property]]\nname = \"rough\"\nlaw = \"barton_bandis\"\nkn = 1\nks = 1\n";
+    check_error(with(rough + "jcs = 80e6\njrc = 21\n"), "jrc = 21", "joint_property[0].jrc",
+                "must be in [0, 20], got 21");
+    check_error(with(rough + "jrc = 10\n"), "[[joint_property]]", "joint_property[0].jcs",
+                "joint property 'rough': missing required key 'jcs'");
+    check_error(with(rough + "jrc = 10\njcs = 80e6\ncohesion = 1e6\n"), "cohesion", "joint_property[0].cohesion",
+                "key 'cohesion' does not apply to a barton_bandis joint property; its keys are: name, law, kn, ks, "
+                "face_shear, friction, jrc, jcs, joint_length");
+    check_error(with("[[joint_property]]\nname = \"j\"\nlaw = \"coulomb\"\nkn = 1\nks = 1\njrc = 5\n"), "jrc",
+                "joint_property[0].jrc", "key 'jrc' does not apply to a coulomb joint property");
     check_error(with(std::string(bond) + "[[joint_property]]\nname = \"bond\" # again\n"),
                 "# again", "joint_property[1].name",
                 "joint property name 'bond' is already used by joint_property[0]");

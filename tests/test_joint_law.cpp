@@ -230,3 +230,52 @@ TEST_CASE("brittle softening (no post-peak points) and the Coulomb law") {
     CHECK(s.sn == 0.0);
     CHECK(s.tau == 0.0);
 }
+
+TEST_CASE("Barton-Bandis joint: peak, dilation, post-peak mobilisation of JRC and its bounds") {
+    JointPropertySpec p;
+    p.law = JointPropertySpec::Law::barton_bandis;
+    p.kn = 100e9, p.ks = 50e9;
+    p.friction = 28.0, p.jrc = 12.0, p.jcs = 80e6, p.joint_length = 0.5;
+    const contact::JointLaw law = contact::make_law(p);
+    const auto& bb = std::get<contact::BartonBandisLaw>(law);
+    CHECK_FALSE(contact::starts_bonded(law));
+    CHECK(contact::law_names[std::size_t(p.law)] == "barton_bandis");
+    const double deg = std::numbers::pi / 180.0;
+    // δp = (L/500)(JRC/L)^0.33 (Barton & Bandis 1982): 0.5 m, JRC 12 -> 2.85 mm.
+    const double dp = 0.5 / 500.0 * std::pow(12.0 / 0.5, 0.33);
+    CHECK(bb.peak_displacement == doctest::Approx(dp).epsilon(1e-12));
+
+    // Sheared under a constant normal stress: the opening follows the dilation.
+    for (double sn : {2e6, 10e6}) {
+        CAPTURE(sn);
+        contact::JointHistory h;
+        h.bonded = false;
+        const double du = 1e-6; // shear increment, m
+        double peak = 0.0, tau_at_4dp = 0.0, upn_at_peak_slip = -1.0;
+        for (int k = 0; k < 400000 && h.ups < 120.0 * dp; ++k) {
+            const double dun = (h.upn - sn / p.kn) - h.un; // keep σn = kn (upn − un) at sn
+            bb.update(h, dun, du);
+            peak = std::max(peak, h.tau);
+            if (upn_at_peak_slip < 0 && h.slipping) upn_at_peak_slip = h.upn;
+            if (tau_at_4dp == 0.0 && h.ups >= 3.0 * dp) tau_at_4dp = h.tau; // δ/δp = 1 + ups/δp = 4
+        }
+        const double roughness = 12.0 * std::log10(80e6 / sn);
+        CHECK(peak == doctest::Approx(sn * std::tan((28.0 + roughness) * deg)).epsilon(1e-4));
+        // JRC_mob = 0.70 JRC at δ/δp = 4 (Barton 1982), the residual σn tan φr beyond 100.
+        const double sn_now = -p.kn * (h.un - h.upn);
+        CHECK(tau_at_4dp == doctest::Approx(sn * std::tan((28.0 + 0.7 * roughness) * deg)).epsilon(1e-3));
+        CHECK(h.tau == doctest::Approx(sn_now * std::tan(28.0 * deg)).epsilon(1e-6));
+        // The opening while sliding: ∫ tan(½ JRC_mob log10(JCS/σn)) dups, between
+        // the peak's rate and zero: at least the first δp at the peak's rate.
+        CHECK(h.upn > dp * std::tan(0.5 * roughness * deg) * 0.99);
+        CHECK(h.upn < 120.0 * dp * std::tan(0.5 * roughness * deg));
+    }
+    // Bounds: φr + JRC log10(JCS/σn) at most 70°; σn above JCS gives φr; apart, no shear.
+    CHECK(bb.strength(1.0, 0.0) == doctest::Approx(1.0 * std::tan(70.0 * deg)));
+    CHECK(bb.strength(100e6, 0.0) == doctest::Approx(100e6 * std::tan(28.0 * deg)));
+    contact::JointHistory open;
+    open.bonded = false;
+    bb.update(open, 1e-4, 1e-4);
+    CHECK(open.sn == 0.0);
+    CHECK(open.tau == 0.0);
+}

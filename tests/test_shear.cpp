@@ -133,3 +133,27 @@ TEST_CASE("direct shear: rock bridges make a joint stronger, the more of them th
         CHECK(intact > half);
     }
 }
+
+TEST_CASE("direct shear: a Barton-Bandis joint peaks at sigma_n tan(phi_r + JRC log10(JCS / sigma_n)) and dilates") {
+    // Rigid halves (one block each), JRC 10, JCS 100 MPa, phi_r 30 deg, no
+    // post-peak fall (no joint length): the peak of Barton & Choubey (1977).
+    for (double sn : {1e6, 5e6}) {
+        auto o = shear_specimen(meshing::PatternSpec::Kind::single, 0.1);
+        o.plane.law = JointPropertySpec::Law::barton_bandis;
+        o.plane.friction = 30.0, o.plane.jrc = 10.0, o.plane.jcs = 100e6;
+        o.normal_stress = sn;
+        o.max_displacement = 5e-4;
+        const auto r = run_shear_test(o);
+        CAPTURE(sn);
+        // At the normal stress of the peak (the servo holds σn within 1% while the
+        // joint dilates against it): 50° at 1 MPa, 43° at 5 MPa.
+        const double at_peak = r.normal_stress_at_peak;
+        CHECK(at_peak == doctest::Approx(sn).epsilon(1e-2));
+        const double angle = 30.0 + 10.0 * std::log10(100e6 / at_peak);
+        CHECK(r.peak_shear_stress == doctest::Approx(at_peak * tan_deg(angle)).epsilon(2e-3));
+        CHECK(r.normal_stress_error < 1e-2);
+        // Sliding opens the joint at the dilation angle ½ JRC log10(JCS/σn).
+        MESSAGE("dilation angle " << r.peak_dilation_angle << " deg, final dilation " << r.final_dilation << " m");
+        CHECK(r.peak_dilation_angle == doctest::Approx(0.5 * 10.0 * std::log10(100e6 / sn)).epsilon(0.05));
+    }
+}

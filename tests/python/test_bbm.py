@@ -277,6 +277,20 @@ def test_shear_coulomb_joint():
         bbm.shear(pattern="single", persistence=0.5)
 
 
+def test_shear_barton_bandis_joint():
+    """The same keywords as bbm shear's flags: a rough joint peaks at Barton's
+    sigma_n tan(phi_r + JRC log10(JCS / sigma_n)) at the normal stress of its peak."""
+    s = bbm.shear(pattern="single", joint_law="barton_bandis", joint_jrc=10, joint_jcs=100e6, joint_friction=30,
+                  normal_stress=2e6, max_displacement=5e-4)
+    run = s["runs"][0]
+    sn = run["normal_stress_at_peak"]
+    assert sn == pytest.approx(2e6, rel=1e-2)
+    assert run["peak_shear_stress"] == pytest.approx(sn * math.tan(math.radians(30 + 10 * math.log10(100e6 / sn))),
+                                                     rel=2e-3)
+    with pytest.raises(bbm.InputError, match="barton_bandis"):
+        bbm.shear(pattern="single", joint_jrc=10)
+
+
 def test_callback_exception_stops_and_propagates():
     m = bbm.Model(str(INSITU))
 
