@@ -98,6 +98,9 @@ int run_cli(int argc, char** argv) {
                   "Continue the run whose checkpoint is in --out (the model file is the checkpoint's; exit 0 if the "
                   "run had already finished)");
     run->add_option("--max-elements", run_options.max_elements, studies::max_elements_help)->check(cli::positive());
+    run->add_flag("--profile", run_options.profile,
+                  "Time each stage of the step (detection, contacts and zones, gather, integration...): a table on "
+                  "stderr at the end, and \"profile\" in summary.json");
 
     std::vector<std::string> compare_models;
     std::string compare_out = "out/compare";

@@ -686,23 +686,34 @@ void Solver::refresh_normals() const {
 }
 
 void Solver::compute_forces() {
-    // First passes (contacts, then zones: independent of each other, no barrier
-    // between them), then one gather per block and node: its contacts' and zones'
-    // forces in a fixed order, plus gravity, boundary loads and relaxing supports.
-    // Support (bolts, liners): one thread, before its share of the contacts.
-    if (!c_.face_du_s.empty()) {
-        contact::face_slip_pass(c_, view(), dt_, corner_radius_);
+    face_slip_stage();
+    support_stage();
+    contact_and_zone_stage();
+    gather_stage();
+}
+
+void Solver::face_slip_stage() {
+    // Rigid faces against deformable blocks that share their mean slip
+    // (face_shear): before the contacts, which read it.
+    if (c_.face_du_s.empty()) return;
+    contact::face_slip_pass(c_, view(), dt_, corner_radius_);
 #pragma omp barrier
-    }
-    const int bolt_ties = bolts_.node_count();
-    const bool bolts = bolt_ties + liners_.node_count() > 0;
-    if (bolts) {
+}
+
+void Solver::support_stage() {
+    // Bolts and liners: one thread, no barrier: it goes on to its share of the
+    // contacts; their reactions are gathered after the contact and zone passes'
+    // barrier.
+    if (bolts_.node_count() + liners_.node_count() == 0) return;
 #pragma omp single nowait
-        {
-            if (bolt_ties > 0) bolt_pass();
-            if (liners_.node_count() > 0) liner_pass();
-        }
+    {
+        if (bolts_.node_count() > 0) bolt_pass();
+        if (liners_.node_count() > 0) liner_pass();
     }
+}
+
+void Solver::contact_and_zone_stage() {
+    // Contacts, then zones: independent of each other, no barrier between them.
     // A team times its shares of the two passes: balance_contact_pass() moves the
     // contacts' split toward equal times.
     const bool timed = omp_get_num_threads() > 1 && int(pass_time_.size()) == omp_get_num_threads();
@@ -717,6 +728,14 @@ void Solver::compute_forces() {
         mine.zones += omp_get_wtime() - t1;
     }
 #pragma omp barrier
+}
+
+void Solver::gather_stage() {
+    // One gather per block and node: its contacts' and zones' forces in a fixed
+    // order, plus gravity, boundary loads, relaxing and constant support pressures
+    // and the reactions of its support ties.
+    const int bolt_ties = bolts_.node_count();
+    const bool bolts = bolt_ties + liners_.node_count() > 0;
     const Vec2 g = settings_.gravity;
     // The support of the excavated rock: relaxed linearly to the fraction kept (a
     // fictitious support pressure, the convergence–confinement method's 1 − λ).
@@ -975,10 +994,22 @@ void Solver::step() {
     // implicit stage), runs the same code serially.
 #pragma omp parallel num_threads(settings_.threads) if (settings_.threads > 1)
     {
-        update_vertices();
-        detect_if_due();
-        compute_forces();
-        integrate();
+        // The stages of SPEC §5, each timed under `bbm run --profile` (StepProfile).
+        profile_.start();
+        update_vertices();          // world vertices from the bodies' positions
+        profile_.lap(StepProfile::vertices);
+        detect_if_due();            // 1. contact detection, when due
+        profile_.lap(StepProfile::detection);
+        face_slip_stage();          // 2. (rigid faces on deformable blocks)
+        profile_.lap(StepProfile::face_slip);
+        support_stage();            // 4. (bolts and liners: forces and reactions)
+        profile_.lap(StepProfile::supports);
+        contact_and_zone_stage();   // 2. contact forces, 3. zone stresses
+        profile_.lap(StepProfile::contacts_and_zones);
+        gather_stage();             // 4. loads and the sum per block and node
+        profile_.lap(StepProfile::gather);
+        integrate();                // 5. damping, integration; 6. the ratio
+        profile_.lap(StepProfile::integrate);
 #pragma omp single
         {
             release_relaxation();
@@ -986,7 +1017,20 @@ void Solver::step() {
             ++steps_;
             if (steps_ % balance_every == 0) balance_contact_pass();
         }
+        profile_.lap(StepProfile::bookkeeping);
     }
+}
+
+void StepProfile::start() {
+    if (enabled && omp_get_thread_num() == 0) last = omp_get_wtime();
+}
+
+void StepProfile::lap(Stage stage) {
+    if (!enabled || omp_get_thread_num() != 0) return;
+    const double now = omp_get_wtime();
+    seconds[stage] += now - last;
+    last = now;
+    if (stage == bookkeeping) ++steps;
 }
 
 double Solver::kinetic_energy() const {

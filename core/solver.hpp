@@ -2,9 +2,9 @@
 //
 // One step is the list of stages of SPEC §5:
 //   1. (when due) contact detection update          — detect_if_due()
-//   2. contact forces from displacement increments   — compute_forces(): contact pass
-//   3. zone stresses of deformable blocks            —   zone pass (fem/cst.hpp)
-//   4. gravity, boundary tractions, applied loads    —   the gather per block and node
+//   2. contact forces from displacement increments   — face_slip_stage(), contact_and_zone_stage()
+//   3. zone stresses of deformable blocks            —   the zone pass (fem/cst.hpp) in the latter
+//   4. gravity, boundary tractions, applied loads    — support_stage() (bolts, liners), gather_stage()
 //   5. damping and integration, prescribed velocities — integrate()
 //   6. convergence measure                           — the unbalanced-force ratio
 //
@@ -55,6 +55,21 @@
 #include <vector>
 
 namespace bbm {
+
+/// Wall time per stage of the step (`bbm run --profile`): measured on the team's
+/// first thread between stage boundaries, so a stage's time includes its wait at
+/// the barrier that ends it (the slowest thread's share). Off: one branch a stage.
+struct StepProfile {
+    enum Stage { vertices, detection, face_slip, supports, contacts_and_zones, gather, integrate, bookkeeping, count };
+    static constexpr std::array<const char*, count> names{
+        "vertices", "detection", "face slip", "supports", "contacts and zones", "gather", "integrate", "bookkeeping"};
+    bool enabled = false;
+    long steps = 0;
+    std::array<double, count> seconds{};
+    double last = 0.0;
+    void start();
+    void lap(Stage stage);
+};
 
 class Solver {
 public:
@@ -221,6 +236,9 @@ public:
     /// Contacts created, removed and transferred by detection so far.
     const contact::DetectionResult& detection_totals() const { return detection_totals_; }
     double detection_tolerance() const { return tolerance_; }
+    /// Time per stage of step() (`bbm run --profile`); enable it before stepping.
+    StepProfile& profile() { return profile_; }
+    const StepProfile& profile() const { return profile_; }
 
 private:
     contact::BlockView view() const;
@@ -230,7 +248,13 @@ private:
     void place_rigid_block(int i);      ///< world vertices and packed state from centroid and θ
     void place_deformable_block(int i); ///< vertices from the block's boundary nodes
     void rebuild_contact_index();
+    /// The force stages below in order (the implicit stage's evaluations).
     void compute_forces();
+    // The force stages of a step (core/solver.cpp), in order.
+    void face_slip_stage();        ///< mean slip of rigid faces on deformable blocks
+    void support_stage();          ///< bolts and liners, one thread, no barrier
+    void contact_and_zone_stage(); ///< the contact and zone passes, then a barrier
+    void gather_stage();           ///< each block's and node's forces, in a fixed order
     /// The contact loop does not store normals (a write of every contact every
     /// step, for readers outside the loop): they are computed on demand from the
     /// vertex positions the last step used, which gives the same values.
@@ -354,6 +378,7 @@ private:
     int unsorted_contacts_ = 0;
     std::uint64_t fingerprint_ = 0; ///< model_fingerprint(), taken at construction
     long steps_ = 0;
+    StepProfile profile_;
 };
 
 } // namespace bbm

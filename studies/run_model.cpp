@@ -407,6 +407,29 @@ void catch_stop_signals() {
 
 bool stop_signal_received() { return interrupted.load() > 0; }
 
+/// `--profile`: the time per stage of the step, printed as a table and returned for
+/// summary.json.
+nlohmann::json report_profile(const StepProfile& p, int contacts) {
+    double total = 0.0;
+    for (double t : p.seconds) total += t;
+    std::fprintf(stderr, "\nprofile: %ld steps, %.3f s in step() (first thread; a stage includes its wait at the barrier "
+                         "that ends it)\n  %-20s %10s %7s %14s\n",
+                 p.steps, total, "stage", "seconds", "share", "us per step");
+    nlohmann::json stages = nlohmann::json::object();
+    for (int k = 0; k < StepProfile::count; ++k) {
+        const double t = p.seconds[std::size_t(k)];
+        std::fprintf(stderr, "  %-20s %10.3f %6.1f%% %14.2f\n", StepProfile::names[std::size_t(k)], t,
+                     total > 0 ? 100.0 * t / total : 0.0, p.steps > 0 ? 1e6 * t / double(p.steps) : 0.0);
+        stages[StepProfile::names[std::size_t(k)]] = t;
+    }
+    const double contact_ns = p.steps > 0 && contacts > 0
+                                  ? 1e9 * p.seconds[StepProfile::contacts_and_zones] / double(p.steps) / contacts
+                                  : 0.0;
+    std::fprintf(stderr, "  contacts and zones per contact (at the end: %d contacts): %.1f ns per step\n", contacts,
+                 contact_ns);
+    return {{"steps", p.steps}, {"seconds", stages}, {"total_seconds", total}};
+}
+
 int run_model(const RunOptions& opt) {
     // From the start: a scheduler's signal during meshing or the elastic solve
     // must not kill the run either (it stops after the first step).
@@ -457,6 +480,7 @@ int run_model(const RunOptions& opt) {
         throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
     }
     if (opt.check_only) return 0;
+    solver->profile().enabled = opt.profile;
     int rigid = 0;
     for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver->blocks().deformable[i];
     if (!opt.quiet)
@@ -512,6 +536,7 @@ int run_model(const RunOptions& opt) {
     const double seconds = output.wall_seconds();
     nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, stop_signal != 0,
                                          health.empty() && stop_signal == 0);
+    if (opt.profile) summary["profile"] = report_profile(solver->profile(), solver->contacts().size());
     const auto& rep = model.analysis.report;
     FailurePlotOptions fo;
     fo.title = model_path;

@@ -130,3 +130,25 @@ TEST_CASE("every field of the state list is saved, hashed and counted") {
     CHECK(memory.other == by_group[std::size_t(MemoryGroup::other)]);
     CHECK(memory.contacts >= by_group[std::size_t(MemoryGroup::contacts)]);
 }
+
+// `bbm run --profile` (StepProfile): every step counted, every stage timed, and
+// the answer the same bit for bit as without it.
+TEST_CASE("the step's stages are timed under --profile without changing the answer") {
+    auto m = example("tunnel_trigon.toml", 300);
+    Solver timed(m.blocks, m.analysis), plain(m.blocks, m.analysis);
+    timed.profile().enabled = true;
+    struct Quiet : StageObserver {} quiet;
+    run_stages(timed, m.analysis.stages, quiet);
+    run_stages(plain, m.analysis.stages, quiet);
+    CHECK(timed.state_hash() == plain.state_hash());
+    const auto& p = timed.profile();
+    CHECK(p.steps == timed.steps());
+    double total = 0.0;
+    for (double t : p.seconds) {
+        CHECK(t >= 0.0);
+        total += t;
+    }
+    CHECK(p.seconds[StepProfile::contacts_and_zones] > 0.0);
+    CHECK(p.seconds[StepProfile::contacts_and_zones] < total);
+    CHECK(plain.profile().steps == 0);
+}
