@@ -1,4 +1,5 @@
 #include "studies/model.hpp"
+#include "studies/version.hpp"
 
 #include "base/error.hpp"
 #include "io/binary_stream.hpp"
@@ -112,6 +113,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         stages.push_back(j);
     }
     nlohmann::json summary{
+        {"bbm_version", version_text()},
         {"model", model_name},
         {"blocks", rigid},
         {"deformable_blocks", blocks.block_count() - rigid},

@@ -56,6 +56,9 @@ def test_model_run_matches_the_program(tmp_path):
     s = m.summary()
     ref = cli_run(INSITU, tmp_path / "cli")
     assert s["state_hash"] == ref["state_hash"]
+    # Which bbm made it: the version and commit, as `bbm --version` prints them.
+    assert s["bbm_version"] == ref["bbm_version"]
+    assert cli("--version")[1].strip() == "bbm " + ref["bbm_version"]
     assert s["steps"] == ref["steps"] == 100
     assert s["complete"] and ref["complete"]
     assert [x["name"] for x in s["stages"]] == [x["name"] for x in ref["stages"]]
