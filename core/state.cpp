@@ -284,13 +284,16 @@ std::uint64_t Solver::compute_model_fingerprint() const {
 }
 
 std::uint64_t Solver::state_hash() const {
-    // Every hashed field, its length and then its bytes (no padding in any: the
-    // static_assert below), in list order.
+    // Every non-empty hashed field, its name, its length and then its bytes (no
+    // padding in any: the static_assert below), in list order. An empty field adds
+    // nothing, so a capability a model does not use (a support type it has no
+    // table of) leaves that model's hash as it was.
     Fnv h;
     for_each_field(*this, [&](const FieldInfo& f, const auto& x) {
         using T = element_t<decltype(x)>;
         if constexpr (ElementTraits<T>::padding_free) {
-            if (f.uses & field_use::hashed) {
+            if ((f.uses & field_use::hashed) && !bytes_of(x).empty()) {
+                h.mix(std::as_bytes(std::span(f.name, std::strlen(f.name))));
                 h.mix_value(std::uint64_t(bytes_of(x).size()));
                 h.mix(bytes_of(x));
             }
