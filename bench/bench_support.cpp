@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
                 Solver s(blocks, an);
                 std::istringstream in(state);
                 s.load_state(in);
-                if (bolted) s.install_bolts(sets);
+                if (bolted) s.install_supports(sets);
                 const auto t0 = clock_type::now();
                 for (long k = 0; k < steps; ++k) s.step();
                 times[bolted].push_back(std::chrono::duration<double>(clock_type::now() - t0).count() / steps);

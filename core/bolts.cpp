@@ -1,5 +1,5 @@
-// Rock bolts and cables in the explicit loop (core/bolts.hpp for the model).
-#include "core/solver.hpp"
+// Rock bolts and cables as a support type (core/bolts.hpp for the model).
+#include "core/bolts.hpp"
 
 #include "base/error.hpp"
 
@@ -30,175 +30,67 @@ std::vector<std::array<Vec2, 2>> expand_bolts(const BoltSetSpec& spec) {
     return out;
 }
 
-BoltHost Solver::find_host(Vec2 p, double reach) const {
-    // The rigid block or zone that contains p, else the nearest one within `reach`
-    // (a head on the wall lies on an edge). Install-time only: a linear scan.
-    BoltHost best;
-    double best_distance = reach;
-    for (int i = 0; i < b_.count(); ++i) {
-        if (b_.removed[i] || b_.deformable[i]) continue;
-        const Vec2 q = rotation(-b_.theta[i])(p - b_.centroid[i]);
-        if (norm(q) > radius_[i] + reach) continue;
-        const std::span<const Vec2> poly(b_.local.data() + b_.first[i], b_.first[i + 1] - b_.first[i]);
-        double d = 0.0;
-        if (!point_in_polygon(q, poly)) {
-            d = INFINITY;
-            for (std::size_t v = 0; v < poly.size(); ++v)
-                d = std::min(d, distance_to_segment(q, poly[v], poly[(v + 1) % poly.size()]));
-        }
-        if (d == 0.0 || d < best_distance) {
-            best = {i, -1, q, {}};
-            best_distance = d;
-            if (d == 0.0) return best;
-        }
+BoltSupport::BoltSupport(const std::vector<BoltSetSpec>& specs) : specs_(specs) {
+    // Properties per metre of model; sets installed by stages.
+    for (const auto& spec : specs) {
+        const double S = spec.spacing;
+        names_.push_back(spec.name);
+        state_.sets.push_back({spec.young * spec.area / S, spec.yield_force / S, spec.rupture_strain,
+                               spec.bond_stiffness / S, spec.bond_strength / S,
+                               (spec.normal_stiffness > 0.0 ? spec.normal_stiffness : spec.bond_stiffness) / S,
+                               spec.density * spec.area / S, S, std::uint8_t(spec.cable)});
     }
-    for (int z = 0; z < z_.size(); ++z) {
-        if (b_.removed[z_.block[z]]) continue;
-        const auto& t = z_.node[z];
-        const Vec2 a = n_.position[t[0]], b = n_.position[t[1]], c = n_.position[t[2]];
-        const double area = cross(b - a, c - a);
-        const std::array<double, 3> w{cross(b - p, c - p) / area, cross(c - p, a - p) / area, cross(a - p, b - p) / area};
-        double d = 0.0;
-        if (std::min({w[0], w[1], w[2]}) < 0.0)
-            d = std::min({distance_to_segment(p, a, b), distance_to_segment(p, b, c), distance_to_segment(p, c, a)});
-        if (d == 0.0 || d < best_distance) {
-            best = {z_.block[z], z, {}, w};
-            best_distance = d;
-            if (d == 0.0) return best;
-        }
-    }
-    return best;
+    state_.installed.assign(state_.sets.size(), 0);
 }
 
-void Solver::tie_reaction(const BoltHost& h, Vec2 x, Vec2 f, Vec2& reaction, double& moment) const {
-    reaction = -f;
-    moment = h.zone < 0 ? -cross(x - b_.centroid[h.block], f) : 0.0;
-}
-
-void Solver::add_tie_stiffness(const BoltHost& h, double stiffness, std::vector<double>& k, std::vector<double>& kr,
-                               std::vector<double>& kn) const {
-    if (h.zone < 0) {
-        k[h.block] += stiffness;
-        kr[h.block] += stiffness * norm2(host_position(h) - b_.centroid[h.block]);
-    } else {
-        for (int j = 0; j < 3; ++j) kn[z_.node[h.zone][j]] += std::abs(h.weight[j]) * stiffness;
-    }
-}
-
-Vec2 Solver::host_position(const BoltHost& h) const {
-    if (h.zone < 0) return b_.centroid[h.block] + rotation(b_.theta[h.block])(h.local);
-    const auto& t = z_.node[h.zone];
-    return h.weight[0] * n_.position[t[0]] + h.weight[1] * n_.position[t[1]] + h.weight[2] * n_.position[t[2]];
-}
-
-void Solver::install_bolts(const std::vector<std::string>& names) {
-    auto& B = bolts_;
-    for (const auto& name : names) {
-        const auto it = std::find(bolt_names_.begin(), bolt_names_.end(), name);
-        if (it == bolt_names_.end()) throw InputError("", 0, "stage.supports", "unknown bolt set '" + name + "'");
-        const int set = int(it - bolt_names_.begin());
-        if (B.installed[set]) throw InputError("", 0, "stage.supports", "bolt set '" + name + "' is already installed");
-        B.installed[set] = 1;
-        const BoltSetSpec& spec = bolt_specs_[set];
-        const auto bolts = expand_bolts(spec);
-        for (std::size_t b = 0; b < bolts.size(); ++b) {
-            const auto [head, toe] = bolts[b];
-            const double length = norm(toe - head);
-            const int n = std::max(1, int(std::ceil(length / spec.segment_length - 1e-9)));
-            const double segment = length / n;
-            const int first = B.node_count();
-            for (int j = 0; j <= n; ++j) {
-                const Vec2 p = head + (double(j) / n) * (toe - head);
-                const BoltHost h = find_host(p, 0.5 * segment);
-                // Inner nodes may lie in an open joint (no rock: held by their
-                // segments); the head and the toe must be in rock.
-                if (h.block < 0 && (j == 0 || j == n))
-                    throw InputError("", 0, "bolt[" + std::to_string(set) + "]",
-                                     "bolt " + std::to_string(b) + " of set '" + name + "': its point (" +
-                                         std::to_string(p.x) + ", " + std::to_string(p.y) +
-                                         ") lies in no rock (inside an opening, or outside the model): its " +
-                                         (j == 0 ? "head" : "toe") + " must be in a block");
-                B.position.push_back(p);
-                B.velocity.push_back({});
-                B.force.push_back({});
-                B.applied.push_back({});
-                B.mass.push_back(0.0);
-                B.length.push_back(j == 0 || j == n ? 0.5 * segment : segment);
-                B.slip.push_back(0.0);
-                B.bond.push_back(0.0);
-                B.host.push_back(h);
-                B.tied.push_back((j == 0 && spec.face_plate) || (j == n && spec.end_anchor));
-                B.node_set.push_back(set);
-                if (j < n) {
-                    B.segment_node.push_back(first + j);
-                    B.rest.push_back(segment);
-                    B.plastic.push_back(0.0);
-                    B.axial.push_back(0.0);
-                    B.state.push_back(BoltState::elastic);
-                }
+void BoltSupport::install(int set, const HostFinder& find) {
+    auto& B = state_;
+    const BoltSetSpec& spec = specs_[set];
+    const std::string& name = spec.name;
+    B.installed[set] = 1;
+    const auto bolts = expand_bolts(spec);
+    for (std::size_t b = 0; b < bolts.size(); ++b) {
+        const auto [head, toe] = bolts[b];
+        const double length = norm(toe - head);
+        const int n = std::max(1, int(std::ceil(length / spec.segment_length - 1e-9)));
+        const double segment = length / n;
+        const int first = B.node_count();
+        for (int j = 0; j <= n; ++j) {
+            const Vec2 p = head + (double(j) / n) * (toe - head);
+            const BoltHost h = find(p, 0.5 * segment);
+            // Inner nodes may lie in an open joint (no rock: held by their
+            // segments); the head and the toe must be in rock.
+            if (h.block < 0 && (j == 0 || j == n))
+                throw InputError("", 0, "bolt[" + std::to_string(set) + "]",
+                                 "bolt " + std::to_string(b) + " of set '" + name + "': its point (" +
+                                     std::to_string(p.x) + ", " + std::to_string(p.y) +
+                                     ") lies in no rock (inside an opening, or outside the model): its " +
+                                     (j == 0 ? "head" : "toe") + " must be in a block");
+            B.position.push_back(p);
+            B.velocity.push_back({});
+            B.force.push_back({});
+            B.applied.push_back({});
+            B.mass.push_back(0.0);
+            B.length.push_back(j == 0 || j == n ? 0.5 * segment : segment);
+            B.slip.push_back(0.0);
+            B.bond.push_back(0.0);
+            B.host.push_back(h);
+            B.tied.push_back((j == 0 && spec.face_plate) || (j == n && spec.end_anchor));
+            B.node_set.push_back(set);
+            if (j < n) {
+                B.segment_node.push_back(first + j);
+                B.rest.push_back(segment);
+                B.plastic.push_back(0.0);
+                B.axial.push_back(0.0);
+                B.state.push_back(BoltState::elastic);
             }
-            B.first.push_back(B.node_count());
-            B.bolt_set.push_back(set);
         }
-    }
-    index_bolt_hosts();
-    update_timestep();
-}
-
-void Solver::install_supports(const std::vector<std::string>& names) {
-    std::vector<std::string> bolts;
-    for (const auto& name : names) {
-        const auto it = std::find(liner_names_.begin(), liner_names_.end(), name);
-        if (it == liner_names_.end()) {
-            bolts.push_back(name);
-            continue;
-        }
-        const int set = int(it - liner_names_.begin());
-        if (liners_.installed[set]) throw InputError("", 0, "stage.supports", "liner '" + name + "' is already installed");
-        install_liner(set);
-    }
-    install_bolts(bolts); // indexes the ties of both and updates the time step
-}
-
-void Solver::index_bolt_hosts() {
-    auto& B = bolts_;
-    B.reaction.assign(B.node_count(), {});
-    B.reaction_moment.assign(B.node_count(), 0.0);
-    const int nb = b_.count(), nn = n_.count();
-    bolt_block_first_.assign(nb + 1, 0);
-    bolt_node_first_.assign(nn + 1, 0);
-    // Ties: bolt nodes 0 … B.node_count() − 1, then liner nodes.
-    auto host_of = [&](int tie) -> const BoltHost& {
-        return tie < B.node_count() ? B.host[tie] : liners_.host[tie - B.node_count()];
-    };
-    const int ties = B.node_count() + liners_.node_count();
-    for (int tie = 0; tie < ties; ++tie) {
-        const BoltHost& h = host_of(tie);
-        if (h.block < 0) continue;
-        if (h.zone < 0) ++bolt_block_first_[h.block + 1];
-        else
-            for (int j = 0; j < 3; ++j) ++bolt_node_first_[z_.node[h.zone][j] + 1];
-    }
-    for (int i = 0; i < nb; ++i) bolt_block_first_[i + 1] += bolt_block_first_[i];
-    for (int i = 0; i < nn; ++i) bolt_node_first_[i + 1] += bolt_node_first_[i];
-    bolt_block_tie_.assign(bolt_block_first_[nb], 0);
-    bolt_node_tie_.assign(bolt_node_first_[nn], {});
-    std::vector<int> fill_block(bolt_block_first_.begin(), bolt_block_first_.end() - 1),
-        fill_node(bolt_node_first_.begin(), bolt_node_first_.end() - 1);
-    for (int k = 0; k < ties; ++k) { // in tie order: the gather's order
-        const BoltHost& h = host_of(k);
-        if (h.block < 0) continue;
-        if (h.zone < 0) bolt_block_tie_[fill_block[h.block]++] = k;
-        else
-            for (int j = 0; j < 3; ++j) {
-                const int node = z_.node[h.zone][j];
-                bolt_node_tie_[fill_node[node]++] = {k, h.weight[j]};
-            }
+        B.first.push_back(B.node_count());
+        B.bolt_set.push_back(set);
     }
 }
-
-void Solver::bolt_pass() {
-    auto& B = bolts_;
+void BoltSupport::force_pass(const SupportRock& rock, Vec2* reaction, double* reaction_moment) {
+    auto& B = state_;
     std::fill(B.force.begin(), B.force.end(), Vec2{});
     for (int s = 0; s < B.segment_count(); ++s) {
         const int a = B.segment_node[s];
@@ -227,14 +119,14 @@ void Solver::bolt_pass() {
         const int first = B.first[b], last = B.first[b + 1] - 1;
         for (int k = first; k <= last; ++k) {
             const BoltHost& h = B.host[k];
-            if (h.block < 0 || b_.removed[h.block]) {
+            if (!rock.holds(h)) {
                 B.bond[k] = 0.0;
-                B.reaction[k] = {};
-                B.reaction_moment[k] = 0.0;
+                reaction[k] = {};
+                reaction_moment[k] = 0.0;
                 continue;
             }
             const auto& set = B.sets[B.node_set[k]];
-            const Vec2 x = host_position(h), d = x - B.position[k];
+            const Vec2 x = rock.position(h), d = x - B.position[k];
             const Vec2 axis = B.position[std::min(k + 1, last)] - B.position[std::max(k - 1, first)];
             const Vec2 t = axis / norm(axis);
             const double s = dot(d, t);
@@ -244,15 +136,15 @@ void Solver::bolt_pass() {
             B.bond[k] = q;
             const Vec2 f = B.length[k] * (q * t + set.normal_stiffness * (d - s * t));
             B.force[k] += f;
-            tie_reaction(h, x, f, B.reaction[k], B.reaction_moment[k]);
+            rock.reaction(h, x, f, reaction[k], reaction_moment[k]);
         }
     }
 }
 
-double Solver::integrate_bolts(double& work) {
-    auto& B = bolts_;
-    const double alpha = settings_.damping, dt = dt_;
-    const Vec2 g = settings_.gravity;
+double BoltSupport::integrate(const SupportMotion& motion, double& work) {
+    auto& B = state_;
+    const double alpha = motion.damping, dt = motion.dt;
+    const Vec2 g = motion.gravity;
     double unbalanced = 0.0;
     for (int k = 0; k < B.node_count(); ++k) {
         const Vec2 weight = (B.sets[B.node_set[k]].line_mass * B.length[k]) * g;
@@ -267,10 +159,10 @@ double Solver::integrate_bolts(double& work) {
     return unbalanced;
 }
 
-void Solver::add_bolt_stiffness(std::vector<double>& k, std::vector<double>& kr, std::vector<double>& kn,
-                                double mass_factor) {
-    auto& B = bolts_;
-    auto& own = bolt_stiffness_;
+void BoltSupport::add_stiffness(RockStiffness& rock) {
+    auto& B = state_;
+    auto& own = stiffness_;
+    const double mass_factor = rock.mass_factor;
     own.assign(B.node_count(), 0.0);
     for (int s = 0; s < B.segment_count(); ++s) {
         if (B.state[s] == BoltState::broken) continue;
@@ -281,10 +173,10 @@ void Solver::add_bolt_stiffness(std::vector<double>& k, std::vector<double>& kr,
     for (int i = 0; i < B.node_count(); ++i) {
         const auto& set = B.sets[B.node_set[i]];
         const BoltHost& h = B.host[i];
-        if (h.block < 0 || b_.removed[h.block]) continue;
+        if (!rock.rock.holds(h)) continue;
         const double kg = B.length[i] * std::max(set.bond_stiffness, set.normal_stiffness);
         own[i] += kg;
-        add_tie_stiffness(h, kg, k, kr, kn);
+        rock.add_tie(h, kg);
     }
     for (int i = 0; i < B.node_count(); ++i) {
         const double real = B.sets[B.node_set[i]].line_mass * B.length[i];
@@ -292,20 +184,55 @@ void Solver::add_bolt_stiffness(std::vector<double>& k, std::vector<double>& kr,
     }
 }
 
-double Solver::bolt_time_limit() const {
+double BoltSupport::time_limit() const {
     double limit = INFINITY;
-    for (int i = 0; i < bolts_.node_count(); ++i)
-        if (bolt_stiffness_[i] > 0.0) limit = std::min(limit, 2.0 * std::sqrt(bolts_.mass[i] / bolt_stiffness_[i]));
+    for (int i = 0; i < state_.node_count(); ++i)
+        if (stiffness_[i] > 0.0) limit = std::min(limit, 2.0 * std::sqrt(state_.mass[i] / stiffness_[i]));
     return limit;
 }
 
-std::vector<BoltSetSummary> Solver::bolt_summary() const {
-    const auto& B = bolts_;
+void BoltSupport::add_force_scale(double& terms, double& squares) const {
+    // Bolts count with their segments' axial forces (a bolt may be all that holds a block).
+    terms += double(state_.segment_count());
+    for (double n : state_.axial) squares += n * n;
+}
+
+void BoltSupport::add_applied_loads(double& sum) const {
+    for (Vec2 f : state_.applied) sum += norm(f);
+}
+
+void BoltSupport::model_parameters(std::vector<double>& out) const {
+    for (const auto& set : state_.sets)
+        out.insert(out.end(), {set.ea, set.yield_force, set.rupture_strain, set.bond_stiffness, set.bond_strength,
+                               set.normal_stiffness, set.line_mass, set.spacing, double(set.cable)});
+}
+
+std::vector<SupportField> BoltSupport::fields() {
+    // Nodes, their ties to the rock, segments; then the step's scratch.
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, R = field_use::rebuilt;
+    auto& B = state_;
+    return {{{"bolts.installed", G::other, E}, &B.installed}, {{"bolts.position", G::other, E}, &B.position},
+            {{"bolts.velocity", G::other, E}, &B.velocity},   {{"bolts.applied", G::other, E}, &B.applied},
+            {{"bolts.mass", G::other, E}, &B.mass},           {{"bolts.length", G::other, E}, &B.length},
+            {{"bolts.slip", G::other, E}, &B.slip},           {{"bolts.bond", G::other, E}, &B.bond},
+            {{"bolts.host", G::other, E}, &B.host},           {{"bolts.tied", G::other, E}, &B.tied},
+            {{"bolts.node_set", G::other, E}, &B.node_set},   {{"bolts.segment_node", G::other, E}, &B.segment_node},
+            {{"bolts.rest", G::other, E}, &B.rest},           {{"bolts.plastic", G::other, E}, &B.plastic},
+            {{"bolts.axial", G::other, E}, &B.axial},         {{"bolts.state", G::other, E}, &B.state},
+            {{"bolts.first", G::other, E}, &B.first},         {{"bolts.bolt_set", G::other, E}, &B.bolt_set},
+            {{"bolts.force", G::other, R}, &B.force},         {{"bolts.stiffness", G::other, R}, &stiffness_}};
+}
+
+void BoltSupport::after_load() { state_.force.assign(state_.position.size(), {}); }
+
+std::vector<BoltSetSummary> BoltSupport::set_summary() const {
+    const auto& B = state_;
     std::vector<BoltSetSummary> out;
     for (std::size_t set = 0; set < B.sets.size(); ++set) {
         if (!B.installed[set]) continue;
         BoltSetSummary s;
-        s.name = bolt_names_[set];
+        s.name = names_[set];
         const double spacing = B.sets[set].spacing;
         for (int b = 0; b < B.bolt_count(); ++b) {
             if (B.bolt_set[b] != int(set)) continue;
@@ -327,6 +254,52 @@ std::vector<BoltSetSummary> Solver::bolt_summary() const {
         }
         out.push_back(s);
     }
+    return out;
+}
+
+std::vector<SupportSetSummary> BoltSupport::summary() const {
+    // The loads an engineer reads, per bolt.
+    std::vector<SupportSetSummary> out;
+    for (const auto& b : set_summary())
+        out.push_back({b.name,
+                       {{"bolts", double(b.bolts), true},
+                        {"max_axial_kN", b.max_axial / 1e3},
+                        {"max_compression_kN", -b.min_axial / 1e3},
+                        {"max_bond_kN_per_m", b.max_bond / 1e3},
+                        {"yielded", double(b.yielded), true},
+                        {"broken", double(b.broken), true}}});
+    return out;
+}
+
+SupportLines BoltSupport::lines() const {
+    const auto& B = state_;
+    SupportLines out;
+    out.points = B.position;
+    const int n = B.segment_count();
+    SupportLines::Array axial{"axial_force_kN", {}, false}, state{"state", {}, true}, set{"set", {}, true},
+        bolt{"bolt", {}, true};
+    int b = 0;
+    for (int i = 0; i < n; ++i) {
+        const int a = B.segment_node[i];
+        while (a >= B.first[b + 1]) ++b;
+        out.cells.push_back({a, a + 1});
+        axial.values.push_back(B.axial[i] * B.sets[B.node_set[a]].spacing / 1e3);
+        state.values.push_back(B.state[i]);
+        set.values.push_back(B.node_set[a]);
+        bolt.values.push_back(b);
+        out.mark.push_back(B.state[i] == BoltState::broken ? 2 : B.state[i] == BoltState::yielded ? 1 : 0);
+    }
+    out.cell_data = {axial, state, set, bolt};
+    SupportLines::Array bond{"bond_kN_per_m", {}, false}, slip{"slip", {}, false};
+    for (int k = 0; k < B.node_count(); ++k) {
+        bond.values.push_back(B.bond[k] * B.sets[B.node_set[k]].spacing / 1e3);
+        slip.values.push_back(B.slip[k]);
+    }
+    out.point_data = {bond, slip};
+    out.names = {{"state_names", {"elastic", "yielded", "broken"}}, {"set_names", names_}};
+    out.look = SupportLines::Look::bar;
+    out.shade = 0;
+    out.shade_label = "kN";
     return out;
 }
 

@@ -29,6 +29,7 @@
 #pragma once
 
 #include "base/vec2.hpp"
+#include "core/support.hpp"
 
 #include <array>
 #include <cmath>
@@ -70,32 +71,8 @@ struct BoltSetSpec {
     bool end_anchor = false;       ///< toe tied to its rock without slip
 };
 
-namespace support {
-/// Perfectly plastic return shared by the support laws: the trial value within
-/// ±limit, else clamped there and `plastic` moved so that stiffness ×
-/// (total − plastic) gives the clamped value.
-inline double plastic_return(double trial, double limit, double stiffness, double total, double& plastic) {
-    if (!(std::abs(trial) > limit)) return trial;
-    const double clamped = trial > 0.0 ? limit : -limit;
-    plastic = total - clamped / stiffness;
-    return clamped;
-}
-/// Local non-viscous damping (Cundall), as the blocks get it: f reduced by α|f| against v.
-inline double damped(double f, double v, double alpha) {
-    return f - alpha * std::abs(f) * double((v > 0.0) - (v < 0.0));
-}
-} // namespace support
-
 /// The bolts of a set as (head, toe) pairs, the ring expanded.
 std::vector<std::array<Vec2, 2>> expand_bolts(const BoltSetSpec& spec);
-
-/// Where a bolt node is tied into the rock: a rigid block (body-frame offset) or a
-/// zone (barycentric weights of its nodes); block −1 = in no rock.
-struct BoltHost {
-    int block = -1, zone = -1;
-    Vec2 local{};
-    std::array<double, 3> weight{};
-};
 
 /// Installed bolts in flat arrays (nodes, segments, bolts), part of the solver's
 /// state. Properties per metre of model (divided by the out-of-plane spacing).
@@ -110,10 +87,6 @@ struct BoltState {
     std::vector<Vec2> applied; ///< a load on a node, N/m (a pull-out test's jack)
     std::vector<double> mass, length, slip, bond; ///< bond: last grout force per metre along the bolt
     std::vector<BoltHost> host;
-    /// What each node's grout puts on its rock this step (the force on the rock,
-    /// and its moment about a rigid host's centroid): scratch, gathered by the rock.
-    std::vector<Vec2> reaction;
-    std::vector<double> reaction_moment;
     std::vector<std::uint8_t> tied;
     std::vector<int> node_set;
     // segments: between nodes segment_node[s] and segment_node[s] + 1
@@ -137,6 +110,44 @@ struct BoltSetSummary {
     double max_axial = 0.0;                 ///< largest tension, N per bolt
     double min_axial = 0.0;                 ///< largest compression (≤ 0), N per bolt
     double max_bond = 0.0;                  ///< largest grout force, N per m of bolt per bolt
+};
+
+/// The [[bolt]] sets of a model as a support type (core/support.hpp).
+class BoltSupport final : public Support {
+public:
+    explicit BoltSupport(const std::vector<BoltSetSpec>& specs);
+    const char* name() const override { return "bolts"; }
+    const std::vector<std::string>& set_names() const override { return names_; }
+    bool installed(int set) const override { return state_.installed[set] != 0; }
+    void install(int set, const HostFinder& find) override;
+    int tie_count() const override { return state_.node_count(); }
+    const BoltHost& host(int tie) const override { return state_.host[tie]; }
+    void force_pass(const SupportRock& rock, Vec2* reaction, double* moment) override;
+    double integrate(const SupportMotion& motion, double& work) override;
+    void add_stiffness(RockStiffness& k) override;
+    double time_limit() const override;
+    void add_force_scale(double& terms, double& squares) const override;
+    void add_applied_loads(double& sum) const override;
+    void model_parameters(std::vector<double>& out) const override;
+    std::vector<SupportField> fields() override;
+    void after_load() override;
+    std::vector<SupportSetSummary> summary() const override;
+    /// One line cell per segment, cell data axial_force_kN (per bolt, tension
+    /// positive), state (0 elastic, 1 yielded, 2 broken), set, bolt; point data
+    /// bond_kN_per_m (grout force along the bolt, per bolt) and slip (plastic grout
+    /// slip, m). Field data state_names, set_names.
+    SupportLines lines() const override;
+
+    const BoltState& state() const { return state_; }
+    BoltState& state() { return state_; } ///< a study may load a node (BoltState::applied)
+    /// Per installed set: loads per bolt and how many yielded or broke.
+    std::vector<BoltSetSummary> set_summary() const;
+
+private:
+    BoltState state_;
+    std::vector<std::string> names_;
+    std::vector<BoltSetSpec> specs_;
+    std::vector<double> stiffness_; ///< per node, scratch of add_stiffness()
 };
 
 } // namespace bbm

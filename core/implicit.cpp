@@ -39,7 +39,7 @@ std::string fmt_value(double v) {
 
 Solver::ElasticSolveReport Solver::solve_elastic() {
     const auto t0 = std::chrono::steady_clock::now();
-    if (bolts_.node_count() + liners_.node_count() > 0)
+    if (!tie_reaction_.empty())
         throw std::runtime_error("the elastic stage does not include support: put it before the stage that installs it");
     ElasticSolveReport report;
     const int nb = b_.count(), nn = n_.count();

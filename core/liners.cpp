@@ -1,5 +1,7 @@
-// Liners in the explicit loop (core/liners.hpp for the model).
-#include "core/solver.hpp"
+// Liners as a support type (core/liners.hpp for the model).
+#include "core/liners.hpp"
+
+#include "core/beam.hpp"
 
 #include "base/error.hpp"
 
@@ -13,9 +15,24 @@ namespace {
 constexpr double degree = std::numbers::pi / 180.0;
 }
 
-void Solver::install_liner(int set) {
-    auto& L = liners_;
-    const LinerSpec& spec = liner_specs_[set];
+LinerSupport::LinerSupport(const std::vector<LinerSpec>& specs) : specs_(specs) {
+    for (const auto& spec : specs) {
+        const double e = spec.young / (1.0 - spec.poisson * spec.poisson), t = spec.thickness;
+        const double ring = e * t / (spec.radius * spec.radius);
+        const double kn = spec.normal_stiffness > 0.0 ? spec.normal_stiffness : 10.0 * ring;
+        names_.push_back(spec.name);
+        state_.sets.push_back({e * t, e * t * t * t / 12.0, spec.density * t, spec.density * t * t * t / 12.0, kn,
+                               spec.shear_stiffness > 0.0 ? spec.shear_stiffness : kn, spec.tensile_strength,
+                               spec.cohesion, std::tan(spec.friction * 3.141592653589793 / 180.0),
+                               spec.thrust_capacity, spec.tension_capacity, spec.moment_capacity,
+                               std::uint8_t(spec.symmetric_ends)});
+    }
+    state_.installed.assign(state_.sets.size(), 0);
+}
+
+void LinerSupport::install(int set, const HostFinder& find) {
+    auto& L = state_;
+    const LinerSpec& spec = specs_[set];
     L.installed[set] = 1;
     const double span = (spec.to - spec.from) * degree;
     const bool closed = std::abs(spec.to - spec.from - 360.0) < 1e-9;
@@ -26,7 +43,7 @@ void Solver::install_liner(int set) {
         const double a = spec.from * degree + span * double(j) / n;
         const Vec2 p = spec.center + spec.radius * Vec2{std::cos(a), std::sin(a)};
         const double chord = 2.0 * spec.radius * std::sin(0.5 * std::abs(span) / n);
-        const BoltHost h = find_host(p, 0.5 * chord);
+        const BoltHost h = find(p, 0.5 * chord);
         if (h.block < 0)
             throw InputError("", 0, "liner[" + std::to_string(set) + "]",
                              "liner '" + spec.name + "': its node at (" + std::to_string(p.x) + ", " +
@@ -46,8 +63,6 @@ void Solver::install_liner(int set) {
         L.separated.push_back(0);
         L.normal_stress.push_back(0.0);
         L.node_set.push_back(set);
-        L.reaction.push_back({});
-        L.reaction_moment.push_back(0.0);
         const bool end = !closed && spec.symmetric_ends && (j == 0 || j == n);
         L.held.push_back(end ? Vec2{-std::sin(a), std::cos(a)} : Vec2{});
     }
@@ -75,16 +90,10 @@ namespace {
 inline int next_node(const LinerState& L, int liner, int a) {
     return a + 1 < L.first[liner + 1] ? a + 1 : L.first[liner];
 }
-/// An angle in (−π, π].
-inline double wrap(double angle) {
-    while (angle > std::numbers::pi) angle -= 2.0 * std::numbers::pi;
-    while (angle < -std::numbers::pi) angle += 2.0 * std::numbers::pi;
-    return angle;
-}
 } // namespace
 
-void Solver::liner_pass() {
-    auto& L = liners_;
+void LinerSupport::force_pass(const SupportRock& rock, Vec2* reaction, double* reaction_moment) {
+    auto& L = state_;
     std::fill(L.force.begin(), L.force.end(), Vec2{});
     std::fill(L.moment.begin(), L.moment.end(), 0.0);
     int liner = 0;
@@ -93,36 +102,17 @@ void Solver::liner_pass() {
         while (a >= L.first[liner + 1]) ++liner;
         const int b = next_node(L, liner, a);
         const auto& set = L.sets[L.node_set[a]];
-        const Vec2 c = L.position[b] - L.position[a];
-        const double l = norm(c), l0 = L.rest[e];
-        const Vec2 ex = c / l, ey = perp(ex);
-        const double beta = wrap(std::atan2(c.y, c.x) - L.chord0[e]);
-        const double ta = L.theta[a] - beta, tb = L.theta[b] - beta;
-        const double strain = (l - l0) / l0;
-        double tension = set.ea * (strain - L.plastic_strain[e]);
-        if (set.thrust_capacity > 0.0 && (-tension > set.thrust_capacity || tension > set.tension_capacity)) {
-            tension = std::clamp(tension, -set.thrust_capacity, set.tension_capacity);
-            L.plastic_strain[e] = strain - tension / set.ea;
-            L.yielded[e] |= 1;
-        }
-        const double ea_ = ta - L.plastic_rotation_a[e], eb_ = tb - L.plastic_rotation_b[e];
-        double ma = set.ei / l0 * (4.0 * ea_ + 2.0 * eb_), mb = set.ei / l0 * (2.0 * ea_ + 4.0 * eb_);
-        if (set.moment_capacity > 0.0 && (std::abs(ma) > set.moment_capacity || std::abs(mb) > set.moment_capacity)) {
-            // Plastic rotations at the ends that bring each end moment back to the
-            // capacity (a hinge), the other end's elastic rotation unchanged.
-            ma = std::clamp(ma, -set.moment_capacity, set.moment_capacity);
-            mb = std::clamp(mb, -set.moment_capacity, set.moment_capacity);
-            // Elastic end rotations giving (ma, mb): the inverse of [[4, 2], [2, 4]] EI/l0.
-            const double ra = l0 / set.ei * (4.0 * ma - 2.0 * mb) / 12.0, rb = l0 / set.ei * (4.0 * mb - 2.0 * ma) / 12.0;
-            L.plastic_rotation_a[e] = ta - ra;
-            L.plastic_rotation_b[e] = tb - rb;
-            L.yielded[e] |= 2;
-        }
-        const double shear = (ma + mb) / l;
-        L.thrust[e] = -tension;
+        const support::BeamSection section{set.ea, set.ei, set.thrust_capacity > 0.0, -set.thrust_capacity,
+                                           set.tension_capacity, set.moment_capacity};
+        const auto beam = support::beam_forces(L.position[a], L.position[b], L.theta[a], L.theta[b], L.rest[e],
+                                               L.chord0[e], section, L.plastic_strain[e], L.plastic_rotation_a[e],
+                                               L.plastic_rotation_b[e]);
+        const double ma = beam.ma, mb = beam.mb;
+        L.yielded[e] |= beam.yielded;
+        L.thrust[e] = -beam.tension;
         L.moment_a[e] = ma;
         L.moment_b[e] = mb;
-        const Vec2 f = tension * ex - shear * ey;
+        const Vec2 f = beam.force_on_a;
         L.force[a] += f;
         L.force[b] -= f;
         L.moment[a] -= ma;
@@ -133,8 +123,8 @@ void Solver::liner_pass() {
         const bool closed = L.closed[l];
         for (int k = first; k <= last; ++k) {
             const BoltHost& h = L.host[k];
-            if (h.block < 0 || b_.removed[h.block]) {
-                L.reaction[k] = {}, L.reaction_moment[k] = 0.0, L.normal_stress[k] = 0.0;
+            if (!rock.holds(h)) {
+                reaction[k] = {}, reaction_moment[k] = 0.0, L.normal_stress[k] = 0.0;
                 continue;
             }
             const auto& set = L.sets[L.node_set[k]];
@@ -142,7 +132,7 @@ void Solver::liner_pass() {
             const int before = k > first ? k - 1 : (closed ? last : k), after = k < last ? k + 1 : (closed ? first : k);
             const Vec2 along = L.position[after] - L.position[before];
             const Vec2 t = along / norm(along), n{t.y, -t.x};
-            const Vec2 x = host_position(h), d = x - L.position[k];
+            const Vec2 x = rock.position(h), d = x - L.position[k];
             const double dn = dot(d, n), ds = dot(d, t);
             double sn = set.kn * dn;
             if (!L.separated[k] && sn > set.tensile) L.separated[k] = 1;
@@ -152,15 +142,15 @@ void Solver::liner_pass() {
             L.normal_stress[k] = sn;
             const Vec2 f = L.length[k] * (sn * n + tau * t);
             L.force[k] += f;
-            tie_reaction(h, x, f, L.reaction[k], L.reaction_moment[k]);
+            rock.reaction(h, x, f, reaction[k], reaction_moment[k]);
         }
     }
 }
 
-double Solver::integrate_liners(double& work) {
-    auto& L = liners_;
-    const double alpha = settings_.damping, dt = dt_;
-    const Vec2 g = settings_.gravity;
+double LinerSupport::integrate(const SupportMotion& motion, double& work) {
+    auto& L = state_;
+    const double alpha = motion.damping, dt = motion.dt;
+    const Vec2 g = motion.gravity;
     double unbalanced = 0.0;
     for (int k = 0; k < L.node_count(); ++k) {
         const Vec2 weight = (L.sets[L.node_set[k]].line_mass * L.length[k]) * g;
@@ -185,11 +175,11 @@ double Solver::integrate_liners(double& work) {
     return unbalanced;
 }
 
-void Solver::add_liner_stiffness(std::vector<double>& k, std::vector<double>& kr, std::vector<double>& kn,
-                                 double mass_factor) {
-    auto& L = liners_;
-    auto& own = liner_stiffness_;
-    auto& own_rotation = liner_rotation_stiffness_;
+void LinerSupport::add_stiffness(RockStiffness& rock) {
+    auto& L = state_;
+    auto& own = stiffness_;
+    auto& own_rotation = rotation_stiffness_;
+    const double mass_factor = rock.mass_factor;
     own.assign(L.node_count(), 0.0);
     own_rotation.assign(L.node_count(), 0.0);
     int liner = 0;
@@ -208,10 +198,10 @@ void Solver::add_liner_stiffness(std::vector<double>& k, std::vector<double>& kr
     for (int i = 0; i < L.node_count(); ++i) {
         const auto& set = L.sets[L.node_set[i]];
         const BoltHost& h = L.host[i];
-        if (h.block >= 0 && !b_.removed[h.block]) {
+        if (rock.rock.holds(h)) {
             const double kg = L.length[i] * std::max(set.kn, set.ks);
             own[i] += kg;
-            add_tie_stiffness(h, kg, k, kr, kn);
+            rock.add_tie(h, kg);
         }
         const double real = set.line_mass * L.length[i], real_inertia = set.line_inertia * L.length[i];
         L.mass[i] = mass_factor > 0.0 ? std::max(own[i] * mass_factor, 1e-300) : real;
@@ -219,23 +209,72 @@ void Solver::add_liner_stiffness(std::vector<double>& k, std::vector<double>& kr
     }
 }
 
-double Solver::liner_time_limit() const {
+double LinerSupport::time_limit() const {
     double limit = INFINITY;
-    for (int i = 0; i < liners_.node_count(); ++i) {
-        if (liner_stiffness_[i] > 0.0) limit = std::min(limit, 2.0 * std::sqrt(liners_.mass[i] / liner_stiffness_[i]));
-        if (liner_rotation_stiffness_[i] > 0.0)
-            limit = std::min(limit, 2.0 * std::sqrt(liners_.inertia[i] / liner_rotation_stiffness_[i]));
+    for (int i = 0; i < state_.node_count(); ++i) {
+        if (stiffness_[i] > 0.0) limit = std::min(limit, 2.0 * std::sqrt(state_.mass[i] / stiffness_[i]));
+        if (rotation_stiffness_[i] > 0.0)
+            limit = std::min(limit, 2.0 * std::sqrt(state_.inertia[i] / rotation_stiffness_[i]));
     }
     return limit;
 }
 
-std::vector<LinerSetSummary> Solver::liner_summary() const {
-    const auto& L = liners_;
+void LinerSupport::model_parameters(std::vector<double>& out) const {
+    for (const auto& set : state_.sets)
+        out.insert(out.end(), {set.ea, set.ei, set.line_mass, set.line_inertia, set.kn, set.ks, set.tensile,
+                               set.cohesion, set.tan_friction, set.thrust_capacity, set.tension_capacity,
+                               set.moment_capacity, double(set.symmetric_ends)});
+}
+
+std::vector<SupportField> LinerSupport::fields() {
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, R = field_use::rebuilt;
+    auto& L = state_;
+    return {{{"liners.installed", G::other, E}, &L.installed},
+            {{"liners.position", G::other, E}, &L.position},
+            {{"liners.velocity", G::other, E}, &L.velocity},
+            {{"liners.theta", G::other, E}, &L.theta},
+            {{"liners.omega", G::other, E}, &L.omega},
+            {{"liners.mass", G::other, E}, &L.mass},
+            {{"liners.inertia", G::other, E}, &L.inertia},
+            {{"liners.length", G::other, E}, &L.length},
+            {{"liners.shear_slip", G::other, E}, &L.shear_slip},
+            {{"liners.host", G::other, E}, &L.host},
+            {{"liners.separated", G::other, E}, &L.separated},
+            {{"liners.normal_stress", G::other, E}, &L.normal_stress},
+            {{"liners.node_set", G::other, E}, &L.node_set},
+            {{"liners.held", G::other, E}, &L.held},
+            {{"liners.element_node", G::other, E}, &L.element_node},
+            {{"liners.rest", G::other, E}, &L.rest},
+            {{"liners.chord0", G::other, E}, &L.chord0},
+            {{"liners.thrust", G::other, E}, &L.thrust},
+            {{"liners.moment_a", G::other, E}, &L.moment_a},
+            {{"liners.moment_b", G::other, E}, &L.moment_b},
+            {{"liners.plastic_strain", G::other, E}, &L.plastic_strain},
+            {{"liners.plastic_rotation_a", G::other, E}, &L.plastic_rotation_a},
+            {{"liners.plastic_rotation_b", G::other, E}, &L.plastic_rotation_b},
+            {{"liners.yielded", G::other, E}, &L.yielded},
+            {{"liners.first", G::other, E}, &L.first},
+            {{"liners.liner_set", G::other, E}, &L.liner_set},
+            {{"liners.closed", G::other, E}, &L.closed},
+            {{"liners.force", G::other, R}, &L.force},
+            {{"liners.moment", G::other, R}, &L.moment},
+            {{"liners.stiffness", G::other, R}, &stiffness_},
+            {{"liners.rotation_stiffness", G::other, R}, &rotation_stiffness_}};
+}
+
+void LinerSupport::after_load() {
+    state_.force.assign(state_.position.size(), {});
+    state_.moment.assign(state_.position.size(), 0.0);
+}
+
+std::vector<LinerSetSummary> LinerSupport::set_summary() const {
+    const auto& L = state_;
     std::vector<LinerSetSummary> out;
     for (std::size_t set = 0; set < L.sets.size(); ++set) {
         if (!L.installed[set]) continue;
         LinerSetSummary s;
-        s.name = liner_names_[set];
+        s.name = names_[set];
         s.min_thrust = INFINITY, s.max_thrust = -INFINITY;
         for (int e = 0; e < L.element_count(); ++e) {
             if (L.node_set[L.element_node[e]] != int(set)) continue;
@@ -250,6 +289,52 @@ std::vector<LinerSetSummary> Solver::liner_summary() const {
         if (!std::isfinite(s.max_thrust)) s.max_thrust = s.min_thrust = 0.0;
         out.push_back(s);
     }
+    return out;
+}
+
+std::vector<SupportSetSummary> LinerSupport::summary() const {
+    std::vector<SupportSetSummary> out;
+    for (const auto& l : set_summary())
+        out.push_back({l.name,
+                       {{"nodes", double(l.nodes), true},
+                        {"max_thrust_kN_per_m", l.max_thrust / 1e3},
+                        {"min_thrust_kN_per_m", l.min_thrust / 1e3},
+                        {"max_moment_kNm_per_m", l.max_moment / 1e3},
+                        {"open_interface_nodes", double(l.open), true},
+                        {"elements", double(l.elements), true},
+                        {"yielded_elements", double(l.yielded), true}}});
+    return out;
+}
+
+SupportLines LinerSupport::lines() const {
+    const auto& L = state_;
+    SupportLines out;
+    out.points = L.position;
+    SupportLines::Array thrust{"thrust_kN_per_m", {}, false}, moment{"moment_kNm_per_m", {}, false},
+        liner{"liner", {}, true}, yielded{"yielded", {}, true};
+    int l = 0;
+    for (int e = 0; e < L.element_count(); ++e) {
+        const int a = L.element_node[e];
+        while (a >= L.first[l + 1]) ++l; // element e's liner, and so its second node
+        out.cells.push_back({a, next_node(L, l, a)});
+        thrust.values.push_back(L.thrust[e] / 1e3);
+        moment.values.push_back(
+            (std::abs(L.moment_a[e]) >= std::abs(L.moment_b[e]) ? L.moment_a[e] : -L.moment_b[e]) / 1e3);
+        liner.values.push_back(l);
+        yielded.values.push_back(L.yielded[e]);
+        out.mark.push_back(L.yielded[e] ? 1 : 0);
+    }
+    out.cell_data = {thrust, moment, liner, yielded};
+    SupportLines::Array normal{"interface_normal_MPa", {}, false}, open{"interface_open", {}, true};
+    for (int k = 0; k < L.node_count(); ++k) {
+        normal.values.push_back(L.normal_stress[k] / 1e6);
+        open.values.push_back(L.separated[k] && L.normal_stress[k] == 0.0);
+    }
+    out.point_data = {normal, open};
+    out.names = {{"liner_names", names_}};
+    out.look = SupportLines::Look::lining;
+    out.shade = 0;
+    out.shade_label = "kN/m thrust";
     return out;
 }
 

@@ -72,8 +72,6 @@ struct LinerState {
     std::vector<std::uint8_t> separated; ///< the interface's tensile bond is gone
     std::vector<double> normal_stress;   ///< last interface normal stress, Pa (> 0 tension)
     std::vector<int> node_set;
-    std::vector<Vec2> reaction;           ///< scratch: the interface's force on the rock
-    std::vector<double> reaction_moment;  ///< scratch: its moment about a rigid host's centroid
     std::vector<Vec2> held;               ///< an end on a symmetry plane: the direction held (else zero)
     // elements: between nodes element_node[e] and element_node[e] + 1
     std::vector<int> element_node;
@@ -97,6 +95,41 @@ struct LinerSetSummary {
     int open = 0; ///< nodes whose interface gap is open now (bond broken, no contact)
     int yielded = 0; ///< elements that have yielded (thrust or moment)
     int elements = 0;
+};
+
+/// The [[liner]]s of a model as a support type (core/support.hpp).
+class LinerSupport final : public Support {
+public:
+    explicit LinerSupport(const std::vector<LinerSpec>& specs);
+    const char* name() const override { return "liners"; }
+    const std::vector<std::string>& set_names() const override { return names_; }
+    bool installed(int set) const override { return state_.installed[set] != 0; }
+    void install(int set, const HostFinder& find) override;
+    int tie_count() const override { return state_.node_count(); }
+    const BoltHost& host(int tie) const override { return state_.host[tie]; }
+    void force_pass(const SupportRock& rock, Vec2* reaction, double* moment) override;
+    double integrate(const SupportMotion& motion, double& work) override;
+    void add_stiffness(RockStiffness& k) override;
+    double time_limit() const override;
+    void model_parameters(std::vector<double>& out) const override;
+    std::vector<SupportField> fields() override;
+    void after_load() override;
+    std::vector<SupportSetSummary> summary() const override;
+    /// One line cell per beam element, cell data thrust_kN_per_m (compression
+    /// positive), moment_kNm_per_m (the larger end moment by magnitude, with its
+    /// sign), liner, yielded (bit 0 thrust, bit 1 bending); point data
+    /// interface_normal_MPa (tension positive), interface_open. Field data liner_names.
+    SupportLines lines() const override;
+
+    const LinerState& state() const { return state_; }
+    /// Per installed liner: thrust and moment extremes, separated interface nodes.
+    std::vector<LinerSetSummary> set_summary() const;
+
+private:
+    LinerState state_;
+    std::vector<std::string> names_;
+    std::vector<LinerSpec> specs_;
+    std::vector<double> stiffness_, rotation_stiffness_; ///< per node, scratch of add_stiffness()
 };
 
 } // namespace bbm

@@ -10,6 +10,7 @@
 
 #include "base/vec2.hpp"
 #include "core/bolts.hpp"
+#include "core/dowels.hpp"
 #include "core/liners.hpp"
 #include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
@@ -156,6 +157,7 @@ struct AnalysisSpec {
     std::vector<StageSpec> stages;
     std::vector<BoltSetSpec> bolts; ///< support sets, installed by install stages
     std::vector<LinerSpec> liners;
+    std::vector<DowelSetSpec> dowels;
     ReportSpec report;
 };
 

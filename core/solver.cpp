@@ -323,30 +323,9 @@ Solver::Solver(const meshing::BlockAssembly& a, const AnalysisSpec& an) : settin
     rebuild_contact_index();
 
     apply_boundaries(an, a);
-    // Support sets (core/bolts.hpp): properties per metre of model; installed by stages.
-    for (const auto& spec : an.bolts) {
-        const double S = spec.spacing;
-        bolt_specs_.push_back(spec);
-        bolt_names_.push_back(spec.name);
-        bolts_.sets.push_back({spec.young * spec.area / S, spec.yield_force / S, spec.rupture_strain,
-                               spec.bond_stiffness / S, spec.bond_strength / S,
-                               (spec.normal_stiffness > 0.0 ? spec.normal_stiffness : spec.bond_stiffness) / S,
-                               spec.density * spec.area / S, S, std::uint8_t(spec.cable)});
-    }
-    bolts_.installed.assign(bolts_.sets.size(), 0);
-    for (const auto& spec : an.liners) {
-        const double e = spec.young / (1.0 - spec.poisson * spec.poisson), t = spec.thickness;
-        const double ring = e * t / (spec.radius * spec.radius);
-        const double kn = spec.normal_stiffness > 0.0 ? spec.normal_stiffness : 10.0 * ring;
-        liner_specs_.push_back(spec);
-        liner_names_.push_back(spec.name);
-        liners_.sets.push_back({e * t, e * t * t * t / 12.0, spec.density * t, spec.density * t * t * t / 12.0, kn,
-                                spec.shear_stiffness > 0.0 ? spec.shear_stiffness : kn, spec.tensile_strength,
-                                spec.cohesion, std::tan(spec.friction * 3.141592653589793 / 180.0),
-                                spec.thrust_capacity, spec.tension_capacity, spec.moment_capacity,
-                                std::uint8_t(spec.symmetric_ends)});
-    }
-    liners_.installed.assign(liners_.sets.size(), 0);
+    // Support types (core/support.hpp), their sets installed by stages.
+    supports_ = make_supports(an);
+    index_support_ties();
     update_vertices();
     update_timestep();
     fingerprint_ = compute_model_fingerprint();
@@ -395,7 +374,7 @@ void Solver::apply_boundaries(const AnalysisSpec& an, const meshing::BlockAssemb
                         sum += norm(q - p) * 0.5 * (p + q);
                         len += norm(q - p);
                     }
-                    if (len > 0) supports_.push_back({i, sum / len - b_.centroid[i]});
+                    if (len > 0) held_points_.push_back({i, sum / len - b_.centroid[i]});
                 }
                 if (bc.vx) b_.fixed[i] |= 1, b_.fixed_velocity[i].x = *bc.vx;
                 if (bc.vy) b_.fixed[i] |= 2, b_.fixed_velocity[i].y = *bc.vy;
@@ -532,11 +511,11 @@ void Solver::update_timestep() {
     }
     const double s = settings_.safety;
     const bool scaled = settings_.mode == SolverSpec::Mode::quasi_static;
-    if (bolts_.node_count() + liners_.node_count() > 0) {
+    if (tie_reaction_.size() > 0) {
         const double step = scaled ? (settings_.timestep > 0 ? settings_.timestep : 1.0) : 0.0;
-        const double factor = scaled ? (step / (2.0 * s)) * (step / (2.0 * s)) : 0.0;
-        if (bolts_.node_count() > 0) add_bolt_stiffness(k, kr, kn, factor);
-        if (liners_.node_count() > 0) add_liner_stiffness(k, kr, kn, factor);
+        RockStiffness rock{support_rock(), k, kr, kn, scaled ? (step / (2.0 * s)) * (step / (2.0 * s)) : 0.0};
+        for (auto& support : supports_)
+            if (support->tie_count() > 0) support->add_stiffness(rock);
     }
     if (scaled) {
         dt_ = settings_.timestep > 0 ? settings_.timestep : 1.0;
@@ -557,8 +536,8 @@ void Solver::update_timestep() {
         }
         for (int i = 0; i < nn; ++i)
             if (!b_.removed[n_.block[i]] && kn[i] > 0) limit = std::min(limit, 2.0 * std::sqrt(n_.real_mass[i] / kn[i]));
-        if (bolts_.node_count() > 0) limit = std::min(limit, bolt_time_limit());
-        if (liners_.node_count() > 0) limit = std::min(limit, liner_time_limit());
+        for (const auto& support : supports_)
+            if (support->tie_count() > 0) limit = std::min(limit, support->time_limit());
         dt_ = settings_.timestep > 0 ? settings_.timestep : (std::isfinite(limit) ? s * limit : 1e-3);
         b_.mass = b_.real_mass;
         b_.inertia = b_.real_inertia;
@@ -701,14 +680,18 @@ void Solver::face_slip_stage() {
 }
 
 void Solver::support_stage() {
-    // Bolts and liners: one thread, no barrier: it goes on to its share of the
+    // The supports: one thread, no barrier: it goes on to its share of the
     // contacts; their reactions are gathered after the contact and zone passes'
     // barrier.
-    if (bolts_.node_count() + liners_.node_count() == 0) return;
+    if (tie_reaction_.empty()) return;
 #pragma omp single nowait
     {
-        if (bolts_.node_count() > 0) bolt_pass();
-        if (liners_.node_count() > 0) liner_pass();
+        const SupportRock rock = support_rock();
+        for (std::size_t k = 0; k < supports_.size(); ++k)
+            if (supports_[k]->tie_count() > 0) {
+                const int first = support_tie_first_[k];
+                supports_[k]->force_pass(rock, tie_reaction_.data() + first, tie_moment_.data() + first);
+            }
     }
 }
 
@@ -734,8 +717,7 @@ void Solver::gather_stage() {
     // One gather per block and node: its contacts' and zones' forces in a fixed
     // order, plus gravity, boundary loads, relaxing and constant support pressures
     // and the reactions of its support ties.
-    const int bolt_ties = bolts_.node_count();
-    const bool bolts = bolt_ties + liners_.node_count() > 0;
+    const bool ties = !tie_reaction_.empty();
     const Vec2 g = settings_.gravity;
     // The support of the excavated rock: relaxed linearly to the fraction kept (a
     // fictitious support pressure, the convergence–confinement method's 1 − λ).
@@ -755,11 +737,10 @@ void Solver::gather_stage() {
         m += b_.applied_moment[i];
         if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
         if (pressure) f += pressure_block_force_[i], m += pressure_block_moment_[i];
-        if (bolts)
-            for (int t = bolt_block_first_[i]; t < bolt_block_first_[i + 1]; ++t) {
-                const int tie = bolt_block_tie_[t];
-                if (tie < bolt_ties) f += bolts_.reaction[tie], m += bolts_.reaction_moment[tie];
-                else f += liners_.reaction[tie - bolt_ties], m += liners_.reaction_moment[tie - bolt_ties];
+        if (ties)
+            for (int t = tie_block_first_[i]; t < tie_block_first_[i + 1]; ++t) {
+                const int tie = tie_block_tie_[t];
+                f += tie_reaction_[tie], m += tie_moment_[tie];
             }
         b_.force[i] = f;
         b_.moment[i] = m;
@@ -769,10 +750,10 @@ void Solver::gather_stage() {
         Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
         if (relax > 0.0) f += relax * relax_node_force_[k];
         if (pressure) f += pressure_node_force_[k];
-        if (bolts)
-            for (int t = bolt_node_first_[k]; t < bolt_node_first_[k + 1]; ++t) {
-                const auto [tie, weight] = bolt_node_tie_[t];
-                f += weight * (tie < bolt_ties ? bolts_.reaction[tie] : liners_.reaction[tie - bolt_ties]);
+        if (ties)
+            for (int t = tie_node_first_[k]; t < tie_node_first_[k + 1]; ++t) {
+                const auto [tie, weight] = tie_node_tie_[t];
+                f += weight * tie_reaction_[tie];
             }
         n_.force[k] = f;
     }
@@ -851,8 +832,9 @@ void Solver::integrate() {
             work_ += chunk_sums_[chunk].work;
             max_unbalanced = std::max(max_unbalanced, chunk_sums_[chunk].unbalanced);
         }
-        if (bolts_.node_count() > 0) max_unbalanced = std::max(max_unbalanced, integrate_bolts(work_));
-        if (liners_.node_count() > 0) max_unbalanced = std::max(max_unbalanced, integrate_liners(work_));
+        const SupportMotion motion{dt_, settings_.damping, settings_.gravity};
+        for (auto& support : supports_)
+            if (support->tie_count() > 0) max_unbalanced = std::max(max_unbalanced, support->integrate(motion, work_));
         const double scale = force_scale();
         ratio_ = scale > 0.0 ? max_unbalanced / scale : 0.0;
     }
@@ -871,15 +853,15 @@ void Solver::sum_boundary_forces() {
 double Solver::force_scale() const {
     // The root-mean-square contact (and zone nodal) force. SPEC §5 says "mean
     // contact force magnitude"; RMS >= mean, and it needs no square root per contact.
-    // Bolts count with their segments' axial forces (a bolt may be all that holds a block).
-    const double terms = double(c_.size()) + 3.0 * double(z_.size()) + double(bolts_.segment_count());
+    // Supports add the elements that may be all that holds a block (a bolt's segments).
+    double terms = double(c_.size()) + 3.0 * double(z_.size());
     double squares = contact::contact_force_squares(c_) + (z_.size() > 0 ? fem::zone_force_squares(z_) : 0.0);
-    for (double n : bolts_.axial) squares += n * n;
+    for (const auto& support : supports_) support->add_force_scale(terms, squares);
     double mean_force = terms > 0 ? std::sqrt(squares / terms) : 0.0;
     if (mean_force <= 0.0) {
         for (int i = 0; i < b_.count(); ++i) mean_force += norm(b_.applied[i] + b_.real_mass[i] * settings_.gravity);
         for (int i = 0; i < n_.count(); ++i) mean_force += norm(n_.applied[i] + n_.real_mass[i] * settings_.gravity);
-        for (Vec2 f : bolts_.applied) mean_force += norm(f);
+        for (const auto& support : supports_) support->add_applied_loads(mean_force);
         mean_force /= std::max(1, b_.count() + n_.count());
     }
     return mean_force;
@@ -1116,7 +1098,7 @@ std::vector<std::array<double, 3>> Solver::block_stresses() const {
     // Supports (reaction = minus the force on the prescribed components), where a
     // `touching` boundary holds the block: without them a block on a symmetry
     // plane would show half its stress across the plane.
-    for (const auto& sp : supports_) {
+    for (const auto& sp : held_points_) {
         const int i = sp.block;
         const Vec2 reaction{(b_.fixed[i] & 1) ? -b_.force[i].x : 0.0, (b_.fixed[i] & 2) ? -b_.force[i].y : 0.0};
         add(i, rotation(b_.theta[i])(sp.offset), reaction);

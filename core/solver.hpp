@@ -4,7 +4,7 @@
 //   1. (when due) contact detection update          — detect_if_due()
 //   2. contact forces from displacement increments   — face_slip_stage(), contact_and_zone_stage()
 //   3. zone stresses of deformable blocks            —   the zone pass (fem/cst.hpp) in the latter
-//   4. gravity, boundary tractions, applied loads    — support_stage() (bolts, liners), gather_stage()
+//   4. gravity, boundary tractions, applied loads    — support_stage() (core/support.hpp), gather_stage()
 //   5. damping and integration, prescribed velocities — integrate()
 //   6. convergence measure                           — the unbalanced-force ratio
 //
@@ -43,6 +43,7 @@
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
 #include "core/model_spec.hpp"
+#include "core/support.hpp"
 #include "core/state_fields.hpp"
 #include "core/verdict.hpp"
 #include "fem/cst.hpp"
@@ -51,6 +52,8 @@
 #include <array>
 #include <cstdint>
 #include <iosfwd>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -89,22 +92,23 @@ public:
     void excavate(const std::vector<std::string>& regions, long relax_steps, double keep = 0.0,
                   double pressure = 0.0);
     void step();
-    /// Installs the named [[bolt]] sets (core/bolts.hpp): nodes along each bolt,
-    /// each tied to the rock it lies in now, unstressed. Throws InputError (key
-    /// "stage.supports") for an unknown or already installed set.
-    void install_bolts(const std::vector<std::string>& sets);
-    /// Installs the named supports, [[bolt]] sets or [[liner]]s (core/liners.hpp):
-    /// what an `install` stage does.
+    /// Installs the named support sets, of any registered type (core/support.hpp:
+    /// [[bolt]] sets, [[liner]]s, …): what an `install` stage does. Each node is
+    /// tied to the rock it lies in now. Throws InputError (key "stage.supports")
+    /// for an unknown or already installed set.
     void install_supports(const std::vector<std::string>& names);
-    const LinerState& liners() const { return liners_; }
-    const std::vector<std::string>& liner_names() const { return liner_names_; }
-    /// Per installed liner: thrust and moment extremes, separated interface nodes.
-    std::vector<LinerSetSummary> liner_summary() const;
-    const BoltState& bolts() const { return bolts_; }
-    BoltState& bolts() { return bolts_; } ///< a study may load a node (BoltState::applied)
-    const std::vector<std::string>& bolt_set_names() const { return bolt_names_; }
-    /// Per installed set: loads per bolt and how many yielded or broke.
-    std::vector<BoltSetSummary> bolt_summary() const;
+    /// The registered support types, in tie order (core/support.cpp).
+    const std::vector<std::unique_ptr<Support>>& supports() const { return supports_; }
+    /// The support of a registered type.
+    template <class T>
+    T& support() const {
+        for (const auto& s : supports_)
+            if (auto* t = dynamic_cast<T*>(s.get())) return *t;
+        throw std::logic_error("support type not registered");
+    }
+    const BoltState& bolts() const { return support<BoltSupport>().state(); }
+    BoltState& bolts() { return support<BoltSupport>().state(); } ///< a study may load a node (BoltState::applied)
+    const LinerState& liners() const { return support<LinerSupport>().state(); }
     /// Recomputes time step and (quasi-static) masses from the current contacts.
     void update_timestep();
     /// Implicit elastic stage (SPEC §5): assembles the linear stiffness of blocks
@@ -252,7 +256,7 @@ private:
     void compute_forces();
     // The force stages of a step (core/solver.cpp), in order.
     void face_slip_stage();        ///< mean slip of rigid faces on deformable blocks
-    void support_stage();          ///< bolts and liners, one thread, no barrier
+    void support_stage();          ///< the supports' force passes, one thread, no barrier
     void contact_and_zone_stage(); ///< the contact and zone passes, then a barrier
     void gather_stage();           ///< each block's and node's forces, in a fixed order
     /// The contact loop does not store normals (a write of every contact every
@@ -269,29 +273,14 @@ private:
     /// Per hashed field, its name and the hash of its bytes (load_state's check).
     std::vector<std::pair<std::string, std::uint64_t>> field_hashes() const;
     void integrate();
-    // Bolts (core/bolts.cpp).
-    void bolt_pass();                       ///< segment and grout forces, reactions on the rock
-    double integrate_bolts(double& work);   ///< returns the largest free force component
-    void add_bolt_stiffness(std::vector<double>& block, std::vector<double>& rotation,
-                            std::vector<double>& node, double mass_factor);
-    double bolt_time_limit() const;         ///< dynamic: the bolts' critical time step
+    /// Where a point lies in the rock (a rigid block or a zone), else the nearest
+    /// within `reach` (core/solver_supports.cpp): a support's install.
     BoltHost find_host(Vec2 p, double reach) const;
-    /// The per-block and per-node lists of support ties — bolt nodes, then liner
-    /// nodes numbered after them (after an install, a load).
-    void index_bolt_hosts();
-    // Liners (core/liners.cpp).
-    void install_liner(int set);
-    void liner_pass();
-    double integrate_liners(double& work);
-    void add_liner_stiffness(std::vector<double>& block, std::vector<double>& rotation, std::vector<double>& node,
-                             double mass_factor);
-    double liner_time_limit() const;
-    Vec2 host_position(const BoltHost& h) const;
-    /// A tie's force f on its support node at rock point x: the opposite on the rock.
-    void tie_reaction(const BoltHost& h, Vec2 x, Vec2 f, Vec2& reaction, double& moment) const;
-    /// A tie's stiffness added to its rock's (block translation and rotation, or zone nodes).
-    void add_tie_stiffness(const BoltHost& h, double stiffness, std::vector<double>& block,
-                           std::vector<double>& rotation, std::vector<double>& node) const;
+    /// The rock as the supports see it this step.
+    SupportRock support_rock() const;
+    /// The per-block and per-node lists of support ties, numbered through the
+    /// support types in registry order (after an install, a load).
+    void index_support_ties();
     void apply_boundaries(const AnalysisSpec& a, const meshing::BlockAssembly& blocks);
     std::vector<int> select_blocks(const SelectionSpec& s) const;
 
@@ -301,17 +290,16 @@ private:
     mutable contact::Contacts c_; ///< mutable: its normals are a cache (refresh_normals)
     mutable bool normals_stale_ = true;
     StageMonitor monitor_;
-    BoltState bolts_;
-    std::vector<std::string> bolt_names_;
-    std::vector<BoltSetSpec> bolt_specs_;
-    std::vector<double> bolt_stiffness_; ///< per bolt node, scratch of update_timestep()
-    LinerState liners_;
-    std::vector<std::string> liner_names_;
-    std::vector<LinerSpec> liner_specs_;
-    std::vector<double> liner_stiffness_, liner_rotation_stiffness_; ///< per liner node, scratch
-    /// Bolt nodes tied to each rigid block (CSR), and (bolt node, weight) to each FE node.
-    std::vector<int> bolt_block_first_, bolt_block_tie_, bolt_node_first_;
-    std::vector<std::pair<int, double>> bolt_node_tie_;
+    /// The support types (core/support.hpp), and the first tie of each (of supports_.size() + 1).
+    std::vector<std::unique_ptr<Support>> supports_;
+    std::vector<int> support_tie_first_;
+    /// What each support tie puts on its rock this step (the force, and its moment
+    /// about a rigid host's centroid): written by the support stage, gathered by the rock.
+    std::vector<Vec2> tie_reaction_;
+    std::vector<double> tie_moment_;
+    /// Ties to each rigid block (CSR), and (tie, weight) to each FE node.
+    std::vector<int> tie_block_first_, tie_block_tie_, tie_node_first_;
+    std::vector<std::pair<int, double>> tie_node_tie_;
     std::vector<contact::JointLaw> laws_;
     std::vector<std::string> property_names_;
     std::vector<std::uint8_t> face_shear_; ///< per property set: JointPropertySpec::face_shear
@@ -324,8 +312,8 @@ private:
     std::vector<Traction> tractions_;
     /// Blocks held by a `touching` velocity boundary: where the support acts (the
     /// mean midpoint of their edges in the box, body frame), for block stresses.
-    struct Support { int block; Vec2 offset; };
-    std::vector<Support> supports_;
+    struct HeldPoint { int block; Vec2 offset; };
+    std::vector<HeldPoint> held_points_;
     /// Work of the loads and largest unbalanced force of a step per fixed chunk of
     /// bodies (integrate()).
     static constexpr int sum_chunk = 512;

@@ -27,6 +27,7 @@
 #include <ostream>
 #include <stdexcept>
 #include <type_traits>
+#include <variant>
 
 namespace bbm {
 
@@ -36,9 +37,9 @@ namespace {
 // stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners; 5 a
 // constant support pressure (excavate's `pressure`); 6 the same fields with a
 // hash of the bolts' and liners' kinematics; 7 the state hash over every saved
-// field (the state-field list).
+// field (the state-field list); 8 the dowels' fields (core/dowels.hpp).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '7';
+constexpr std::uint64_t format = '8';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -202,44 +203,14 @@ void Solver::for_each_field(Self& s, Visit&& v) {
     v({"blocks.applied", G::blocks, E | M}, b.applied), v({"blocks.applied_moment", G::blocks, E}, b.applied_moment);
     v({"nodes.fixed_velocity", G::nodes, E}, n.fixed_velocity), v({"nodes.applied", G::nodes, E | M}, n.applied);
     v({"properties.face_shear", G::other, M}, s.face_shear_);
-    // Installed bolts (core/bolts.hpp): nodes, their ties to the rock, segments.
-    auto& B = s.bolts_;
-    v({"bolts.installed", G::other, E}, B.installed), v({"bolts.position", G::other, E}, B.position);
-    v({"bolts.velocity", G::other, E}, B.velocity), v({"bolts.applied", G::other, E}, B.applied);
-    v({"bolts.mass", G::other, E}, B.mass), v({"bolts.length", G::other, E}, B.length);
-    v({"bolts.slip", G::other, E}, B.slip), v({"bolts.bond", G::other, E}, B.bond), v({"bolts.host", G::other, E}, B.host);
-    v({"bolts.tied", G::other, E}, B.tied), v({"bolts.node_set", G::other, E}, B.node_set);
-    v({"bolts.segment_node", G::other, E}, B.segment_node), v({"bolts.rest", G::other, E}, B.rest);
-    v({"bolts.plastic", G::other, E}, B.plastic), v({"bolts.axial", G::other, E}, B.axial);
-    v({"bolts.state", G::other, E}, B.state), v({"bolts.first", G::other, E}, B.first);
-    v({"bolts.bolt_set", G::other, E}, B.bolt_set);
-    v({"bolts.force", G::other, R}, B.force), v({"bolts.reaction", G::other, R}, B.reaction);
-    v({"bolts.reaction_moment", G::other, R}, B.reaction_moment);
-    // Installed liners (core/liners.hpp).
-    auto& L = s.liners_;
-    v({"liners.installed", G::other, E}, L.installed), v({"liners.position", G::other, E}, L.position);
-    v({"liners.velocity", G::other, E}, L.velocity), v({"liners.theta", G::other, E}, L.theta);
-    v({"liners.omega", G::other, E}, L.omega), v({"liners.mass", G::other, E}, L.mass);
-    v({"liners.inertia", G::other, E}, L.inertia), v({"liners.length", G::other, E}, L.length);
-    v({"liners.shear_slip", G::other, E}, L.shear_slip), v({"liners.host", G::other, E}, L.host);
-    v({"liners.separated", G::other, E}, L.separated), v({"liners.normal_stress", G::other, E}, L.normal_stress);
-    v({"liners.node_set", G::other, E}, L.node_set), v({"liners.held", G::other, E}, L.held);
-    v({"liners.element_node", G::other, E}, L.element_node), v({"liners.rest", G::other, E}, L.rest);
-    v({"liners.chord0", G::other, E}, L.chord0), v({"liners.thrust", G::other, E}, L.thrust);
-    v({"liners.moment_a", G::other, E}, L.moment_a), v({"liners.moment_b", G::other, E}, L.moment_b);
-    v({"liners.plastic_strain", G::other, E}, L.plastic_strain);
-    v({"liners.plastic_rotation_a", G::other, E}, L.plastic_rotation_a);
-    v({"liners.plastic_rotation_b", G::other, E}, L.plastic_rotation_b);
-    v({"liners.yielded", G::other, E}, L.yielded), v({"liners.first", G::other, E}, L.first);
-    v({"liners.liner_set", G::other, E}, L.liner_set), v({"liners.closed", G::other, E}, L.closed);
-    v({"liners.force", G::other, R}, L.force), v({"liners.moment", G::other, R}, L.moment);
-    v({"liners.reaction", G::other, R}, L.reaction), v({"liners.reaction_moment", G::other, R}, L.reaction_moment);
-    // Supports' ties to the rock and their stiffness (index_bolt_hosts, update_timestep).
-    v({"supports.bolt_stiffness", G::other, R}, s.bolt_stiffness_);
-    v({"supports.liner_stiffness", G::other, R}, s.liner_stiffness_);
-    v({"supports.liner_rotation_stiffness", G::other, R}, s.liner_rotation_stiffness_);
-    v({"supports.block_first", G::other, R}, s.bolt_block_first_), v({"supports.block_tie", G::other, R}, s.bolt_block_tie_);
-    v({"supports.node_first", G::other, R}, s.bolt_node_first_), v({"supports.node_tie", G::other, R}, s.bolt_node_tie_);
+    // The support types' arrays (core/support.hpp), in registry order.
+    for (const auto& support : s.supports_)
+        for (const SupportField& f : support->fields()) std::visit([&](auto* x) { v(f.info, *x); }, f.field);
+    // Their ties to the rock (index_support_ties) and this step's reactions.
+    v({"supports.tie_first", G::other, R}, s.support_tie_first_);
+    v({"supports.tie_reaction", G::other, R}, s.tie_reaction_), v({"supports.tie_moment", G::other, R}, s.tie_moment_);
+    v({"supports.block_first", G::other, R}, s.tie_block_first_), v({"supports.block_tie", G::other, R}, s.tie_block_tie_);
+    v({"supports.node_first", G::other, R}, s.tie_node_first_), v({"supports.node_tie", G::other, R}, s.tie_node_tie_);
     // The step's scratch: packed body state, stiffness, partial sums, thread balance.
     v({"step.body", G::blocks, R}, s.body_), v({"step.chunk_sums", G::other, R}, s.chunk_sums_);
     v({"step.block_stiffness", G::blocks, R}, s.stiffness_scratch_.block);
@@ -265,16 +236,11 @@ std::uint64_t Solver::compute_model_fingerprint() const {
             if (f.uses & field_use::model) throw std::logic_error(std::string("unhashable field ") + f.name);
         }
     });
-    for (const auto& set : bolts_.sets) {
-        const double p[9] = {set.ea, set.yield_force, set.rupture_strain, set.bond_stiffness, set.bond_strength,
-                             set.normal_stiffness, set.line_mass, set.spacing, double(set.cable)};
-        h.mix_value(p);
-    }
-    for (const auto& set : liners_.sets) {
-        const double p[13] = {set.ea, set.ei, set.line_mass, set.line_inertia, set.kn, set.ks, set.tensile,
-                              set.cohesion, set.tan_friction, set.thrust_capacity, set.tension_capacity,
-                              set.moment_capacity, double(set.symmetric_ends)};
-        h.mix_value(p);
+    std::vector<double> parameters;
+    for (const auto& support : supports_) {
+        parameters.clear();
+        support->model_parameters(parameters);
+        h.mix(std::as_bytes(std::span(parameters)));
     }
     for (const auto& law : laws_) {
         const double k[2] = {contact::normal_stiffness(law), contact::shear_stiffness(law)};
@@ -390,12 +356,8 @@ void Solver::load_state(std::istream& i) {
     if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
     const auto loaded = field_hashes();
     c_.normal.resize(c_.size());
-    bolts_.force.assign(bolts_.position.size(), {});
-    liners_.force.assign(liners_.position.size(), {});
-    liners_.moment.assign(liners_.position.size(), 0.0);
-    liners_.reaction.assign(liners_.position.size(), {});
-    liners_.reaction_moment.assign(liners_.position.size(), 0.0);
-    index_bolt_hosts();
+    for (auto& support : supports_) support->after_load();
+    index_support_ties();
     normals_stale_ = true;
     update_vertices(); // the faces of assign_face_groups are read off the current geometry
     rebuild_contact_index();

@@ -741,23 +741,30 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     read_tables(c, doc, "history", [&](const toml::table& t, const Path& p, std::size_t) {
         an.histories.push_back(read_history(c, t, p, histories, boundaries));
     });
-    // Support: bolt sets and liners, named apart from each other; install stages name either.
-    Names supports{"support", "supports", "bolt]] or [[liner", {}, {}};
-    Names bolt_sets{"bolt set", "bolt sets", "bolt", {}, {}}, liners{"liner", "liners", "liner", {}, {}};
+    // Support: bolt sets, dowel sets and liners, named apart from each other;
+    // install stages name any of them.
+    Names supports{"support", "supports", "bolt]], [[dowel]] or [[liner", {}, {}};
+    Names bolt_sets{"bolt set", "bolt sets", "bolt", {}, {}}, dowel_sets{"dowel set", "dowel sets", "dowel", {}, {}},
+        liners{"liner", "liners", "liner", {}, {}};
     read_bolt_sets(c, doc, an.bolts, bolt_sets);
+    read_dowel_sets(c, doc, an.dowels, dowel_sets);
     read_liners(c, doc, an.liners, liners);
-    for (std::size_t i = 0; i < liners.names.size(); ++i) {
-        const auto bolt = std::ranges::find(bolt_sets.names, liners.names[i]);
-        if (bolt == bolt_sets.names.end()) continue;
-        const Path np = Path{}.key("liner").at(i).key("name");
-        const auto j = std::size_t(bolt - bolt_sets.names.begin());
-        c.fail(mf.source.line_of(np.full), np,
-               "name " + quoted(liners.names[i]) + " is already used by bolt[" + std::to_string(j) + "] (line " +
-                   std::to_string(bolt_sets.lines[j]) + "): bolt sets and liners share their names (install stages "
-                   "name either)");
-    }
-    supports.names = bolt_sets.names;
-    supports.names.insert(supports.names.end(), liners.names.begin(), liners.names.end());
+    const Names* support_kinds[] = {&bolt_sets, &dowel_sets, &liners};
+    for (std::size_t later = 1; later < std::size(support_kinds); ++later)
+        for (std::size_t i = 0; i < support_kinds[later]->names.size(); ++i)
+            for (std::size_t earlier = 0; earlier < later; ++earlier) {
+                const Names& mine = *support_kinds[later];
+                const Names& theirs = *support_kinds[earlier];
+                const auto other = std::ranges::find(theirs.names, mine.names[i]);
+                if (other == theirs.names.end()) continue;
+                const Path np = Path{}.key(std::string(mine.table)).at(i).key("name");
+                const auto j = std::size_t(other - theirs.names.begin());
+                c.fail(mf.source.line_of(np.full), np,
+                       "name " + quoted(mine.names[i]) + " is already used by " + std::string(theirs.table) + "[" +
+                           std::to_string(j) + "] (line " + std::to_string(theirs.lines[j]) +
+                           "): bolt sets, dowel sets and liners share their names (install stages name any)");
+            }
+    for (const Names* kind : support_kinds) supports.names.insert(supports.names.end(), kind->names.begin(), kind->names.end());
     Names stages{"stage", "stages", "stage", {}, {}};
     read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
         an.stages.push_back(read_stage(c, t, p, i, stages, regions, supports));
@@ -881,9 +888,9 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     c.file = name;
     c.source = &mf.source;
     const Path root{};
-    static constexpr std::array<std::string_view, 12> top_keys{
+    static constexpr std::array<std::string_view, 13> top_keys{
         "model",    "region", "material", "joint_property", "joint_assignment",
-        "boundary", "solver", "history",  "stage",          "report", "bolt", "liner"};
+        "boundary", "solver", "history",  "stage",          "report", "bolt", "liner", "dowel"};
     check_keys(c, doc, root, top_keys);
 
     if (const toml::node* n = find(c, doc, root, "model")) {

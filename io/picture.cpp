@@ -283,45 +283,42 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
         cairo_line_to(cr, y.x, y.y);
         cairo_stroke(cr);
     }
-    // Bolts: each segment coloured by its axial force, green (none) to purple (the
-    // largest of the run); yielded segments drawn thicker, broken ones dashed black.
-    const auto& bolts = s.bolts();
-    double bolt_max = 0.0;
-    for (int seg = 0; seg < bolts.segment_count(); ++seg)
-        bolt_max = std::max(bolt_max, std::abs(bolts.axial[seg]) * bolts.sets[bolts.node_set[bolts.segment_node[seg]]].spacing);
-    for (int seg = 0; seg < bolts.segment_count(); ++seg) {
-        const int a = bolts.segment_node[seg];
-        const double f = bolt_max > 0 ? std::abs(bolts.axial[seg]) * bolts.sets[bolts.node_set[a]].spacing / bolt_max : 0.0;
-        const bool broken = bolts.state[seg] == BoltState::broken, yielded = bolts.state[seg] == BoltState::yielded;
-        if (broken) {
-            cairo_set_source_rgb(cr, 0, 0, 0);
-            const double dash[2] = {3.0 * px, 3.0 * px};
-            cairo_set_dash(cr, dash, 2, 0.0);
-        } else {
-            cairo_set_source_rgb(cr, 0.1 + 0.5 * f, 0.6 - 0.5 * f, 0.2 + 0.5 * f);
-        }
-        cairo_set_line_width(cr, (yielded ? 4.0 : 2.5) * px);
-        cairo_move_to(cr, bolts.position[a].x, bolts.position[a].y);
-        cairo_line_to(cr, bolts.position[a + 1].x, bolts.position[a + 1].y);
-        cairo_stroke(cr);
-        cairo_set_dash(cr, nullptr, 0, 0.0);
-    }
-    // Liners: a thick line along the wall, darker blue the higher its thrust.
-    const auto& liners = s.liners();
-    double thrust_max = 0.0;
-    for (double t : liners.thrust) thrust_max = std::max(thrust_max, std::abs(t));
-    {
-        int l = 0;
-        for (int e = 0; e < liners.element_count(); ++e) {
-            const int a = liners.element_node[e];
-            while (a >= liners.first[l + 1]) ++l;
-            const int next = a + 1 < liners.first[l + 1] ? a + 1 : liners.first[l];
-            const double f = thrust_max > 0 ? std::abs(liners.thrust[e]) / thrust_max : 0.0;
-            cairo_set_source_rgb(cr, 0.55 - 0.45 * f, 0.75 - 0.55 * f, 0.95 - 0.35 * f);
-            cairo_set_line_width(cr, 5.0 * px);
-            cairo_move_to(cr, liners.position[a].x, liners.position[a].y);
-            cairo_line_to(cr, liners.position[next].x, liners.position[next].y);
+    // Supports (core/support.hpp), each line cell shaded by its headline force
+    // against the largest now. Bars (bolts, dowels): green (none) to purple,
+    // yielded segments thicker, broken ones dashed black. Linings: a thick line
+    // along the wall, darker blue the higher its thrust.
+    std::string support_legend;
+    for (const auto& support : s.supports()) {
+        if (support->tie_count() == 0) continue;
+        const SupportLines lines = support->lines();
+        const auto& shading = lines.cell_data[lines.shade].values;
+        double largest = 0.0;
+        for (double v : shading) largest = std::max(largest, std::abs(v));
+        char label[160];
+        std::snprintf(label, sizeof label, "   %s: %s %.0f %s", support->name(),
+                      lines.look == SupportLines::Look::lining ? "light to dark blue" : "green 0 to purple", largest,
+                      lines.shade_label.c_str());
+        support_legend += label;
+        for (std::size_t cell = 0; cell < lines.cells.size(); ++cell) {
+            const Vec2 from = lines.points[lines.cells[cell][0]], to = lines.points[lines.cells[cell][1]];
+            const double f = largest > 0 ? std::abs(shading[cell]) / largest : 0.0;
+            if (lines.look == SupportLines::Look::lining) {
+                cairo_set_source_rgb(cr, 0.55 - 0.45 * f, 0.75 - 0.55 * f, 0.95 - 0.35 * f);
+                cairo_set_line_width(cr, 5.0 * px);
+            } else {
+                if (lines.mark[cell] == 2) {
+                    cairo_set_source_rgb(cr, 0, 0, 0);
+                    const double dash[2] = {3.0 * px, 3.0 * px};
+                    cairo_set_dash(cr, dash, 2, 0.0);
+                } else {
+                    cairo_set_source_rgb(cr, 0.1 + 0.5 * f, 0.6 - 0.5 * f, 0.2 + 0.5 * f);
+                }
+                cairo_set_line_width(cr, (lines.mark[cell] == 1 ? 4.0 : 2.5) * px);
+            }
+            cairo_move_to(cr, from.x, from.y);
+            cairo_line_to(cr, to.x, to.y);
             cairo_stroke(cr);
+            cairo_set_dash(cr, nullptr, 0, 0.0);
         }
     }
     if (!o.outline.empty()) {
@@ -348,15 +345,9 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    char bolt_text[200] = "";
-    if (bolts.segment_count() > 0)
-        std::snprintf(bolt_text, sizeof bolt_text, "   bolts: green 0 to purple %.0f kN", bolt_max / 1e3);
-    if (liners.element_count() > 0)
-        std::snprintf(bolt_text + std::strlen(bolt_text), sizeof bolt_text - std::strlen(bolt_text),
-                      "   liner: light to dark blue %.0f kN/m thrust", thrust_max / 1e3);
     std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s%s",
                   s.cracks(contact::JointState::broken_shear), 1e3 * umax, 1e3 * umax_all,
-                  o.outline.empty() ? "" : "   dashed: failed zone", bolt_text, o.title.empty() ? "" : "   ",
+                  o.outline.empty() ? "" : "   dashed: failed zone", support_legend.c_str(), o.title.empty() ? "" : "   ",
                   o.title.c_str());
     text(cr, 292, y0, buf);
     canvas.finish();

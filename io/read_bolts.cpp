@@ -1,5 +1,6 @@
-// bbm io: the [[bolt]] tables of a model file — rock bolts and cables (core/bolts.hpp,
-// docs/input.md "Rock bolts and cables").
+// bbm io: the [[bolt]] and [[dowel]] tables of a model file — rock bolts and
+// cables (core/bolts.hpp), dowels (core/dowels.hpp); docs/input.md "Rock bolts
+// and cables", "Dowels".
 #include "io/reader.hpp"
 
 namespace bbm::io::reader {
@@ -32,12 +33,21 @@ BoltSetSpec::Ring read_ring(const Ctx& c, const toml::node& node, const Path& p)
     return r;
 }
 
-BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 17> keys{
-        "name",          "bolts",          "ring",             "segment_length", "young",
-        "area",          "diameter",       "density",          "yield_force",    "rupture_strain",
-        "cable",         "bond_stiffness", "bond_strength",    "normal_stiffness", "spacing",
-        "face_plate",    "end_anchor"};
+constexpr std::array<std::string_view, 17> bolt_keys{
+    "name",          "bolts",          "ring",             "segment_length", "young",
+    "area",          "diameter",       "density",          "yield_force",    "rupture_strain",
+    "cable",         "bond_stiffness", "bond_strength",    "normal_stiffness", "spacing",
+    "face_plate",    "end_anchor"};
+/// A dowel's: a bolt's but the cable, and its pretension.
+constexpr std::array<std::string_view, 17> dowel_keys{
+    "name",          "bolts",          "ring",             "segment_length", "young",
+    "area",          "diameter",       "density",          "yield_force",    "rupture_strain",
+    "pretension",    "bond_stiffness", "bond_strength",    "normal_stiffness", "spacing",
+    "face_plate",    "end_anchor"};
+
+/// The keys a bolt and a dowel share (`keys`: the table's own, checked first).
+BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& names,
+                          std::span<const std::string_view> keys) {
     check_keys(c, t, p, keys);
     BoltSetSpec b;
     b.name = read_name(c, t, p, names);
@@ -79,7 +89,23 @@ BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& na
 
 void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names) {
     read_tables(c, doc, "bolt", [&](const toml::table& t, const Path& p, std::size_t) {
-        bolts.push_back(read_bolt_set(c, t, p, names));
+        bolts.push_back(read_bolt_set(c, t, p, names, bolt_keys));
+    });
+}
+
+void read_dowel_sets(Ctx& c, const toml::table& doc, std::vector<DowelSetSpec>& dowels, Names& names) {
+    read_tables(c, doc, "dowel", [&](const toml::table& t, const Path& p, std::size_t) {
+        DowelSetSpec d{read_bolt_set(c, t, p, names, dowel_keys)};
+        d.pretension = number(c, t, p, "pretension", at_least(0, newtons)).value_or(0.0);
+        if (d.pretension > 0.0 && !(d.face_plate && d.end_anchor))
+            c.fail(t, p.key("pretension"),
+                   "a pretension is held by the face plate and the end anchor: set face_plate = true and "
+                   "end_anchor = true");
+        if (d.yield_force > 0.0 && d.pretension >= d.yield_force)
+            c.fail(t, p.key("pretension"),
+                   "the pretension " + fmt(d.pretension) + " N must be below the yield force " + fmt(d.yield_force) +
+                       " N");
+        dowels.push_back(d);
     });
 }
 

@@ -510,6 +510,8 @@ inline StressFieldSpec read_stress(const Ctx& c, const toml::table& t, const Pat
 
 /// [[bolt]] tables (io/read_bolts.cpp): appended to `bolts`; their names to `names`.
 void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names);
+/// [[dowel]] tables (io/read_bolts.cpp).
+void read_dowel_sets(Ctx& c, const toml::table& doc, std::vector<DowelSetSpec>& dowels, Names& names);
 /// A [[history]] table and a [[stage]] table (io/read_stages.cpp).
 HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& names, const Names& boundaries);
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,

@@ -530,34 +530,27 @@ vtkSmartPointer<vtkUnstructuredGrid> line_grid(const std::vector<Vec2>& nodes, v
 }
 } // namespace
 
-void write_state_bolts_vtu(const Solver& s, const fs::path& file) {
-    const auto& B = s.bolts();
-    const auto nodes = static_cast<vtkIdType>(B.node_count()), n = static_cast<vtkIdType>(B.segment_count());
-    auto grid = line_grid(B.position, n, [&](vtkIdType i) {
-        return std::pair<vtkIdType, vtkIdType>{B.segment_node[i], B.segment_node[i] + 1};
+void write_support_vtu(const SupportLines& lines, const fs::path& file) {
+    const auto n = static_cast<vtkIdType>(lines.cells.size());
+    auto grid = line_grid(lines.points, n, [&](vtkIdType i) {
+        return std::pair<vtkIdType, vtkIdType>{lines.cells[i][0], lines.cells[i][1]};
     });
-    auto bond = double_array("bond_kN_per_m", nodes), slip = double_array("slip", nodes);
-    for (vtkIdType k = 0; k < nodes; ++k) {
-        bond->SetValue(k, B.bond[k] * B.sets[B.node_set[k]].spacing / 1e3);
-        slip->SetValue(k, B.slip[k]);
-    }
-    auto axial = double_array("axial_force_kN", n);
-    auto state = int_array("state", n), set = int_array("set", n), bolt = int_array("bolt", n);
-    int b = 0;
-    for (vtkIdType i = 0; i < n; ++i) {
-        const int a = B.segment_node[i];
-        while (a >= B.first[b + 1]) ++b;
-        axial->SetValue(i, B.axial[i] * B.sets[B.node_set[a]].spacing / 1e3);
-        state->SetValue(i, B.state[i]);
-        set->SetValue(i, B.node_set[a]);
-        bolt->SetValue(i, b);
-    }
-    add_cell_arrays(grid, axial, state, set, bolt);
-    grid->GetPointData()->AddArray(bond);
-    grid->GetPointData()->AddArray(slip);
-    const std::vector<std::string> states{"elastic", "yielded", "broken"};
-    grid->GetFieldData()->AddArray(string_array("state_names", states, [](const std::string& x) { return x; }));
-    grid->GetFieldData()->AddArray(string_array("set_names", s.bolt_set_names(), [](const std::string& x) { return x; }));
+    auto add = [](vtkDataSetAttributes* data, const SupportLines::Array& array) {
+        const auto size = static_cast<vtkIdType>(array.values.size());
+        if (array.integer) {
+            auto a = int_array(array.name.c_str(), size);
+            for (vtkIdType i = 0; i < size; ++i) a->SetValue(i, int(array.values[i]));
+            data->AddArray(a);
+        } else {
+            auto a = double_array(array.name.c_str(), size);
+            for (vtkIdType i = 0; i < size; ++i) a->SetValue(i, array.values[i]);
+            data->AddArray(a);
+        }
+    };
+    for (const auto& array : lines.cell_data) add(grid->GetCellData(), array);
+    for (const auto& array : lines.point_data) add(grid->GetPointData(), array);
+    for (const auto& [name, values] : lines.names)
+        grid->GetFieldData()->AddArray(string_array(name.c_str(), values, [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }
 
@@ -578,40 +571,6 @@ void write_fractures_vtu(const meshing::BlockAssembly& a, const fs::path& file) 
     add_cell_arrays(grid, set, region, length);
     grid->GetFieldData()->AddArray(
         string_array("set_names", a.fracture_sets, [](const meshing::BlockAssembly::FractureSet& s) { return s.name; }));
-    write_grid(grid, file);
-}
-
-void write_state_liners_vtu(const Solver& s, const fs::path& file) {
-    const auto& L = s.liners();
-    const auto nodes = static_cast<vtkIdType>(L.node_count()), n = static_cast<vtkIdType>(L.element_count());
-    // Element e's liner, and so its second node (a closed ring's last element wraps).
-    std::vector<int> liner_of(n);
-    for (int e = 0, l = 0; e < n; ++e) {
-        while (L.element_node[e] >= L.first[l + 1]) ++l;
-        liner_of[e] = l;
-    }
-    auto grid = line_grid(L.position, n, [&](vtkIdType e) {
-        const int a = L.element_node[e], l = liner_of[e];
-        return std::pair<vtkIdType, vtkIdType>{a, a + 1 < L.first[l + 1] ? a + 1 : L.first[l]};
-    });
-    auto normal = double_array("interface_normal_MPa", nodes);
-    auto open = int_array("interface_open", nodes);
-    for (vtkIdType k = 0; k < nodes; ++k) {
-        normal->SetValue(k, L.normal_stress[k] / 1e6);
-        open->SetValue(k, L.separated[k] && L.normal_stress[k] == 0.0);
-    }
-    auto thrust = double_array("thrust_kN_per_m", n), moment = double_array("moment_kNm_per_m", n);
-    auto liner = int_array("liner", n), yielded = int_array("yielded", n);
-    for (vtkIdType e = 0; e < n; ++e) {
-        thrust->SetValue(e, L.thrust[e] / 1e3);
-        moment->SetValue(e, (std::abs(L.moment_a[e]) >= std::abs(L.moment_b[e]) ? L.moment_a[e] : -L.moment_b[e]) / 1e3);
-        liner->SetValue(e, liner_of[e]);
-        yielded->SetValue(e, L.yielded[e]);
-    }
-    add_cell_arrays(grid, thrust, moment, liner, yielded);
-    grid->GetPointData()->AddArray(normal);
-    grid->GetPointData()->AddArray(open);
-    grid->GetFieldData()->AddArray(string_array("liner_names", s.liner_names(), [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }
 

@@ -20,6 +20,7 @@
 // Failures throw std::runtime_error naming the file.
 #pragma once
 
+#include "core/support.hpp"
 #include "meshing/blocks.hpp"
 
 namespace bbm {
@@ -69,16 +70,9 @@ void write_state_blocks_vtu(const Solver& s, const std::filesystem::path& file);
 /// us, damage, state (0 intact, 1 softening, 2 broken-tension, 3 broken-shear,
 /// 4 sliding), property, length).
 void write_state_contacts_vtu(const Solver& s, const std::filesystem::path& file);
-/// Installed bolts (core/bolts.hpp): one line cell per segment, cell data
-/// axial_force_kN (per bolt, tension positive), state (0 elastic, 1 yielded,
-/// 2 broken), set, bolt; point data bond_kN_per_m (grout force along the bolt,
-/// per bolt) and slip (plastic grout slip, m). Field data set_names, state_names.
-void write_state_bolts_vtu(const Solver& s, const std::filesystem::path& file);
-/// Installed liners (core/liners.hpp): one line cell per beam element, cell data
-/// thrust_kN_per_m (compression positive), moment_kNm_per_m (the larger end
-/// moment by magnitude, with its sign), liner, yielded (bit 0 thrust, bit 1
-/// bending); point data
-/// interface_normal_MPa (tension positive), interface_open.
-void write_state_liners_vtu(const Solver& s, const std::filesystem::path& file);
+/// An installed support type (core/support.hpp) as line cells with the arrays
+/// its lines() names: bolts (core/bolts.hpp), liners (core/liners.hpp), dowels
+/// (core/dowels.hpp) document theirs.
+void write_support_vtu(const SupportLines& lines, const std::filesystem::path& file);
 
 } // namespace bbm::io

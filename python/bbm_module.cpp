@@ -417,7 +417,7 @@ PYBIND11_MODULE(_bbm, mod) {
             std::copy(b.node_set.begin(), b.node_set.end(), out.mutable_data());
             return out;
         }, "n set index of each node (set_names)")
-        .def_property_readonly("set_names", [](const BoltArrays& a) { return solver_of(a).bolt_set_names(); });
+        .def_property_readonly("set_names", [](const BoltArrays& a) { return solver_of(a).support<BoltSupport>().set_names(); });
 
     py::class_<LinerArrays>(mod, "LinerArrays",
                             "Installed liners (core/liners.hpp): n nodes, e beam elements (element i joins nodes "
@@ -453,7 +453,7 @@ PYBIND11_MODULE(_bbm, mod) {
             std::copy(l.normal_stress.begin(), l.normal_stress.end(), out.mutable_data());
             return out;
         }, "n normal stresses on the wall, Pa, tension positive")
-        .def_property_readonly("names", [](const LinerArrays& a) { return solver_of(a).liner_names(); });
+        .def_property_readonly("names", [](const LinerArrays& a) { return solver_of(a).support<LinerSupport>().set_names(); });
 
     py::class_<Model>(mod, "Model")
         .def(py::init([](const std::string& path, int threads, double max_elements) {

@@ -143,31 +143,21 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             summary["verdict"]["stage"] = r->name;
             break;
         }
-    // Support: per installed bolt set, the loads an engineer reads (per bolt).
-    if (const auto sets = solver.bolt_summary(); !sets.empty()) {
-        nlohmann::json bolts = nlohmann::json::array();
-        for (const auto& b : sets)
-            bolts.push_back({{"name", b.name},
-                             {"bolts", b.bolts},
-                             {"max_axial_kN", b.max_axial / 1e3},
-                             {"max_compression_kN", -b.min_axial / 1e3},
-                             {"max_bond_kN_per_m", b.max_bond / 1e3},
-                             {"yielded", b.yielded},
-                             {"broken", b.broken}});
-        summary["bolts"] = bolts;
-    }
-    if (const auto liners = solver.liner_summary(); !liners.empty()) {
+    // Support: per installed set of each type, the figures an engineer reads
+    // ("bolts": loads per bolt; "liners": thrust and moment per metre; …).
+    for (const auto& support : solver.supports()) {
+        const auto sets = support->summary();
+        if (sets.empty()) continue;
         nlohmann::json out = nlohmann::json::array();
-        for (const auto& l : liners)
-            out.push_back({{"name", l.name},
-                           {"nodes", l.nodes},
-                           {"max_thrust_kN_per_m", l.max_thrust / 1e3},
-                           {"min_thrust_kN_per_m", l.min_thrust / 1e3},
-                           {"max_moment_kNm_per_m", l.max_moment / 1e3},
-                           {"open_interface_nodes", l.open},
-                           {"elements", l.elements},
-                           {"yielded_elements", l.yielded}});
-        summary["liners"] = out;
+        for (const auto& set : sets) {
+            nlohmann::json entry{{"name", set.name}};
+            for (const auto& f : set.figures) {
+                if (f.count) entry[f.key] = static_cast<long>(f.value);
+                else entry[f.key] = f.value;
+            }
+            out.push_back(entry);
+        }
+        summary[support->name()] = out;
     }
     const auto& rep = file.analysis.report;
     if (rep.opening) {

@@ -25,6 +25,7 @@
 #include <fstream>
 #include <future>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -254,30 +255,23 @@ public:
         std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
         write_state_contacts_vtu(s, out_ / name);
         series_.push_back({s.time(), name});
-        if (s.bolts().node_count() > 0) {
-            std::snprintf(name, sizeof name, "vtk/bolts_%08ld.vtu", s.steps());
-            write_state_bolts_vtu(s, out_ / name);
+        for (const auto& support : s.supports()) {
+            if (support->tie_count() == 0) continue;
+            std::snprintf(name, sizeof name, "vtk/%s_%08ld.vtu", support->name(), s.steps());
+            write_support_vtu(support->lines(), out_ / name);
             series_.push_back({s.time(), name});
         }
-        if (s.liners().node_count() > 0) {
-            std::snprintf(name, sizeof name, "vtk/liners_%08ld.vtu", s.steps());
-            write_state_liners_vtu(s, out_ / name);
-            series_.push_back({s.time(), name});
-        }
-        // result.pvd holds every part; blocks.pvd, contacts.pvd (and bolts.pvd) one
-        // each (for scripts that style them apart, examples/paraview_view.py).
+        // result.pvd holds every part; blocks.pvd, contacts.pvd (and bolts.pvd,
+        // liners.pvd, … per installed support type) one each (for scripts that
+        // style them apart, examples/paraview_view.py).
         write_pvd(out_ / "result.pvd", series_);
-        std::vector<std::pair<double, std::string>> blocks, contacts, bolts, liners;
-        for (const auto& entry : series_)
-            (entry.second.starts_with("vtk/blocks_")  ? blocks
-             : entry.second.starts_with("vtk/bolts_")  ? bolts
-             : entry.second.starts_with("vtk/liners_") ? liners
-                                                       : contacts)
-                .push_back(entry);
-        write_pvd(out_ / "blocks.pvd", blocks);
-        write_pvd(out_ / "contacts.pvd", contacts);
-        if (!bolts.empty()) write_pvd(out_ / "bolts.pvd", bolts);
-        if (!liners.empty()) write_pvd(out_ / "liners.pvd", liners);
+        // One series per part: "vtk/<part>_<step>.vtu" goes to <part>.pvd.
+        std::map<std::string, std::vector<std::pair<double, std::string>>> parts;
+        for (const auto& entry : series_) {
+            const auto& file = entry.second;
+            parts[file.substr(4, file.rfind('_') - 4)].push_back(entry);
+        }
+        for (const auto& [part, series] : parts) write_pvd(out_ / (part + ".pvd"), series);
     }
     void flush_history() {
         std::ostringstream csv;

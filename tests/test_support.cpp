@@ -75,7 +75,7 @@ Pulled pull(const Built& m, double P, int threads) {
     AnalysisSpec an = m.file.analysis;
     an.solver.threads = threads;
     Solver s(m.blocks, an);
-    s.install_bolts({"bolt"});
+    s.install_supports({"bolt"});
     auto& B = s.bolts();
     REQUIRE(B.node_count() == int(std::lround(L / segment)) + 1);
     B.applied[0] = {-P, 0.0};
@@ -181,7 +181,7 @@ type = "install"
 supports = ["bolt"]
 )");
     Solver s(m.blocks, m.file.analysis);
-    s.install_bolts({"bolt"});
+    s.install_supports({"bolt"});
     const double weight = 2700.0 * 9.81 * 1.0 * 1.4; // N per metre of model
     std::string saved;
     for (long k = 0; k < 60000; ++k) {
@@ -207,7 +207,7 @@ supports = ["bolt"]
         }
     }
     CHECK(in_gap >= 1);
-    const auto summary = s.bolt_summary();
+    const auto summary = s.support<BoltSupport>().set_summary();
     REQUIRE(summary.size() == 1);
     MESSAGE("block weight " << weight << " N/m; bolt load " << summary[0].max_axial << " N per bolt at 1.5 m spacing, "
                             << s.steps() << " steps");
@@ -392,7 +392,7 @@ TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and
     CHECK(thrust == doctest::Approx(p_mean * a).epsilon(0.01));
     CHECK(u1 == doctest::Approx((p0 - p_expected) / k_ground).epsilon(0.01));
     // No bending under an isotropic load.
-    const auto summary = lined->liner_summary();
+    const auto summary = lined->support<LinerSupport>().set_summary();
     REQUIRE(summary.size() == 1);
     CHECK(summary[0].max_moment < 0.001 * thrust * t);
     CHECK(summary[0].open == 0);
@@ -415,7 +415,7 @@ TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and
     CHECK(thrust_yield == doctest::Approx(3e6).epsilon(0.01));
     CHECK(p_yield == doctest::Approx(3e6 / a).epsilon(0.01));
     CHECK(u_yield == doctest::Approx((p0 - 3e6 / a) / k_ground).epsilon(0.01));
-    CHECK(yielding->liner_summary()[0].yielded == Y.element_count());
+    CHECK(yielding->support<LinerSupport>().set_summary()[0].yielded == Y.element_count());
 }
 
 namespace {
