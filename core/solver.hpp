@@ -52,6 +52,7 @@
 #include <array>
 #include <cstdint>
 #include <iosfwd>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -76,9 +77,10 @@ struct StepProfile {
 
 class Solver {
 public:
-    /// Builds blocks, property sets and the contacts of the initial assembly.
-    /// Throws InputError (file "" with the key) if a joint has no property set or a
-    /// name does not resolve.
+    /// Builds the model (core/build_model.cpp): blocks, FE nodes and zones,
+    /// property sets and the contacts of the initial assembly, boundaries and
+    /// support types. Throws InputError (file "" with the key) if a joint has no
+    /// property set or a name does not resolve.
     Solver(const meshing::BlockAssembly& blocks, const AnalysisSpec& analysis);
 
     // --- stages -------------------------------------------------------------
@@ -245,6 +247,17 @@ public:
     const StepProfile& profile() const { return profile_; }
 
 private:
+    // Building the model (core/build_model.cpp), in the constructor's order.
+    void build_bodies(const meshing::BlockAssembly& a, const AnalysisSpec& an); ///< blocks, FE nodes, zones
+    /// Property sets (with their derived strength classes and deformable splits)
+    /// and the contacts of the assembly's joints; the set of new contacts.
+    void build_contacts(const meshing::BlockAssembly& a, const AnalysisSpec& an);
+    /// A joint's two point contacts (one per end, half its length each; collinear
+    /// edges share one).
+    void add_joint_contacts(const meshing::BlockAssembly& a, const meshing::JointRecord& j, int property,
+                            std::map<std::pair<int, int>, int>& existing);
+    void prepare_detection(const meshing::BlockAssembly& a); ///< tolerance, reach, junctions
+    void prepare_team();                                     ///< the step's per-thread scratch
     contact::BlockView view() const;
     void detect_if_due();
     void detection_pass();

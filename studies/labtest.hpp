@@ -237,6 +237,10 @@ struct LabTestResult {
 
 /// Whether the test has separate platen blocks (platen_friction ≥ 0, compression).
 bool uses_platen_blocks(const LabTestOptions& o);
+/// The loaded height: the specimen's, or a Brazilian disc's diameter.
+inline double specimen_height(const LabTestOptions& o) {
+    return o.kind == LabTestOptions::Kind::brazilian ? o.width : o.height;
+}
 
 /// The traces of the persistent joint set (o.joint_set), clipped to the specimen.
 std::vector<meshing::SegmentSpec> joint_set_traces(const LabTestOptions& o);
