@@ -927,6 +927,58 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     return mf;
 }
 
+RockFile parse_rock(std::string_view text, const std::string& name) {
+    refuse_non_ascii_outside_strings(text, name);
+    toml::table doc;
+    try {
+        doc = toml::parse(text, std::string_view{name});
+    } catch (const toml::parse_error& e) {
+        throw InputError(name, static_cast<int>(e.source().begin.line), "",
+                         "TOML syntax error: " + std::string(e.description()));
+    }
+    RockFile rock;
+    if (doc.contains("region")) {
+        rock.model = parse_model(text, name);
+        return rock;
+    }
+    ModelSource source;
+    source.file = name;
+    Ctx c;
+    c.file = name;
+    c.source = &source;
+    const Path root{};
+    static constexpr std::array<std::string_view, 3> top_keys{"joint_property", "material", "region"};
+    check_keys(c, doc, root, top_keys);
+    Names properties{"joint property", "joint properties", "joint_property", {}, {}};
+    std::vector<JointPropertySpec> joints;
+    read_tables(c, doc, "joint_property", [&](const toml::table& t, const Path& p, std::size_t) {
+        joints.push_back(read_joint_property(c, t, p, properties));
+    });
+    if (joints.size() != 1)
+        c.fail(joints.empty() ? 0 : properties.lines[1], root.key("joint_property"),
+               "a rock file holds the bonds as one [[joint_property]] table (what bbm calibrate writes), found " +
+                   std::to_string(joints.size()) + "; a full model file (with its [[region]]s) is read as its rock");
+    rock.joint = joints.front();
+    Names materials{"material", "materials", "material", {}, {}};
+    std::vector<MaterialSpec> found;
+    read_tables(c, doc, "material", [&](const toml::table& t, const Path& p, std::size_t) {
+        found.push_back(read_material(c, t, p, materials));
+    });
+    if (found.size() > 1)
+        c.fail(materials.lines[1], root.key("material").at(1), "a rock file holds at most one [[material]], found " +
+                                                                   std::to_string(found.size()));
+    if (!found.empty()) rock.material = found.front();
+    return rock;
+}
+
+RockFile read_rock(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "", "cannot open file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_rock(text.str(), path);
+}
+
 ModelFile read_model(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, 0, "", "cannot open file");

@@ -23,6 +23,7 @@
 #include "meshing/spec.hpp"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,6 +64,19 @@ struct ModelFile {
 ModelFile read_model(const std::string& path);
 /// The same from text; `name` stands for the file name in messages (for tests).
 ModelFile parse_model(std::string_view text, const std::string& name);
+
+/// A rock as `--rock FILE` gives it to the lab tests, calibrate, envelope and
+/// shear: one [[joint_property]] (the bonds) and at most one [[material]] —
+/// what `bbm calibrate` writes (joint_property.toml) — read by the model file's
+/// own readers (the same keys, bounds and messages); or a whole model file, whose
+/// rock is then its bonded region (`model`; studies/model_rock.hpp).
+struct RockFile {
+    JointPropertySpec joint;
+    std::optional<MaterialSpec> material;
+    std::optional<ModelFile> model; ///< a model file given as the rock
+};
+RockFile read_rock(const std::string& path);
+RockFile parse_rock(std::string_view text, const std::string& name);
 
 /// The text of a model file with keys set (`set`: full key as in messages,
 /// "joint_property[0].tensile" or "region[1].pattern.size", and a TOML value) and

@@ -11,6 +11,7 @@
 #include "studies/envelope.hpp"
 #include "studies/cli_checks.hpp"
 #include "studies/labtest.hpp"
+#include "studies/model_rock.hpp"
 #include "studies/ranks.hpp"
 
 #include <CLI/CLI.hpp>
@@ -213,8 +214,74 @@ const char* const max_elements_help =
     "Largest number of blocks plus triangles the model may ask for (estimated before generating; default: what "
     "fits in half of this machine's memory)";
 
+namespace {
+
+/// The flags of the rock (its bonds, material and block pattern): given beside
+/// --rock, each overrides the file's value.
+struct RockFlag {
+    const char* flag;
+    void (*keep)(LabTestCli& to, const LabTestCli& given);
+};
+#define BBM_ROCK_FLAG(flag, field) {flag, [](LabTestCli& to, const LabTestCli& given) { to.field = given.field; }}
+constexpr RockFlag rock_flags[] = {
+    BBM_ROCK_FLAG("--pattern", pattern),
+    BBM_ROCK_FLAG("--size", o.size),
+    BBM_ROCK_FLAG("--size-measure", size_measure),
+    BBM_ROCK_FLAG("--seed", o.seed),
+    BBM_ROCK_FLAG("--lloyd", o.lloyd),
+    BBM_ROCK_FLAG("--kn", o.joint.kn),
+    BBM_ROCK_FLAG("--ks", o.joint.ks),
+    BBM_ROCK_FLAG("--tensile", o.joint.tensile),
+    BBM_ROCK_FLAG("--cohesion", o.joint.cohesion),
+    BBM_ROCK_FLAG("--friction", o.joint.friction),
+    BBM_ROCK_FLAG("--residual-friction", o.joint.residual_friction),
+    BBM_ROCK_FLAG("--confined-friction", o.joint.confined_friction),
+    BBM_ROCK_FLAG("--confined-friction-from", o.joint.confined_friction_from),
+    BBM_ROCK_FLAG("--weibull-m", o.joint.weibull_modulus),
+    BBM_ROCK_FLAG("--strength-classes", o.joint.strength_classes),
+    BBM_ROCK_FLAG("--tension-softening", tension_softening),
+    BBM_ROCK_FLAG("--shear-softening", shear_softening),
+    BBM_ROCK_FLAG("--density", o.density),
+    BBM_ROCK_FLAG("--deformable-fraction", o.deformable_fraction),
+    BBM_ROCK_FLAG("--young", o.young),
+    BBM_ROCK_FLAG("--poisson", o.poisson),
+    BBM_ROCK_FLAG("--mesh-size", o.mesh_size),
+};
+#undef BBM_ROCK_FLAG
+
+} // namespace
+
+void apply_rock_file(const CLI::App& cmd, LabTestCli& c) {
+    if (c.rock.empty()) return;
+    const LabTestCli given = c;
+    const io::RockFile rock = io::read_rock(c.rock);
+    if (rock.model) {
+        c = labtest_of_model(*rock.model, c.rock, c);
+    } else {
+        c.o.joint = rock.joint;
+        // The file's curves as they are (any number of points; not the flags' b1, a1, a2).
+        c.tension_softening.clear();
+        c.shear_softening.clear();
+        if (rock.material) {
+            const MaterialSpec& m = *rock.material;
+            c.o.density = m.density;
+            c.o.deformable_fraction = m.deformable_fraction;
+            if (m.deformable_fraction > 0.0) c.o.young = m.young, c.o.poisson = m.poisson;
+        }
+    }
+    for (const auto& f : rock_flags)
+        if (cmd.count(f.flag) > 0) f.keep(c, given);
+}
+
 void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     auto& o = c.o;
+    sub->add_option("--rock", c.rock,
+                    "The rock from a file: one [[joint_property]] and at most one [[material]] as a model file has "
+                    "them (what bbm calibrate writes: joint_property.toml), or a whole model file (its bonded "
+                    "region's pattern, bonds and material); the rock's flags given beside it override it")
+        ->check(CLI::ExistingFile);
+    // After the command's flags are parsed: the file, then the flags given beside it.
+    sub->parse_complete_callback([sub, &c] { apply_rock_file(*sub, c); });
     sub->add_option("--pattern", c.pattern, "Inner-block pattern")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
         ->capture_default_str();
@@ -992,10 +1059,12 @@ void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
 }
 
 void note_given_joint_values(const CLI::App& cmd, CalibrateCli& v) {
-    v.given_kn = cmd.count("--kn") > 0;
-    v.given_ks = cmd.count("--ks") > 0;
-    v.given_tensile = cmd.count("--tensile") > 0;
-    v.given_cohesion = cmd.count("--cohesion") > 0;
+    // A --rock file gives them too: the calibration starts from its bonds.
+    const bool rock = !v.lab.rock.empty();
+    v.given_kn = rock || cmd.count("--kn") > 0;
+    v.given_ks = rock || cmd.count("--ks") > 0;
+    v.given_tensile = rock || cmd.count("--tensile") > 0;
+    v.given_cohesion = rock || cmd.count("--cohesion") > 0;
 }
 
 LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,

@@ -33,6 +33,9 @@ struct LabTestCli {
     std::vector<double> tension_softening{0.5, 1.7, 4.0}, shear_softening{0.5, 1.3, 2.1};
     std::string platens = "rough";
     std::string size_measure = "feret";
+    /// --rock: a rock file or a model file whose rock the test takes (flags given
+    /// beside it override its values; apply_rock_file).
+    std::string rock;
     int realizations = 1;
     int threads = 0;
     std::string out = "out";
