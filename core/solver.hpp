@@ -60,6 +60,10 @@
 
 namespace bbm {
 
+namespace fem {
+struct SparseTriplets;
+}
+
 /// Wall time per stage of the step (`bbm run --profile`): measured on the team's
 /// first thread between stage boundaries, so a stage's time includes its wait at
 /// the barrier that ends it (the slowest thread's share). Off: one branch a stage.
@@ -258,6 +262,23 @@ private:
                             std::map<std::pair<int, int>, int>& existing);
     void prepare_detection(const meshing::BlockAssembly& a); ///< tolerance, reach, junctions
     void prepare_team();                                     ///< the step's per-thread scratch
+    // The elastic stage's pieces (core/implicit.cpp).
+    struct ElasticDofs {
+        std::vector<std::array<int, 3>> block; ///< per block: x, y, rotation (−1: held or not in the model)
+        std::vector<std::array<int, 2>> node;  ///< per FE node: x, y
+        int count = 0;
+    };
+    ElasticDofs number_elastic_dofs() const;
+    /// Forces at the current state; the largest free force over the force scale.
+    double elastic_residual_ratio(const ElasticDofs& d);
+    std::vector<double> elastic_residual(const ElasticDofs& d) const;
+    /// The linear stiffness of zones and contacts (not open cracks) at the current state.
+    void assemble_elastic_stiffness(const ElasticDofs& d, fem::SparseTriplets& K, std::vector<double>& diagonal) const;
+    /// Throws naming a floating body, or loads no stiffness could carry.
+    void check_elastic_system(const ElasticDofs& d, const std::vector<double>& diagonal,
+                              const std::vector<double>& r) const;
+    /// Δu applied through the laws and zones as one kinematic step.
+    void apply_elastic_increment(const ElasticDofs& d, const std::vector<double>& du);
     contact::BlockView view() const;
     void detect_if_due();
     void detection_pass();
