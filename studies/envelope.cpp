@@ -297,62 +297,48 @@ void draw_envelope(const nlohmann::json& e, const fs::path& file) {
 
 } // namespace
 
-int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
-    quiet = quiet || !Ranks::root();
-    LabTestCli& c = e.lab;
-    if (e.replot) {
-        // envelope.png again from envelope.json (another record to compare, a new style), no test run.
-        const fs::path file = fs::path(c.out) / "envelope.json";
-        std::ifstream in(file);
-        if (!in) throw InputError(file.string(), 0, "", "no envelope.json to draw from (run bbm envelope first)");
-        auto summary = nlohmann::json::parse(in, nullptr, false);
-        if (summary.is_discarded() || !summary.contains("runs"))
-            throw InputError(file.string(), 0, "", "not an envelope.json written by bbm envelope");
-        if (!e.target_record.empty()) {
-            nlohmann::json pairs = nlohmann::json::array();
-            for (const auto& [a, b] : read_strength_record(e.target_record)) pairs.push_back({a, b});
-            summary["target_record"] = {{"file", e.target_record}, {"pairs", pairs}};
-        }
-        if (e.target_sigma_ci > 0.0 && e.target_mi > 0.0)
-            summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
-        if (check_only) return 0;
-        add_fits(summary); // this bbm's fits of the same runs
-        io::write_text_atomically(file, summary.dump(2) + "\n");
-        draw_envelope(summary, fs::path(c.out) / "envelope.png");
-        if (!quiet) print_fits(summary);
-        if (!quiet) std::fprintf(stderr, "wrote %s and envelope.png\n", file.string().c_str());
-        return 0;
-    }
-    for (double s3 : e.confinements)
-        if (!(s3 > 0.0) || !std::isfinite(s3))
-            throw InputError("--confinements", 0, "", "each confinement must be a positive stress in Pa");
-    if (!e.model.empty()) c = labtest_of_model(io::read_model(e.model), e.model, c);
-    std::vector<std::pair<double, double>> record;
-    if (!e.target_record.empty()) record = read_strength_record(e.target_record);
-    if ((e.target_sigma_ci > 0.0) != (e.target_mi > 0.0))
-        throw InputError(e.target_mi > 0.0 ? "--target-sigma-ci" : "--target-mi", 0, "",
-                         "--target-sigma-ci and --target-mi go together (the Hoek-Brown record to draw)");
-    // The tests' options: compression as given; tension loaded like `bbm tension`
-    // (ten times slower: it peaks at a tenth of the strain), Brazilian like `bbm brazilian`.
-    const bool brazilian = e.tension_test == "brazilian";
-    LabTestCli compression = c, tension = c;
-    prepare_labtest(compression, LabTestOptions::Kind::ucs);
-    const auto tension_kind = brazilian ? LabTestOptions::Kind::brazilian : LabTestOptions::Kind::tension;
-    if (brazilian) tension.o.width = e.brazilian_diameter;
-    tension.o.strain_per_step = c.o.strain_per_step * (brazilian ? 0.2 : 0.1);
-    tension.o.platen_friction = -1.0;
-    prepare_labtest(tension, tension_kind);
-    if (check_only) return 0;
-    const fs::path out = c.out;
-    if (c.write_files && Ranks::root()) io::make_output_directory(out);
+namespace {
 
-    const int n = c.realizations;
-    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
-    const bool one_at_a_time = c.o.deformable_fraction > 0.0;
-    std::vector<EnvelopeRun> runs;
-    std::mutex print;
-    auto run_jobs = [&](const std::vector<Job>& jobs) {
+/// `--replot`: envelope.png again from envelope.json (another record to compare, a
+/// new style), no test run.
+int replot_envelope(const EnvelopeOptions& e, bool quiet, bool check_only) {
+    const LabTestCli& c = e.lab;
+    const fs::path file = fs::path(c.out) / "envelope.json";
+    std::ifstream in(file);
+    if (!in) throw InputError(file.string(), 0, "", "no envelope.json to draw from (run bbm envelope first)");
+    auto summary = nlohmann::json::parse(in, nullptr, false);
+    if (summary.is_discarded() || !summary.contains("runs"))
+        throw InputError(file.string(), 0, "", "not an envelope.json written by bbm envelope");
+    if (!e.target_record.empty()) {
+        nlohmann::json pairs = nlohmann::json::array();
+        for (const auto& [a, b] : read_strength_record(e.target_record)) pairs.push_back({a, b});
+        summary["target_record"] = {{"file", e.target_record}, {"pairs", pairs}};
+    }
+    if (e.target_sigma_ci > 0.0 && e.target_mi > 0.0)
+        summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
+    if (check_only) return 0;
+    add_fits(summary); // this bbm's fits of the same runs
+    io::write_text_atomically(file, summary.dump(2) + "\n");
+    draw_envelope(summary, fs::path(c.out) / "envelope.png");
+    if (!quiet) print_fits(summary);
+    if (!quiet) std::fprintf(stderr, "wrote %s and envelope.png\n", file.string().c_str());
+    return 0;
+}
+
+/// The tests of a list, side by side over the threads (deformable specimens one at
+/// a time, with the threads in their loop, as `bbm ucs`); each result printed as
+/// it ends, appended to `runs` in list order.
+struct EnvelopeRunner {
+    const LabTestCli& c;
+    const LabTestCli& compression;
+    const LabTestCli& tension;
+    LabTestOptions::Kind tension_kind;
+    int available;
+    bool one_at_a_time, quiet;
+    std::vector<EnvelopeRun>& runs;
+    std::mutex print{};
+
+    void operator()(const std::vector<Job>& jobs) {
         const int side_by_side = one_at_a_time ? 1 : std::max(1, std::min(int(jobs.size()), available));
         const auto texts = run_spread(int(jobs.size()), side_by_side, [&](int k) {
             const Job& job = jobs[k];
@@ -392,7 +378,123 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         for (std::size_t k = 0; k < jobs.size(); ++k)
             runs.push_back({test_name(jobs[k].kind), jobs[k].confinement, c.o.seed + std::uint64_t(jobs[k].realization),
                             labtest_from_record_text(texts[k])});
-    };
+    }
+};
+
+/// Per level of confinement (0 = the UCS tests): peak, σci, σcd, their ratios, E,
+/// ν, strain at the peak, first stall (mean and spread over the realizations).
+nlohmann::json envelope_levels(const std::vector<EnvelopeRun>& runs, const std::vector<double>& confinements) {
+    nlohmann::json levels = nlohmann::json::array();
+    std::vector<double> levels_s3{0.0};
+    levels_s3.insert(levels_s3.end(), confinements.begin(), confinements.end());
+    for (double level : levels_s3) {
+        std::vector<double> peak, ci, cd, ci_ratio, cd_ratio, E, nu, stall, strain_at_peak;
+        int still_loading = 0;
+        for (const auto& r : runs) {
+            if ((r.test != "ucs" && r.test != "biaxial") || r.confinement != level) continue;
+            const auto& x = r.result;
+            peak.push_back(x.peak_stress), E.push_back(x.E), nu.push_back(x.nu);
+            still_loading += x.still_loading;
+            strain_at_peak.push_back(x.strain_at_peak);
+            if (x.first_stall_stress > 0) stall.push_back(x.first_stall_stress);
+            if (x.crack_initiation_stress > 0) ci.push_back(x.crack_initiation_stress), ci_ratio.push_back(x.crack_initiation_stress / x.peak_stress);
+            if (x.crack_damage_stress > 0) cd.push_back(x.crack_damage_stress), cd_ratio.push_back(x.crack_damage_stress / x.peak_stress);
+        }
+        levels.push_back({{"sigma3", level}, {"peak", stats(peak)}, {"sigma_ci", stats(ci)}, {"sigma_cd", stats(cd)},
+                          {"sigma_ci_over_peak", stats(ci_ratio)}, {"sigma_cd_over_peak", stats(cd_ratio)},
+                          {"E", stats(E)}, {"nu", stats(nu)}, {"still_loading", still_loading},
+                          {"strain_at_peak", stats(strain_at_peak)}, {"first_stall", stats(stall)}});
+    }
+    return levels;
+}
+
+/// Every run, as envelope.json's "runs" and as envelope.csv's text.
+std::pair<nlohmann::json, std::string> envelope_runs_table(const std::vector<EnvelopeRun>& runs) {
+    nlohmann::json per_run = nlohmann::json::array();
+    std::ostringstream csv;
+    csv << "test,sigma3_Pa,seed,peak_Pa,sigma_ci_Pa,sigma_cd_Pa,tensile_strength_Pa,E_Pa,nu,cracks_tensile,cracks_shear,"
+           "steps,post_peak_locking,still_loading,strain_at_peak,first_stall_Pa,reloads\n";
+    csv.precision(10);
+    for (const auto& r : runs) {
+        const auto& x = r.result;
+        per_run.push_back({{"test", r.test}, {"sigma3", r.confinement}, {"seed", r.seed}, {"peak", x.peak_stress},
+                           {"sigma_ci", x.crack_initiation_stress}, {"sigma_cd", x.crack_damage_stress},
+                           {"tensile_strength", x.tensile_strength}, {"E", x.E}, {"nu", x.nu},
+                           {"cracks", {{"tensile", x.cracks_tensile}, {"shear", x.cracks_shear}}},
+                           {"steps", x.steps}, {"wall_seconds", x.wall_seconds},
+                           {"post_peak_locking", x.post_peak_locking}, {"still_loading", x.still_loading},
+                           {"strain_at_peak", x.strain_at_peak}, {"first_stall", x.first_stall_stress},
+                           {"reloads", x.reloads}});
+        csv << r.test << ',' << r.confinement << ',' << r.seed << ',' << x.peak_stress << ','
+            << x.crack_initiation_stress << ',' << x.crack_damage_stress << ',' << x.tensile_strength << ',' << x.E
+            << ',' << x.nu << ',' << x.cracks_tensile << ',' << x.cracks_shear << ',' << x.steps << ','
+            << x.post_peak_locking << ',' << x.still_loading << ',' << x.strain_at_peak << ','
+            << x.first_stall_stress << ',' << x.reloads << '\n';
+    }
+    return {per_run, csv.str()};
+}
+
+/// What an engineer must know of the runs: peaks that are lower bounds, confined
+/// specimens that hardened past their yield.
+void warn_about_envelope_runs(const std::vector<EnvelopeRun>& runs, const LabTestCli& c) {
+    int still_loading = 0;
+    for (const auto& r : runs) still_loading += r.result.still_loading;
+    if (still_loading > 0)
+        std::fprintf(stderr, "warning: %d test%s reached the strain cap %g still loading: %s peak is a lower bound "
+                             "of the strength, and the fits with it (blocks jammed, or raise --strain-cap)\n",
+                     still_loading, still_loading == 1 ? "" : "s", std::max(c.o.max_strain, c.o.strain_cap),
+                     still_loading == 1 ? "its" : "their");
+    // Interlocking: a confined peak far above its first stall (the yield).
+    int hardened = 0, confined = 0;
+    for (const auto& r : runs) {
+        if (r.test != "biaxial") continue;
+        ++confined;
+        hardened += r.result.hardened_past_yield();
+    }
+    if (hardened > 0 && !c.o.confined_peak_at_stall)
+        std::fprintf(stderr, "warning: %d of %d confined tests hardened past their first stall (the yield) by more "
+                             "than 20%%: broken blocks interlocking, and the fits mix them with the specimens that "
+                             "failed. A residual friction below the joints' lets broken joints slide "
+                             "(--residual-friction); --confined-peak first-stall reads the yield "
+                             "(docs/calibration.md, The confined peak)\n",
+                     hardened, confined);
+}
+
+} // namespace
+
+int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
+    quiet = quiet || !Ranks::root();
+    LabTestCli& c = e.lab;
+    if (e.replot) return replot_envelope(e, quiet, check_only);
+    for (double s3 : e.confinements)
+        if (!(s3 > 0.0) || !std::isfinite(s3))
+            throw InputError("--confinements", 0, "", "each confinement must be a positive stress in Pa");
+    if (!e.model.empty()) c = labtest_of_model(io::read_model(e.model), e.model, c);
+    std::vector<std::pair<double, double>> record;
+    if (!e.target_record.empty()) record = read_strength_record(e.target_record);
+    if ((e.target_sigma_ci > 0.0) != (e.target_mi > 0.0))
+        throw InputError(e.target_mi > 0.0 ? "--target-sigma-ci" : "--target-mi", 0, "",
+                         "--target-sigma-ci and --target-mi go together (the Hoek-Brown record to draw)");
+    // The tests' options: compression as given; tension loaded like `bbm tension`
+    // (ten times slower: it peaks at a tenth of the strain), Brazilian like `bbm brazilian`.
+    const bool brazilian = e.tension_test == "brazilian";
+    LabTestCli compression = c, tension = c;
+    prepare_labtest(compression, LabTestOptions::Kind::ucs);
+    const auto tension_kind = brazilian ? LabTestOptions::Kind::brazilian : LabTestOptions::Kind::tension;
+    if (brazilian) tension.o.width = e.brazilian_diameter;
+    tension.o.strain_per_step = c.o.strain_per_step * (brazilian ? 0.2 : 0.1);
+    tension.o.platen_friction = -1.0;
+    prepare_labtest(tension, tension_kind);
+    if (check_only) return 0;
+    const fs::path out = c.out;
+    if (c.write_files && Ranks::root()) io::make_output_directory(out);
+
+    const int n = c.realizations;
+    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
+    const bool one_at_a_time = c.o.deformable_fraction > 0.0;
+    std::vector<EnvelopeRun> runs;
+    EnvelopeRunner run_jobs{c, compression, tension, tension_kind, available, one_at_a_time, quiet, runs};
     if (!quiet)
         std::fprintf(stderr, "bbm envelope: %s blocks of %.3g m, %g m x %g m, %d realization%s of each test on %d thread%s\n",
                      c.pattern.c_str(), c.o.size, c.o.width, c.o.height, n, n > 1 ? "s" : "", available,
@@ -419,48 +521,8 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});
     run_jobs(second);
 
-    nlohmann::json levels = nlohmann::json::array();
-    std::vector<double> levels_s3{0.0};
-    levels_s3.insert(levels_s3.end(), confinements.begin(), confinements.end());
-    for (double level : levels_s3) {
-        std::vector<double> peak, ci, cd, ci_ratio, cd_ratio, E, nu, stall, strain_at_peak;
-        int still_loading = 0;
-        for (const auto& r : runs) {
-            if ((r.test != "ucs" && r.test != "biaxial") || r.confinement != level) continue;
-            const auto& x = r.result;
-            peak.push_back(x.peak_stress), E.push_back(x.E), nu.push_back(x.nu);
-            still_loading += x.still_loading;
-            strain_at_peak.push_back(x.strain_at_peak);
-            if (x.first_stall_stress > 0) stall.push_back(x.first_stall_stress);
-            if (x.crack_initiation_stress > 0) ci.push_back(x.crack_initiation_stress), ci_ratio.push_back(x.crack_initiation_stress / x.peak_stress);
-            if (x.crack_damage_stress > 0) cd.push_back(x.crack_damage_stress), cd_ratio.push_back(x.crack_damage_stress / x.peak_stress);
-        }
-        levels.push_back({{"sigma3", level}, {"peak", stats(peak)}, {"sigma_ci", stats(ci)}, {"sigma_cd", stats(cd)},
-                          {"sigma_ci_over_peak", stats(ci_ratio)}, {"sigma_cd_over_peak", stats(cd_ratio)},
-                          {"E", stats(E)}, {"nu", stats(nu)}, {"still_loading", still_loading},
-                          {"strain_at_peak", stats(strain_at_peak)}, {"first_stall", stats(stall)}});
-    }
-    nlohmann::json per_run = nlohmann::json::array();
-    std::ostringstream csv;
-    csv << "test,sigma3_Pa,seed,peak_Pa,sigma_ci_Pa,sigma_cd_Pa,tensile_strength_Pa,E_Pa,nu,cracks_tensile,cracks_shear,"
-           "steps,post_peak_locking,still_loading,strain_at_peak,first_stall_Pa,reloads\n";
-    csv.precision(10);
-    for (const auto& r : runs) {
-        const auto& x = r.result;
-        per_run.push_back({{"test", r.test}, {"sigma3", r.confinement}, {"seed", r.seed}, {"peak", x.peak_stress},
-                           {"sigma_ci", x.crack_initiation_stress}, {"sigma_cd", x.crack_damage_stress},
-                           {"tensile_strength", x.tensile_strength}, {"E", x.E}, {"nu", x.nu},
-                           {"cracks", {{"tensile", x.cracks_tensile}, {"shear", x.cracks_shear}}},
-                           {"steps", x.steps}, {"wall_seconds", x.wall_seconds},
-                           {"post_peak_locking", x.post_peak_locking}, {"still_loading", x.still_loading},
-                           {"strain_at_peak", x.strain_at_peak}, {"first_stall", x.first_stall_stress},
-                           {"reloads", x.reloads}});
-        csv << r.test << ',' << r.confinement << ',' << r.seed << ',' << x.peak_stress << ','
-            << x.crack_initiation_stress << ',' << x.crack_damage_stress << ',' << x.tensile_strength << ',' << x.E
-            << ',' << x.nu << ',' << x.cracks_tensile << ',' << x.cracks_shear << ',' << x.steps << ','
-            << x.post_peak_locking << ',' << x.still_loading << ',' << x.strain_at_peak << ','
-            << x.first_stall_stress << ',' << x.reloads << '\n';
-    }
+    const nlohmann::json levels = envelope_levels(runs, confinements);
+    const auto [per_run, csv] = envelope_runs_table(runs);
     const auto ucs_stats = stats(ucs), t_stats = stats(strength_t);
     const double t_over_c = ucs_stats["mean"].get<double>() > 0
                                 ? t_stats["mean"].get<double>() / ucs_stats["mean"].get<double>() : 0.0;
@@ -484,7 +546,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
 
     if (c.write_files && Ranks::root()) {
         io::write_text_atomically(out / "envelope.json", summary.dump(2) + "\n");
-        io::write_text_atomically(out / "envelope.csv", csv.str());
+        io::write_text_atomically(out / "envelope.csv", csv);
         draw_envelope(summary, out / "envelope.png");
     }
     if (!quiet) {
@@ -492,27 +554,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                      ucs_stats["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
                      t_stats["mean"].get<double>() / 1e6, t_over_c);
         print_fits(summary);
-        int still_loading = 0;
-        for (const auto& r : runs) still_loading += r.result.still_loading;
-        if (still_loading > 0)
-            std::fprintf(stderr, "warning: %d test%s reached the strain cap %g still loading: %s peak is a lower bound "
-                                 "of the strength, and the fits with it (blocks jammed, or raise --strain-cap)\n",
-                         still_loading, still_loading == 1 ? "" : "s", std::max(c.o.max_strain, c.o.strain_cap),
-                         still_loading == 1 ? "its" : "their");
-        // Interlocking: a confined peak far above its first stall (the yield).
-        int hardened = 0, confined = 0;
-        for (const auto& r : runs) {
-            if (r.test != "biaxial") continue;
-            ++confined;
-            hardened += r.result.hardened_past_yield();
-        }
-        if (hardened > 0 && !c.o.confined_peak_at_stall)
-            std::fprintf(stderr, "warning: %d of %d confined tests hardened past their first stall (the yield) by more "
-                                 "than 20%%: broken blocks interlocking, and the fits mix them with the specimens that "
-                                 "failed. A residual friction below the joints' lets broken joints slide "
-                                 "(--residual-friction); --confined-peak first-stall reads the yield "
-                                 "(docs/calibration.md, The confined peak)\n",
-                         hardened, confined);
+        warn_about_envelope_runs(runs, c);
         if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
     }
     if (study) {

@@ -27,6 +27,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
@@ -424,6 +425,126 @@ nlohmann::json report_profile(const StepProfile& p, int contacts) {
     return {{"steps", p.steps}, {"seconds", stages}, {"total_seconds", total}};
 }
 
+namespace {
+
+/// --resume: the checkpoint opened and its model file checked (the same path, the
+/// same text); the model file to run. None: nothing to resume (said already).
+std::optional<std::string> model_to_run(const RunOptions& opt, std::ifstream& checkpoint, CheckpointHeader& header) {
+    if (!opt.resume) return opt.model;
+    if (!open_checkpoint(opt, checkpoint, header)) return std::nullopt;
+    const fs::path file = opt.out / "checkpoint.bin";
+    if (!opt.model.empty() && fs::absolute(opt.model).lexically_normal() != fs::path(header.model).lexically_normal())
+        throw InputError(file.string(), 0, "",
+                         "the checkpoint is of the model " + header.model + ", not " + opt.model +
+                             " (resume without a model file, or run " + opt.model + " into another --out)");
+    if (!fs::exists(header.model))
+        throw InputError(file.string(), 0, "", "the checkpoint's model file " + header.model + " is gone");
+    if (text_hash(read_file_text(header.model)) != header.model_hash)
+        throw InputError(header.model, 0, "",
+                         "the model file changed since " + file.string() +
+                             " was written (its text no longer matches the checkpoint's model hash): resume "
+                             "with the file as it was, or run the edited model from the start");
+    return header.model;
+}
+
+/// failure.png's window (around the opening, or the report's) and the failed zone's outline.
+FailurePlotOptions failure_plot_options(const io::ModelFile& model, const meshing::BlockAssembly& blocks,
+                                        const Solver& solver, const std::string& model_path) {
+    const auto& rep = model.analysis.report;
+    FailurePlotOptions fo;
+    fo.title = model_path;
+    if (rep.opening) {
+        const double r = std::max(norm(rep.springline - rep.center), norm(rep.crown - rep.center));
+        Box2 all;
+        for (Vec2 p : blocks.points) all.add(p);
+        fo.window.add({std::max(all.lo.x, rep.center.x - 2.2 * r), std::max(all.lo.y, rep.center.y - 2.2 * r)});
+        fo.window.add({std::min(all.hi.x, rep.center.x + 2.2 * r), std::min(all.hi.y, rep.center.y + 2.2 * r)});
+        const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
+        if (zone.area > 0) fo.outline = zone.outline();
+    }
+    if (rep.window) fo.window = *rep.window;
+    return fo;
+}
+
+/// failure.png, failure.svg and history.png. They are independent: with a second
+/// thread, failure.png is drawn beside the other two (after the one lazy cache a
+/// drawing reads, the contact normals, is refreshed here, so that both only read
+/// the solver).
+void draw_pictures(const Solver& solver, const RunOutput& output, const RunOptions& opt, const FailurePlotOptions& fo) {
+    auto svg_and_history = [&] {
+        draw_failure(solver, opt.out / "failure.svg", fo);
+        draw_history(output, opt.out / "history.png");
+    };
+    if (opt.threads > 1) {
+        (void)solver.contacts();
+        auto other = std::async(std::launch::async, svg_and_history);
+        draw_failure(solver, opt.out / "failure.png", fo);
+        other.get();
+    } else {
+        draw_failure(solver, opt.out / "failure.png", fo);
+        svg_and_history();
+    }
+}
+
+/// What the run did, on stderr: steps, cracks, the opening, the supports' loads.
+void print_run_report(const Solver& solver, const nlohmann::json& summary, const io::ModelFile& model,
+                      const RunOptions& opt, double seconds) {
+    const auto& rep = model.analysis.report;
+    std::fprintf(stderr, "%ld steps in %.2f s; cracks %d tensile, %d shear\n", solver.steps(), seconds,
+                 solver.cracks(contact::JointState::broken_tension),
+                 solver.cracks(contact::JointState::broken_shear));
+    if (rep.opening)
+        std::fprintf(stderr, "opening: convergence %.2f mm at the springline, %.2f mm at the crown; cracks in the "
+                             "±30° sectors %d (springline) vs %d (crown)\n",
+                     1e3 * summary["opening"]["springline_convergence"].get<double>(),
+                     1e3 * summary["opening"]["crown_convergence"].get<double>(),
+                     summary["opening"]["cracks_springline_sector"].get<int>(),
+                     summary["opening"]["cracks_crown_sector"].get<int>());
+    if (rep.opening) {
+        const auto& zone = summary["opening"]["failed_zone"];
+        if (zone.value("reaches_region_edge", false)) {
+            const auto& p = zone["region_edge_point"];
+            std::fprintf(stderr, "warning: the failed zone reaches the edge of the opening's region at (%.2f, %.2f) "
+                                 "m, its interface with the elastic far field: the failure there is the model "
+                                 "boundary's as much as the rock's; enlarge the bonded region\n",
+                         p[0].get<double>(), p[1].get<double>());
+        } else if (zone.value("region_edge_cells_damaged", 0) >= 2) {
+            std::fprintf(stderr, "warning: the rock is damaged along the edge of the opening's region (%d of its "
+                                 "%d cells there), where it meets the elastic far field: the boundary, not only "
+                                 "the opening, breaks rock; enlarge the bonded region\n",
+                         zone["region_edge_cells_damaged"].get<int>(), zone["region_edge_cells"].get<int>());
+        }
+    }
+    if (summary.contains("bolts"))
+        for (const auto& b : summary["bolts"])
+            std::fprintf(stderr, "bolts '%s': %d, largest load %.1f kN (bond %.1f kN/m), %d yielded, %d broken\n",
+                         b["name"].get<std::string>().c_str(), b["bolts"].get<int>(),
+                         b["max_axial_kN"].get<double>(), b["max_bond_kN_per_m"].get<double>(),
+                         b["yielded"].get<int>(), b["broken"].get<int>());
+    if (summary.contains("liners"))
+        for (const auto& l : summary["liners"])
+            std::fprintf(stderr, "liner '%s': thrust %.0f to %.0f kN/m, largest moment %.1f kNm/m, %d of %d "
+                                 "elements yielded, %d of %d interface nodes open\n",
+                         l["name"].get<std::string>().c_str(), l["min_thrust_kN_per_m"].get<double>(),
+                         l["max_thrust_kN_per_m"].get<double>(), l["max_moment_kNm_per_m"].get<double>(),
+                         l["yielded_elements"].get<int>(), l["elements"].get<int>(),
+                         l["open_interface_nodes"].get<int>(), l["nodes"].get<int>());
+    for (const auto& support : solver.supports()) {
+        if (std::string(support->name()) == "bolts" || std::string(support->name()) == "liners") continue;
+        for (const auto& set : support->summary()) {
+            std::string figures;
+            for (const auto& f : set.figures)
+                figures += (figures.empty() ? "" : ", ") + f.key + " " +
+                           (f.count ? std::to_string(long(f.value)) : std::to_string(f.value));
+            std::fprintf(stderr, "%s '%s': %s\n", support->name(), set.name.c_str(), figures.c_str());
+        }
+    }
+    std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
+                 opt.out.string().c_str());
+}
+
+} // namespace
+
 int run_model(const RunOptions& opt) {
     // From the start: a scheduler's signal during meshing or the elastic solve
     // must not kill the run either (it stops after the first step).
@@ -436,25 +557,11 @@ int run_model(const RunOptions& opt) {
     // its first step. Only an earlier run's --stop-at-step is forgotten.
     if (interrupted.load() < 0) interrupted = 0;
     catch_stop_signals();
-    std::string model_path = opt.model;
     std::ifstream checkpoint;
     CheckpointHeader header;
-    if (opt.resume) {
-        if (!open_checkpoint(opt, checkpoint, header)) return 0;
-        const fs::path file = opt.out / "checkpoint.bin";
-        if (!opt.model.empty() && fs::absolute(opt.model).lexically_normal() != fs::path(header.model).lexically_normal())
-            throw InputError(file.string(), 0, "",
-                             "the checkpoint is of the model " + header.model + ", not " + opt.model +
-                                 " (resume without a model file, or run " + opt.model + " into another --out)");
-        model_path = header.model;
-        if (!fs::exists(model_path))
-            throw InputError(file.string(), 0, "", "the checkpoint's model file " + model_path + " is gone");
-        if (text_hash(read_file_text(model_path)) != header.model_hash)
-            throw InputError(model_path, 0, "",
-                             "the model file changed since " + file.string() +
-                                 " was written (its text no longer matches the checkpoint's model hash): resume "
-                                 "with the file as it was, or run the edited model from the start");
-    }
+    const auto to_run = model_to_run(opt, checkpoint, header);
+    if (!to_run) return 0;
+    const std::string& model_path = *to_run;
     io::ModelFile model = io::read_model(model_path);
     model.analysis.solver.threads = opt.threads;
     if (opt.max_elements > 0) model.geometry.max_elements = opt.max_elements;
@@ -531,88 +638,16 @@ int run_model(const RunOptions& opt) {
     nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, stop_signal != 0,
                                          health.empty() && stop_signal == 0);
     if (opt.profile) summary["profile"] = report_profile(solver->profile(), solver->contacts().size());
-    const auto& rep = model.analysis.report;
-    FailurePlotOptions fo;
-    fo.title = model_path;
-    if (rep.opening) {
-        const double r = std::max(norm(rep.springline - rep.center), norm(rep.crown - rep.center));
-        Box2 all;
-        for (Vec2 p : blocks.points) all.add(p);
-        fo.window.add({std::max(all.lo.x, rep.center.x - 2.2 * r), std::max(all.lo.y, rep.center.y - 2.2 * r)});
-        fo.window.add({std::min(all.hi.x, rep.center.x + 2.2 * r), std::min(all.hi.y, rep.center.y + 2.2 * r)});
-        const auto zone = measure_failed_zone(*solver, rep.center, rep.springline, rep.crown);
-        if (zone.area > 0) fo.outline = zone.outline();
-    }
-    if (rep.window) fo.window = *rep.window;
-    if (!health.empty()) {
-        summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
-    } else {
-        // The pictures are independent: with a second thread, failure.png is drawn
-        // beside the other two (after the one lazy cache a drawing reads, the
-        // contact normals, is refreshed here, so that both only read the solver).
-        auto svg_and_history = [&] {
-            draw_failure(*solver, opt.out / "failure.svg", fo);
-            draw_history(output, opt.out / "history.png");
-        };
-        if (opt.threads > 1) {
-            (void)solver->contacts();
-            auto other = std::async(std::launch::async, svg_and_history);
-            draw_failure(*solver, opt.out / "failure.png", fo);
-            other.get();
-        } else {
-            draw_failure(*solver, opt.out / "failure.png", fo);
-            svg_and_history();
-        }
-    }
+    const FailurePlotOptions fo = failure_plot_options(model, blocks, *solver, model_path);
+    if (!health.empty()) summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
+    else draw_pictures(*solver, output, opt, fo);
     write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");
     if (!health.empty()) {
         std::fprintf(stderr, "\nbbm: stopped: %s\nThe output of the last good step is kept in %s.\n", health.c_str(),
                      opt.out.string().c_str());
         return 3;
     }
-    if (!opt.quiet) {
-        std::fprintf(stderr, "%ld steps in %.2f s; cracks %d tensile, %d shear\n", solver->steps(), seconds,
-                     solver->cracks(contact::JointState::broken_tension),
-                     solver->cracks(contact::JointState::broken_shear));
-        if (rep.opening)
-            std::fprintf(stderr, "opening: convergence %.2f mm at the springline, %.2f mm at the crown; cracks in the "
-                                 "±30° sectors %d (springline) vs %d (crown)\n",
-                         1e3 * summary["opening"]["springline_convergence"].get<double>(),
-                         1e3 * summary["opening"]["crown_convergence"].get<double>(),
-                         summary["opening"]["cracks_springline_sector"].get<int>(),
-                         summary["opening"]["cracks_crown_sector"].get<int>());
-        if (rep.opening) {
-            const auto& zone = summary["opening"]["failed_zone"];
-            if (zone.value("reaches_region_edge", false)) {
-                const auto& p = zone["region_edge_point"];
-                std::fprintf(stderr, "warning: the failed zone reaches the edge of the opening's region at (%.2f, %.2f) "
-                                     "m, its interface with the elastic far field: the failure there is the model "
-                                     "boundary's as much as the rock's; enlarge the bonded region\n",
-                             p[0].get<double>(), p[1].get<double>());
-            } else if (zone.value("region_edge_cells_damaged", 0) >= 2) {
-                std::fprintf(stderr, "warning: the rock is damaged along the edge of the opening's region (%d of its "
-                                     "%d cells there), where it meets the elastic far field: the boundary, not only "
-                                     "the opening, breaks rock; enlarge the bonded region\n",
-                             zone["region_edge_cells_damaged"].get<int>(), zone["region_edge_cells"].get<int>());
-            }
-        }
-        if (summary.contains("bolts"))
-            for (const auto& b : summary["bolts"])
-                std::fprintf(stderr, "bolts '%s': %d, largest load %.1f kN (bond %.1f kN/m), %d yielded, %d broken\n",
-                             b["name"].get<std::string>().c_str(), b["bolts"].get<int>(),
-                             b["max_axial_kN"].get<double>(), b["max_bond_kN_per_m"].get<double>(),
-                             b["yielded"].get<int>(), b["broken"].get<int>());
-        if (summary.contains("liners"))
-            for (const auto& l : summary["liners"])
-                std::fprintf(stderr, "liner '%s': thrust %.0f to %.0f kN/m, largest moment %.1f kNm/m, %d of %d "
-                                     "elements yielded, %d of %d interface nodes open\n",
-                             l["name"].get<std::string>().c_str(), l["min_thrust_kN_per_m"].get<double>(),
-                             l["max_thrust_kN_per_m"].get<double>(), l["max_moment_kNm_per_m"].get<double>(),
-                             l["yielded_elements"].get<int>(), l["elements"].get<int>(),
-                             l["open_interface_nodes"].get<int>(), l["nodes"].get<int>());
-        std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
-                     opt.out.string().c_str());
-    }
+    if (!opt.quiet) print_run_report(*solver, summary, model, opt, seconds);
     return stop_signal != 0 ? 130 : 0;
 }
 
