@@ -126,15 +126,11 @@ void BoltSupport::force_pass(const SupportRock& rock, Vec2* reaction, double* re
                 continue;
             }
             const auto& set = B.sets[B.node_set[k]];
-            const Vec2 x = rock.position(h), d = x - B.position[k];
-            const Vec2 axis = B.position[std::min(k + 1, last)] - B.position[std::max(k - 1, first)];
-            const Vec2 t = axis / norm(axis);
-            const double s = dot(d, t);
-            double q = set.bond_stiffness * (s - B.slip[k]);
-            if (!B.tied[k] && set.bond_strength > 0.0)
-                q = support::plastic_return(q, set.bond_strength, set.bond_stiffness, s, B.slip[k]);
-            B.bond[k] = q;
-            const Vec2 f = B.length[k] * (q * t + set.normal_stiffness * (d - s * t));
+            const Vec2 x = rock.position(h);
+            const auto g = support::grout(x - B.position[k], support::bar_axis(B.position, k, first, last),
+                                          set.bond_stiffness, set.bond_strength, set.normal_stiffness, B.tied[k], B.slip[k]);
+            B.bond[k] = g.along;
+            const Vec2 f = B.length[k] * g.per_metre;
             B.force[k] += f;
             rock.reaction(h, x, f, reaction[k], reaction_moment[k]);
         }

@@ -127,17 +127,12 @@ void DowelSupport::force_pass(const SupportRock& rock, Vec2* reaction, double* r
                 continue;
             }
             const auto& set = D.sets[D.node_set[k]];
-            const Vec2 x = rock.position(h), gap = x - D.position[k];
-            const Vec2 axis = D.position[std::min(k + 1, last)] - D.position[std::max(k - 1, first)];
-            const Vec2 t = axis / norm(axis);
-            const double s = dot(gap, t);
-            double q = set.bond_stiffness * (s - D.slip[k]);
-            if (!D.tied[k] && set.bond_strength > 0.0)
-                q = support::plastic_return(q, set.bond_strength, set.bond_stiffness, s, D.slip[k]);
-            const Vec2 across = set.normal_stiffness * (gap - s * t);
-            D.bond[k] = q;
-            D.shear[k] = dot(across, perp(t));
-            const Vec2 f = D.length[k] * (q * t + across);
+            const Vec2 x = rock.position(h), t = support::bar_axis(D.position, k, first, last);
+            const auto g = support::grout(x - D.position[k], t, set.bond_stiffness, set.bond_strength,
+                                          set.normal_stiffness, D.tied[k], D.slip[k]);
+            D.bond[k] = g.along;
+            D.shear[k] = dot(g.across, perp(t));
+            const Vec2 f = D.length[k] * g.per_metre;
             D.force[k] += f;
             rock.reaction(h, x, f, reaction[k], reaction_moment[k]);
         }

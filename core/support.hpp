@@ -25,6 +25,7 @@
 #include "base/vec2.hpp"
 #include "core/state_fields.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -178,6 +179,28 @@ inline double plastic_return(double trial, double limit, double stiffness, doubl
     const double clamped = trial > 0.0 ? limit : -limit;
     plastic = total - clamped / stiffness;
     return clamped;
+}
+/// A bar's unit axis at node k of the bar whose nodes are [first, last]: along its
+/// neighbours (bolts, dowels).
+inline Vec2 bar_axis(const std::vector<Vec2>& position, int k, int first, int last) {
+    const Vec2 axis = position[std::min(k + 1, last)] - position[std::max(k - 1, first)];
+    return axis / norm(axis);
+}
+/// A bar's grout at one node, the rock point having moved `gap` from the node:
+/// along the axis t, q = k_bond (s − s_p) with s = gap·t, limited to ±strength
+/// (plastic slip s_p) unless the node is tied (a face plate, an end anchor);
+/// across it k_across (gap − s t), elastic. per_metre: the force on the node per
+/// metre of bar (times its tributary length: the node's).
+struct Grout {
+    double along;
+    Vec2 across, per_metre;
+};
+inline Grout grout(Vec2 gap, Vec2 t, double k_bond, double strength, double k_across, bool tied, double& slip) {
+    const double s = dot(gap, t);
+    double q = k_bond * (s - slip);
+    if (!tied && strength > 0.0) q = plastic_return(q, strength, k_bond, s, slip);
+    const Vec2 across = k_across * (gap - s * t);
+    return {q, across, q * t + across};
 }
 /// Local non-viscous damping (Cundall), as the blocks get it: f reduced by α|f| against v.
 inline double damped(double f, double v, double alpha) {

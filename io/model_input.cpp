@@ -872,15 +872,29 @@ void refuse_non_ascii_outside_strings(std::string_view text, const std::string& 
 
 } // namespace
 
-ModelFile parse_model(std::string_view text, const std::string& name) {
+namespace {
+/// A file's TOML, its syntax errors named with file and line.
+toml::table parse_toml(std::string_view text, const std::string& name) {
     refuse_non_ascii_outside_strings(text, name);
-    toml::table doc;
     try {
-        doc = toml::parse(text, std::string_view{name});
+        return toml::parse(text, std::string_view{name});
     } catch (const toml::parse_error& e) {
         throw InputError(name, static_cast<int>(e.source().begin.line), "",
                          "TOML syntax error: " + std::string(e.description()));
     }
+}
+/// A file's text; InputError if it cannot be opened.
+std::string file_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "", "cannot open file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+} // namespace
+
+ModelFile parse_model(std::string_view text, const std::string& name) {
+    toml::table doc = parse_toml(text, name);
 
     ModelFile mf;
     mf.source.file = name;
@@ -928,14 +942,7 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
 }
 
 RockFile parse_rock(std::string_view text, const std::string& name) {
-    refuse_non_ascii_outside_strings(text, name);
-    toml::table doc;
-    try {
-        doc = toml::parse(text, std::string_view{name});
-    } catch (const toml::parse_error& e) {
-        throw InputError(name, static_cast<int>(e.source().begin.line), "",
-                         "TOML syntax error: " + std::string(e.description()));
-    }
+    toml::table doc = parse_toml(text, name);
     RockFile rock;
     if (doc.contains("region")) {
         rock.model = parse_model(text, name);
@@ -972,19 +979,11 @@ RockFile parse_rock(std::string_view text, const std::string& name) {
 }
 
 RockFile read_rock(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, 0, "", "cannot open file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_rock(text.str(), path);
+    return parse_rock(file_text(path), path);
 }
 
 ModelFile read_model(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, 0, "", "cannot open file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_model(text.str(), path);
+    return parse_model(file_text(path), path);
 }
 
 InputError to_input_error(const ModelSource& source, const GeometryError& error) {
@@ -1053,14 +1052,7 @@ toml::node_view<toml::node> parse_value(const std::string& text, toml::table& ho
 
 std::string edit_model_text(std::string_view text, const std::string& name,
                             const std::vector<std::pair<std::string, std::string>>& set, long seed_offset) {
-    refuse_non_ascii_outside_strings(text, name);
-    toml::table doc;
-    try {
-        doc = toml::parse(text, std::string_view{name});
-    } catch (const toml::parse_error& e) {
-        throw InputError(name, static_cast<int>(e.source().begin.line), "",
-                         "TOML syntax error: " + std::string(e.description()));
-    }
+    toml::table doc = parse_toml(text, name);
     for (const auto& [key, value] : set) {
         const auto steps = split_key(key, "--set");
         toml::table* table = &doc;
