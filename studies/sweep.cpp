@@ -108,19 +108,23 @@ std::string csv_field(std::string s) {
 
 } // namespace
 
-int run_sweep(const SweepOptions& o) {
-    if (o.seeds < 1) throw InputError("--seeds", 0, "", "needs at least 1");
-    const std::string base = read_text(o.model);
-    // The cross product: the first --set slowest, the seed fastest.
+namespace {
+
+/// One run of a sweep: its --set values, seed offset, edited model text and folder.
+struct SweepRun {
+    std::vector<std::pair<std::string, std::string>> set;
+    long seed_offset = 0;
+    std::string text, dir;
+};
+
+/// The cross product of the --set values and the seeds (the first --set slowest,
+/// the seed fastest), every edited model read before anything runs: a wrong key or
+/// value is an error now (exit 2, naming it), not a table of failed runs.
+std::vector<SweepRun> plan_sweep(const SweepOptions& o, const std::string& base) {
     std::size_t runs = std::size_t(o.seeds);
     for (const auto& s : o.set) runs *= s.second.size();
     if (runs > 100000) throw InputError("--set", 0, "", "more than 100,000 runs in the cross product");
-    struct Run {
-        std::vector<std::pair<std::string, std::string>> set;
-        long seed_offset = 0;
-        std::string text, dir;
-    };
-    std::vector<Run> plan(runs);
+    std::vector<SweepRun> plan(runs);
     for (std::size_t k = 0; k < runs; ++k) {
         std::size_t rest = k;
         auto& r = plan[k];
@@ -137,8 +141,6 @@ int run_sweep(const SweepOptions& o) {
         r.dir = dir;
         r.text = io::edit_model_text(base, o.model, split_joined_keys(r.set), r.seed_offset);
     }
-    // Every edited model is read before anything runs: a wrong key or value is an
-    // error now (exit 2, naming it), not a table of failed runs.
     for (std::size_t k = 0; k < runs; ++k) {
         try {
             (void)io::parse_model(plan[k].text, o.model);
@@ -149,57 +151,62 @@ int run_sweep(const SweepOptions& o) {
                              e.message() + (what.empty() ? "" : " (with --set " + what + ")"));
         }
     }
-    if (o.check_only) return 0;
-    if (Ranks::root()) io::make_output_directory(o.out);
-    const bool quiet = o.quiet || !Ranks::root();
-    if (!quiet)
-        std::fprintf(stderr, "bbm sweep: %zu runs of %s (%zu values x %d seeds) on %d rank%s, %d at once per rank\n",
-                     runs, o.model.c_str(), runs / std::size_t(o.seeds), o.seeds, Ranks::size(),
-                     Ranks::size() > 1 ? "s" : "", o.jobs);
-    std::vector<std::string> errors;
-    const auto summaries = run_spread(int(runs), o.jobs, [&](int k) -> std::string {
-        // Interrupted (Ctrl-C, a scheduler's signal): the runs under way stop with a
-        // checkpoint, no further run starts; `bbm sweep --resume` runs the rest.
-        if (stop_signal_received())
-            throw std::runtime_error("not started: the sweep was interrupted (bbm sweep --resume runs it)");
-        const auto& r = plan[std::size_t(k)];
-        const fs::path dir = o.out / r.dir;
-        if (o.resume && fs::exists(dir / "summary.json") && read_text(dir / "model.toml") == r.text) {
-            const auto s = nlohmann::json::parse(read_text(dir / "summary.json"), nullptr, false);
-            if (!s.is_discarded() && s.value("complete", false)) {
-                nlohmann::json kept = s;
-                kept["resumed"] = true;
-                return kept.dump();
-            }
-        }
-        io::make_output_directory(dir);
-        io::write_text_atomically(dir / "model.toml", r.text);
-        RunOptions run;
-        run.model = (dir / "model.toml").string();
-        run.out = dir;
-        run.threads = o.threads;
-        run.quiet = true;
-        const int status = run_model(run);
-        auto s = nlohmann::json::parse(read_text(dir / "summary.json"));
-        s["exit_status"] = status;
-        if (!quiet) std::fprintf(stderr, "  %s done: %ld steps, status %d\n", r.dir.c_str(), s.value("steps", 0L), status);
-        return s.dump();
-    }, &errors);
-    if (!Ranks::root()) return 0;
+    return plan;
+}
 
-    // The table.
+/// Runs one (or keeps it, resumed and complete); its summary.json's text.
+std::string run_one(const SweepOptions& o, const SweepRun& r, bool quiet) {
+    // Interrupted (Ctrl-C, a scheduler's signal): the runs under way stop with a
+    // checkpoint, no further run starts; `bbm sweep --resume` runs the rest.
+    if (stop_signal_received())
+        throw std::runtime_error("not started: the sweep was interrupted (bbm sweep --resume runs it)");
+    const fs::path dir = o.out / r.dir;
+    if (o.resume && fs::exists(dir / "summary.json") && read_text(dir / "model.toml") == r.text) {
+        const auto s = nlohmann::json::parse(read_text(dir / "summary.json"), nullptr, false);
+        if (!s.is_discarded() && s.value("complete", false)) {
+            nlohmann::json kept = s;
+            kept["resumed"] = true;
+            return kept.dump();
+        }
+    }
+    io::make_output_directory(dir);
+    io::write_text_atomically(dir / "model.toml", r.text);
+    RunOptions run;
+    run.model = (dir / "model.toml").string();
+    run.out = dir;
+    run.threads = o.threads;
+    run.quiet = true;
+    const int status = run_model(run);
+    auto s = nlohmann::json::parse(read_text(dir / "summary.json"));
+    s["exit_status"] = status;
+    if (!quiet) std::fprintf(stderr, "  %s done: %ld steps, status %d\n", r.dir.c_str(), s.value("steps", 0L), status);
+    return s.dump();
+}
+
+/// The sweep's table (sweep.csv, sweep.json's runs) and its plot's series.
+struct SweepTable {
     std::ostringstream csv;
+    nlohmann::json table = nlohmann::json::array();
+    int failed = 0;
+    /// Series of the plot: one per seed offset and per value of the other swept keys
+    /// (a sweep over bolt length and bolt count draws one line per count); the mean
+    /// over seeds per value of the other keys.
+    std::map<std::pair<std::string, long>, io::Series> by_seed;
+    std::map<std::string, std::map<double, std::pair<double, int>>> mean; // others -> x -> (sum, count)
+};
+
+void tabulate_sweep(const SweepOptions& o, const std::vector<SweepRun>& plan, const std::vector<std::string>& summaries,
+                    const std::vector<std::string>& errors, SweepTable& out) {
+    auto& csv = out.csv;
+    auto& table = out.table;
+    auto& failed = out.failed;
+    auto& by_seed = out.by_seed;
+    auto& mean = out.mean;
+    const std::size_t runs = plan.size();
     csv << "run";
     for (const auto& s : o.set) csv << ',' << csv_field(s.first);
     csv << ",seed_offset,status,error,steps,cracks_tensile,cracks_shear,wall_seconds,state_hash," << csv_field(o.plot)
         << ",folder\n";
-    nlohmann::json table = nlohmann::json::array();
-    int failed = 0;
-    // Series of the plot: one per seed offset and per value of the other swept keys
-    // (a sweep over bolt length and bolt count draws one line per count); the mean
-    // over seeds per value of the other keys.
-    std::map<std::pair<std::string, long>, io::Series> by_seed;
-    std::map<std::string, std::map<double, std::pair<double, int>>> mean; // others -> x -> (sum, count)
     for (std::size_t k = 0; k < runs; ++k) {
         const auto& r = plan[k];
         nlohmann::json row{{"run", k + 1}, {"folder", r.dir}, {"seed_offset", r.seed_offset}};
@@ -259,7 +266,32 @@ int run_sweep(const SweepOptions& o) {
             }
         }
     }
-    io::write_text_atomically(o.out / "sweep.csv", csv.str());
+}
+
+} // namespace
+
+int run_sweep(const SweepOptions& o) {
+    if (o.seeds < 1) throw InputError("--seeds", 0, "", "needs at least 1");
+    const std::string base = read_text(o.model);
+    const std::vector<SweepRun> plan = plan_sweep(o, base);
+    const std::size_t runs = plan.size();
+    if (o.check_only) return 0;
+    if (Ranks::root()) io::make_output_directory(o.out);
+    const bool quiet = o.quiet || !Ranks::root();
+    if (!quiet)
+        std::fprintf(stderr, "bbm sweep: %zu runs of %s (%zu values x %d seeds) on %d rank%s, %d at once per rank\n",
+                     runs, o.model.c_str(), runs / std::size_t(o.seeds), o.seeds, Ranks::size(),
+                     Ranks::size() > 1 ? "s" : "", o.jobs);
+    std::vector<std::string> errors;
+    const auto summaries = run_spread(int(runs), o.jobs, [&](int k) -> std::string {
+        return run_one(o, plan[std::size_t(k)], quiet);
+    }, &errors);
+    if (!Ranks::root()) return 0;
+
+    SweepTable t;
+    tabulate_sweep(o, plan, summaries, errors, t);
+    auto& mean = t.mean;
+    io::write_text_atomically(o.out / "sweep.csv", t.csv.str());
     io::write_text_atomically(o.out / "sweep.json",
                               nlohmann::json{{"model", o.model},
                                              {"seeds", o.seeds},
@@ -270,7 +302,7 @@ int run_sweep(const SweepOptions& o) {
                                               }()},
                                              {"plot", o.plot},
                                              {"ranks", Ranks::size()},
-                                             {"runs", table}}
+                                             {"runs", t.table}}
                                       .dump(2) + "\n");
     if (!mean.empty()) {
         std::vector<io::Series> series;
@@ -280,13 +312,13 @@ int run_sweep(const SweepOptions& o) {
                 for (const auto& [x, sum] : points) m.x.push_back(x), m.y.push_back(sum.first / sum.second);
                 series.push_back(std::move(m));
             }
-        for (auto& [seed, ser] : by_seed) series.push_back(std::move(ser));
+        for (auto& [seed, ser] : t.by_seed) series.push_back(std::move(ser));
         io::draw_curves(series, o.set.front().first, o.plot, o.out / "sweep.png", "bbm sweep: " + o.model);
     }
     if (!o.quiet)
-        std::fprintf(stderr, "%zu runs, %d failed or incomplete; wrote %s/{sweep.csv, sweep.json%s}\n", runs, failed,
+        std::fprintf(stderr, "%zu runs, %d failed or incomplete; wrote %s/{sweep.csv, sweep.json%s}\n", runs, t.failed,
                      o.out.string().c_str(), mean.empty() ? "" : ", sweep.png");
-    return stop_signal_received() ? 130 : failed ? 1 : 0;
+    return stop_signal_received() ? 130 : t.failed ? 1 : 0;
 }
 
 } // namespace bbm::studies
