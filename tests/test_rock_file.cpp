@@ -2,10 +2,12 @@
 // the bonds and material of a rock file — a [[joint_property]] and a [[material]]
 // read by the model file's own readers, as bbm calibrate writes them — the same
 // bits as the same values given as flags; flags given beside it override it; a
-// bad file is refused naming file, line and key.
+// bad file is refused naming file, line and key. The first runs four lab tests to
+// their answer: a validation (tests/validation.hpp), not run in the checking build.
 #include "base/error.hpp"
 #include "io/model_input.hpp"
 #include "studies/commands.hpp"
+#include "tests/validation.hpp"
 
 #include <doctest/doctest.h>
 
@@ -60,7 +62,8 @@ void check_same(const LabTestStudy& a, const LabTestStudy& b) {
 
 } // namespace
 
-TEST_CASE("--rock: a rock file is the same rock as its values given as flags, and flags beside it override it") {
+TEST_CASE("--rock: a rock file is the same rock as its values given as flags, and flags beside it override it" *
+          validation) {
     const auto dir = std::filesystem::temp_directory_path() / "bbm_test_rock_file";
     std::filesystem::create_directories(dir);
     const std::string file = (dir / "rock.toml").string();
