@@ -28,6 +28,7 @@
 #include "contact/joint_property.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string_view>
 
@@ -35,6 +36,9 @@ namespace bbm::contact {
 
 struct BartonBandisLaw {
     static constexpr std::string_view name = "barton_bandis";
+    /// The [[joint_property]] keys it reads (declared in joint_keys.hpp).
+    static constexpr std::array<std::string_view, 9> keys{"name", "law", "kn", "ks", "face_shear",
+                                                          "friction", "jrc", "jcs", "joint_length"};
     static constexpr double max_angle_deg = 70.0; ///< Barton's bound on φr + JRC log10(JCS/σn)
 
     double kn, ks;

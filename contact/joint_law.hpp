@@ -100,6 +100,8 @@ inline bool intact_elastic_update(JointHistory& h, double kn, double ks, double 
 // the time; plastic returns and failures go out of line.
 struct ElasticLaw {
     static constexpr std::string_view name = "elastic";
+    /// The [[joint_property]] keys it reads (declared in joint_keys.hpp).
+    static constexpr std::array<std::string_view, 5> keys{"name", "law", "kn", "ks", "face_shear"};
     double kn, ks;
     explicit ElasticLaw(const JointPropertySpec& p) : kn(p.kn), ks(p.ks) {}
     bool starts_bonded() const { return true; }
@@ -117,6 +119,9 @@ struct ElasticLaw {
 /// vanish at the first failure).
 struct CoulombLaw {
     static constexpr std::string_view name = "coulomb";
+    static constexpr std::array<std::string_view, 12> keys{
+        "name",     "law",    "kn",  "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
+        "weibull_modulus", "strength_classes", "strength_seed"};
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     BondFriction friction; ///< plain tan φ: the confined friction is the softening law's
     explicit CoulombLaw(const JointPropertySpec& p);
@@ -137,6 +142,10 @@ struct CoulombLaw {
 
 struct SofteningLaw {
     static constexpr std::string_view name = "softening";
+    static constexpr std::array<std::string_view, 16> keys{
+        "name",     "law",    "kn",  "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
+        "weibull_modulus", "strength_classes", "strength_seed", "tension_softening", "shear_softening",
+        "confined_friction", "confined_friction_from"};
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     BondFriction friction; ///< the bonded cap's frictional term, confined friction included
     SofteningCurve tension, shear;
@@ -158,7 +167,8 @@ struct SofteningLaw {
 };
 
 /// Every joint law, one alternative each, in the order of JointPropertySpec::Law.
-/// A law is a type with its `name` (the model file's `law`), kn and ks, update(),
+/// A law is a type with its `name` (the model file's `law`), the `keys` it reads
+/// (each declared in joint_keys.hpp), kn and ks, update(),
 /// starts_bonded() and elastic_limit(); the contact pass dispatches once per batch
 /// of contacts that share a property set (no virtual call per contact).
 using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw, BartonBandisLaw>;

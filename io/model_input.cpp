@@ -9,6 +9,7 @@
 #define TOML_IMPLEMENTATION
 #include "io/reader.hpp"
 
+#include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
 
 #include "core/verdict.hpp"
@@ -505,71 +506,36 @@ std::vector<std::pair<double, double>> read_curve(const Ctx& c, const toml::tabl
 }
 
 /// Peak strength of a softening law: > 0, the curves are normalised by it.
-double peak(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
-            std::string_view curve) {
-    const std::string why = "the peak the " + std::string(curve) + " curve is normalised by";
-    const toml::node& n = need(c, t, p, key, "a number > 0 Pa, " + why);
-    const double v = to_number(c, n, p.key(key));
-    if (!(v > 0))
-        c.fail(n, p.key(key),
-               "a softening law needs " + std::string(key) + " > 0 Pa, " + why + "; got " + fmt(v));
-    return v;
+
+/// strength_classes and strength_seed go with a Weibull modulus.
+void check_heterogeneity_keys(const Ctx& c, const toml::table& t, const Path& p, const JointPropertySpec& j) {
+    if (j.weibull_modulus > 0.0) return;
+    for (const char* key : {"strength_classes", "strength_seed"})
+        if (t.contains(key)) c.fail(*t.get(key), p.key(key), "goes with weibull_modulus > 0");
 }
 
-/// weibull_modulus, strength_classes, strength_seed: heterogeneous strengths.
-void read_heterogeneity(const Ctx& c, const toml::table& t, const Path& p, JointPropertySpec& j) {
-    if (const auto m = number(c, t, p, "weibull_modulus", above(0, ""))) {
-        if (!(j.cohesion > 0 || j.tensile > 0))
-            c.fail(*t.get("weibull_modulus"), p.key("weibull_modulus"),
-                   "heterogeneous strengths need a bond: cohesion or tensile > 0");
-        j.weibull_modulus = *m;
-    } else {
-        for (const char* key : {"strength_classes", "strength_seed"})
-            if (t.contains(key)) c.fail(*t.get(key), p.key(key), "goes with weibull_modulus");
+/// A number or integer key as contact/joint_keys.hpp declares it: its bounds,
+/// required or left at the spec's default.
+void read_declared_key(const Ctx& c, const toml::table& t, const Path& p, const contact::JointKey& k,
+                       JointPropertySpec& j) {
+    using contact::KeyKind;
+    if (k.kind == KeyKind::integer) {
+        if (const toml::node* n = k.required ? &need(c, t, p, k.key, "a whole number " + k.bounds.text())
+                                             : find(c, t, p, k.key))
+            k.set(j, double(to_whole_number(c, *n, p.key(k.key), k.bounds)));
+    } else if (k.required) {
+        k.set(j, required_number(c, t, p, k.key, k.bounds));
+    } else if (const auto v = number(c, t, p, k.key, k.bounds)) {
+        k.set(j, *v);
     }
-    j.strength_classes = int(integer(c, t, p, "strength_classes", 1, 1000).value_or(j.strength_classes));
-    j.strength_seed = std::uint64_t(
-        integer(c, t, p, "strength_seed", 0, std::numeric_limits<std::int64_t>::max()).value_or(1));
 }
 
-/// confined_friction and confined_friction_from: the bonds' friction steepening
-/// under high normal stress; the two go together.
-void read_confined_friction(const Ctx& c, const toml::table& t, const Path& p, JointPropertySpec& j) {
-    const auto phi2 = number(c, t, p, "confined_friction", below(0, 90, degrees));
-    const auto from = number(c, t, p, "confined_friction_from", above(0, pascals));
-    if (phi2.has_value() != from.has_value()) {
-        const char* given = phi2 ? "confined_friction" : "confined_friction_from";
-        c.fail(*t.get(given), p.key(given),
-               "confined_friction (the steeper friction angle, degrees) and confined_friction_from (the normal "
-               "stress it starts at, Pa) go together");
-    }
-    if (phi2) j.confined_friction = *phi2, j.confined_friction_from = *from;
-}
-
-/// The keys of each law's [[joint_property]] (in the order of JointPropertySpec::Law).
-constexpr std::array<std::string_view, 5> elastic_keys{"name", "law", "kn", "ks", "face_shear"};
-constexpr std::array<std::string_view, 12> coulomb_keys{
-    "name", "law", "kn", "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
-    "weibull_modulus", "strength_classes", "strength_seed"};
-constexpr std::array<std::string_view, 16> softening_keys{
-    "name", "law", "kn", "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
-    "weibull_modulus", "strength_classes", "strength_seed", "tension_softening", "shear_softening",
-    "confined_friction", "confined_friction_from"};
-constexpr std::array<std::string_view, 9> barton_bandis_keys{"name", "law",  "kn",  "ks",          "face_shear",
-                                                             "friction", "jrc", "jcs", "joint_length"};
-constexpr std::array<Keys, 4> law_keys{elastic_keys, coulomb_keys, softening_keys, barton_bandis_keys};
-static_assert(law_keys.size() == contact::law_names.size());
-constexpr std::array<std::string_view, 19> all_joint_keys{
-    "name", "law", "kn", "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
-    "weibull_modulus", "strength_classes", "strength_seed", "tension_softening", "shear_softening",
-    "confined_friction", "confined_friction_from", "jrc", "jcs", "joint_length"};
-
-/// jrc, jcs and joint_length of a Barton-Bandis joint (`friction` is its φr).
-void read_barton_bandis(const Ctx& c, const toml::table& t, const Path& p, JointPropertySpec& j) {
-    j.jrc = required_number(c, t, p, "jrc", between(0, 20, ""));
-    j.jcs = required_number(c, t, p, "jcs", above(0, pascals));
-    j.joint_length = number(c, t, p, "joint_length", above(0, metres)).value_or(-1.0);
-}
+/// Every key a [[joint_property]] may have (contact/joint_keys.hpp).
+constexpr auto all_joint_keys = [] {
+    std::array<std::string_view, std::size(contact::joint_keys)> keys;
+    for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = contact::joint_keys[i].key;
+    return keys;
+}();
 
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
     check_keys(c, t, p, all_joint_keys);
@@ -578,28 +544,24 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
     j.name = read_name(c, t, p, names);
     j.law = static_cast<Law>(choice(c, t, p, "law", contact::law_names, "joint law"));
     const auto law = static_cast<std::size_t>(j.law);
-    check_keys(c, t, p, law_keys[law], all_joint_keys, article(contact::law_names[law]) + " joint property");
-    j.kn = required_number(c, t, p, "kn", above(0, pascals_per_metre));
-    j.ks = required_number(c, t, p, "ks", above(0, pascals_per_metre));
-    j.face_shear = boolean(c, t, p, "face_shear").value_or(false);
-    if (j.law == Law::elastic) return j;
-    j.friction = number(c, t, p, "friction", below(0, 90, degrees)).value_or(j.friction);
-    if (j.law == Law::barton_bandis) {
-        read_barton_bandis(c, t, p, j);
-        return j;
+    const auto keys = contact::law_keys(j.law);
+    check_keys(c, t, p, keys, all_joint_keys, article(contact::law_names[law]) + " joint property");
+    for (const std::string_view key : keys) {
+        const contact::JointKey& k = *contact::find_joint_key(key);
+        if (k.kind == contact::KeyKind::number || k.kind == contact::KeyKind::integer) read_declared_key(c, t, p, k, j);
+        else if (k.kind == contact::KeyKind::boolean) j.face_shear = boolean(c, t, p, key).value_or(false);
+        else if (key == "tension_softening") j.tension_softening = read_curve(c, t, p, key);
+        else if (key == "shear_softening") j.shear_softening = read_curve(c, t, p, key);
     }
-    j.residual_friction = number(c, t, p, "residual_friction", below(0, 90, degrees)).value_or(-1);
-    if (j.law == Law::coulomb) {
-        j.cohesion = number(c, t, p, "cohesion", at_least(0, pascals)).value_or(0.0);
-        j.tensile = number(c, t, p, "tensile", at_least(0, pascals)).value_or(0.0);
-    } else {
-        j.cohesion = peak(c, t, p, "cohesion", "shear softening");
-        j.tensile = peak(c, t, p, "tensile", "tension softening");
-        j.tension_softening = read_curve(c, t, p, "tension_softening");
-        j.shear_softening = read_curve(c, t, p, "shear_softening");
-        read_confined_friction(c, t, p, j);
+    // The rules between keys, by law (the flags keep the same ones).
+    if (const auto problem = contact::check_joint_property(j)) {
+        const toml::node* n = t.get(problem->key);
+        if (!n)
+            c.fail(t, p.key(problem->key),
+                   c.in_owner() + "missing required key " + quoted(problem->key) + ": " + problem->message);
+        c.fail(*n, p.key(problem->key), problem->message);
     }
-    read_heterogeneity(c, t, p, j);
+    check_heterogeneity_keys(c, t, p, j);
     return j;
 }
 

@@ -7,6 +7,7 @@
 // names of tables with the references between them. Only io/ includes it.
 #pragma once
 
+#include "base/bounds.hpp"
 #include "io/model_input.hpp"
 
 #include <toml++/toml.h>
@@ -240,41 +241,10 @@ inline const toml::node& need(const Ctx& c, const toml::table& t, const Path& p,
     return *n;
 }
 
-/// Allowed values of a number, and its unit (with a leading space) for messages.
-struct Range {
-    double lo = -std::numeric_limits<double>::infinity();
-    double hi = std::numeric_limits<double>::infinity();
-    bool lo_open = false, hi_open = false;
-    std::string_view unit;
-
-    bool contains(double v) const {
-        return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
-    }
-    std::string text() const {
-        if (std::isinf(hi))
-            return std::isinf(lo) ? "" : (lo_open ? "> " : ">= ") + fmt(lo) + std::string(unit);
-        return "in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) +
-               (hi_open ? ")" : "]") + std::string(unit);
-    }
-};
-inline Range unbounded(std::string_view unit) {
-    return {.unit = unit};
-}
-inline Range above(double lo, std::string_view unit) {
-    return {.lo = lo, .lo_open = true, .unit = unit};
-}
-inline Range at_least(double lo, std::string_view unit) {
-    return {.lo = lo, .unit = unit};
-}
-inline Range below(double lo, double hi, std::string_view unit) {
-    return {.lo = lo, .hi = hi, .hi_open = true, .unit = unit};
-}
-inline Range between(double lo, double hi, std::string_view unit) {
-    return {.lo = lo, .hi = hi, .unit = unit};
-}
-
-constexpr std::string_view metres = " m";
-constexpr std::string_view degrees = " degrees";
+/// Allowed values of a number and its unit (base/bounds.hpp: the flags share them).
+using Range = Bounds;
+using bbm::above, bbm::at_least, bbm::below, bbm::between, bbm::unbounded;
+using bbm::degrees, bbm::metres, bbm::pascals, bbm::pascals_per_metre;
 
 inline double checked_number(const Ctx& c, const toml::node& n, const Path& p, const Range& r) {
     const double v = to_number(c, n, p);
@@ -306,6 +276,16 @@ inline std::int64_t to_integer(const Ctx& c, const toml::node& n, const Path& p,
     if (i->get() > hi)
         c.fail(n, p,
                "must be an integer <= " + std::to_string(hi) + ", got " + std::to_string(i->get()));
+    return i->get();
+}
+
+/// A whole number within declared bounds (a key of contact/joint_keys.hpp): "must
+/// be a whole number in [1, 1000], got 0", as its flag says it.
+inline std::int64_t to_whole_number(const Ctx& c, const toml::node& n, const Path& p, const Bounds& b) {
+    const auto* i = n.as_integer();
+    if (!i) c.fail(n, p, "expected a whole number " + b.text() + ", got " + describe(n));
+    if (!b.contains(double(i->get())))
+        c.fail(n, p, "must be a whole number " + b.text() + ", got " + std::to_string(i->get()));
     return i->get();
 }
 
@@ -488,8 +468,6 @@ template <class F> void read_tables(Ctx& c, const toml::table& doc, std::string_
 
 // --- stress fields (boundaries and initialize stages) -----------------------------
 
-constexpr std::string_view pascals = " Pa";
-constexpr std::string_view pascals_per_metre = " Pa/m";
 
 constexpr std::array<std::string_view, 7> stress_keys{"sxx",     "syy",     "sxy",    "y_ref",
                                                       "dsxx_dy", "dsyy_dy", "dsxy_dy"};

@@ -7,6 +7,7 @@
 // number > 0, got nan". CLI11 prefixes the option name; main() exits with status 2.
 #pragma once
 
+#include "base/bounds.hpp"
 #include "base/error.hpp"
 
 #include <CLI/CLI.hpp>
@@ -60,6 +61,29 @@ inline CLI::Validator non_negative() {
 inline CLI::Validator in_range(double lo, double hi) {
     return detail::finite_number("in [" + detail::shortest(lo) + ", " + detail::shortest(hi) + "]",
                                  [lo, hi](double v) { return v >= lo && v <= hi; });
+}
+
+/// A finite number within the bounds a model-file key declares (base/bounds.hpp):
+/// "must be a finite number in [0, 90) degrees, got 95".
+inline CLI::Validator within(const Bounds& b) {
+    return detail::finite_number(b.text(), [b](double v) { return b.contains(v); });
+}
+
+/// A whole number within the bounds.
+inline CLI::Validator whole_within(const Bounds& b) {
+    return CLI::Validator(
+        [b](std::string& text) -> std::string {
+            std::size_t used = 0;
+            long long v = 0;
+            try {
+                v = std::stoll(text, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used == text.size() && !text.empty() && b.contains(double(v))) return {};
+            return "must be a whole number " + b.text() + ", got " + text;
+        },
+        b.text());
 }
 
 /// A whole number >= lo (for counts and seeds held in unsigned or int options:

@@ -1,6 +1,7 @@
 #include "studies/commands.hpp"
 
 #include "base/progress.hpp"
+#include "contact/joint_keys.hpp"
 #include "io/model_input.hpp"
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"
@@ -17,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -214,6 +216,45 @@ const char* const max_elements_help =
     "Largest number of blocks plus triangles the model may ask for (estimated before generating; default: what "
     "fits in half of this machine's memory)";
 
+void add_joint_flags(CLI::App* cmd, JointPropertySpec& joint, std::span<const std::string_view> keys,
+                     std::string_view prefix, std::string_view help_prefix) {
+    using contact::KeyKind;
+    for (const std::string_view key : keys) {
+        const contact::JointKey& k = *contact::find_joint_key(key);
+        if (k.kind != KeyKind::number && k.kind != KeyKind::integer)
+            throw std::logic_error("add_joint_flags: " + std::string(key) + " is not a number");
+        // The key's meaning in the flags' words: other keys named by their flags.
+        std::string meaning;
+        for (std::size_t at = 0; at < k.meaning.size();) {
+            std::size_t end = at;
+            while (end < k.meaning.size() && (std::islower(static_cast<unsigned char>(k.meaning[end])) || k.meaning[end] == '_'))
+                ++end;
+            const std::string_view word = k.meaning.substr(at, std::max(end, at + 1) - at);
+            const bool key_name = word.find('_') != std::string_view::npos && contact::find_joint_key(word);
+            meaning += key_name ? contact::joint_flag(word, prefix) : std::string(word);
+            at += word.size();
+        }
+        std::string help = std::string(help_prefix) + meaning;
+        if (!k.bounds.unit.empty()) help += " (" + std::string(k.bounds.unit.substr(1)) + ")";
+        const double now = k.get(joint);
+        const bool has_default = k.bounds.contains(now);
+        if (!has_default && !k.absent.empty()) help += "; if not given: " + std::string(k.absent);
+        std::string names = contact::joint_flag(key, prefix);
+        if (key == "weibull_modulus" && prefix.empty()) names += ",--weibull-m"; // its name before the keys were shared
+        auto set = k.set;
+        CLI::Option* opt = cmd->add_option_function<double>(names, [&joint, set](double v) { set(joint, v); }, help);
+        const bool whole = k.kind == KeyKind::integer;
+        opt->check(whole ? cli::whole_within(k.bounds) : cli::within(k.bounds));
+        opt->type_name(whole ? "INT" : "FLOAT");
+        if (has_default) opt->default_str(shortest_text(now));
+    }
+}
+
+void check_joint_flags(const JointPropertySpec& joint, std::string_view prefix) {
+    if (const auto problem = contact::check_joint_property(joint))
+        throw InputError(contact::joint_flag(problem->key, prefix), 0, "", problem->message);
+}
+
 namespace {
 
 /// The flags of the rock (its bonds, material and block pattern): given beside
@@ -229,16 +270,6 @@ constexpr RockFlag rock_flags[] = {
     BBM_ROCK_FLAG("--size-measure", size_measure),
     BBM_ROCK_FLAG("--seed", o.seed),
     BBM_ROCK_FLAG("--lloyd", o.lloyd),
-    BBM_ROCK_FLAG("--kn", o.joint.kn),
-    BBM_ROCK_FLAG("--ks", o.joint.ks),
-    BBM_ROCK_FLAG("--tensile", o.joint.tensile),
-    BBM_ROCK_FLAG("--cohesion", o.joint.cohesion),
-    BBM_ROCK_FLAG("--friction", o.joint.friction),
-    BBM_ROCK_FLAG("--residual-friction", o.joint.residual_friction),
-    BBM_ROCK_FLAG("--confined-friction", o.joint.confined_friction),
-    BBM_ROCK_FLAG("--confined-friction-from", o.joint.confined_friction_from),
-    BBM_ROCK_FLAG("--weibull-m", o.joint.weibull_modulus),
-    BBM_ROCK_FLAG("--strength-classes", o.joint.strength_classes),
     BBM_ROCK_FLAG("--tension-softening", tension_softening),
     BBM_ROCK_FLAG("--shear-softening", shear_softening),
     BBM_ROCK_FLAG("--density", o.density),
@@ -269,8 +300,16 @@ void apply_rock_file(const CLI::App& cmd, LabTestCli& c) {
             if (m.deformable_fraction > 0.0) c.o.young = m.young, c.o.poisson = m.poisson;
         }
     }
+    // The flags given beside the file (a command may lack some: bbm shear has no deformable blocks).
+    auto given_flag = [&cmd](const std::string& flag) {
+        const CLI::Option* opt = cmd.get_option_no_throw(flag);
+        return opt && opt->count() > 0;
+    };
     for (const auto& f : rock_flags)
-        if (cmd.count(f.flag) > 0) f.keep(c, given);
+        if (given_flag(f.flag)) f.keep(c, given);
+    for (const std::string_view key : labtest_joint_keys)
+        if (const auto& k = *contact::find_joint_key(key); given_flag(contact::joint_flag(key)))
+            k.set(c.o.joint, k.get(given.o.joint));
 }
 
 void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
@@ -297,26 +336,7 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--seed", o.seed, "Random seed of the block pattern")->check(cli::whole_at_least(0))->capture_default_str();
     sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations (0: cells of random points; more: more regular cells)")
         ->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--kn", o.joint.kn, "Joint normal stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--ks", o.joint.ks, "Joint shear stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--tensile", o.joint.tensile, "Joint tensile strength (Pa)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--cohesion", o.joint.cohesion, "Joint cohesion (Pa)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--friction", o.joint.friction, "Joint friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
-    sub->add_option("--residual-friction", o.joint.residual_friction, "Friction after failure (degrees; default: --friction)")
-        ->check(cli::in_range(0.0, 89.9));
-    sub->add_option("--confined-friction", o.joint.confined_friction,
-                    "Bonds whose friction steepens under high normal stress: this friction angle (degrees) above "
-                    "--confined-friction-from (docs/input.md, confined_friction)")
-        ->check(cli::in_range(0.0, 89.9));
-    sub->add_option("--confined-friction-from", o.joint.confined_friction_from,
-                    "The joint normal stress (Pa) above which --confined-friction acts")
-        ->check(cli::positive());
-    sub->add_option("--weibull-m", o.joint.weibull_modulus,
-                    "Heterogeneous bonds: tensile strength and cohesion of each joint times a Weibull factor of "
-                    "this modulus and mean 1 (small: heterogeneous; 0: every joint the same)")
-        ->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--strength-classes", o.joint.strength_classes, "Heterogeneous bonds: classes the Weibull law is discretised into")
-        ->check(cli::whole_at_least(1))->capture_default_str();
+    add_joint_flags(sub, o.joint, labtest_joint_keys, "", "The rock's bonds: ");
     sub->add_option("--tension-softening", c.tension_softening, "Tension softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
@@ -357,7 +377,7 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--platen-friction", o.platen_friction,
                     "Rigid platen blocks pressing on the faces through contacts of this friction angle (degrees), "
                     "instead of prescribed face blocks (--platens); ucs and biaxial")
-        ->check(cli::in_range(0.0, 89.9));
+        ->check(cli::within(below(0, 90, degrees)));
     sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
         ->check(cli::in_range(0.0, 1.0))->capture_default_str();
     sub->add_option("--failure-drop", o.failure_drop,
@@ -392,15 +412,8 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
         ->check(cli::in_range(0.0, 180.0));
     sub->add_option("--joint-set-spacing", o.joint_set_spacing, "Joint set: spacing along the normal (m; 0 = one joint)")
         ->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--joint-set-friction", o.joint_set_joint.friction, "Joint set: friction angle (degrees)")
-        ->check(cli::in_range(0.0, 89.9))->capture_default_str();
-    sub->add_option("--joint-set-residual-friction", o.joint_set_joint.residual_friction,
-                    "Joint set: friction after its bond fails (degrees; default --joint-set-friction)")
-        ->check(cli::in_range(0.0, 89.9));
-    sub->add_option("--joint-set-cohesion", o.joint_set_joint.cohesion, "Joint set: cohesion (Pa)")
-        ->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--joint-set-tensile", o.joint_set_joint.tensile, "Joint set: tensile strength (Pa)")
-        ->check(cli::non_negative())->capture_default_str();
+    static constexpr std::string_view joint_set_keys[] = {"friction", "residual_friction", "cohesion", "tensile"};
+    add_joint_flags(sub, o.joint_set_joint, joint_set_keys, "joint-set-", "Joint set: ");
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--threads", c.threads,
@@ -553,9 +566,7 @@ void apply_softening_flags(LabTestCli& c) {
     };
     if (!c.tension_softening.empty()) c.o.joint.tension_softening = curve(c.tension_softening, "--tension-softening");
     if (!c.shear_softening.empty()) c.o.joint.shear_softening = curve(c.shear_softening, "--shear-softening");
-    if ((c.o.joint.confined_friction >= 0.0) != (c.o.joint.confined_friction_from > 0.0))
-        throw InputError(c.o.joint.confined_friction >= 0.0 ? "--confined-friction" : "--confined-friction-from", 0, "",
-                         "--confined-friction (degrees) and --confined-friction-from (Pa) go together");
+    check_joint_flags(c.o.joint);
 }
 
 std::string fmt_number(double v) {

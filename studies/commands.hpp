@@ -17,6 +17,8 @@
 
 #include <filesystem>
 #include <functional>
+#include <span>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -53,6 +55,24 @@ LabTestOptions::Kind labtest_kind(const std::string& command);
 LabTestCli labtest_defaults(LabTestOptions::Kind kind);
 
 extern const char* const max_elements_help;
+
+/// The [[joint_property]] keys (contact/joint_keys.hpp) the lab tests' rock takes
+/// as flags: the softening bond's numbers (its curves are --tension-softening and
+/// --shear-softening as b1,a1,a2; its seed is the specimen's).
+inline constexpr std::string_view labtest_joint_keys[] = {
+    "kn", "ks", "tensile", "cohesion", "friction", "residual_friction", "confined_friction",
+    "confined_friction_from", "weibull_modulus", "strength_classes"};
+
+/// The flags of a joint's keys on a command, made from their declarations
+/// (contact/joint_keys.hpp): `--residual-friction` is the key residual_friction,
+/// bound to joint's field, checked against the key's bounds in the reader's words,
+/// its help the key's meaning after `help_prefix`. `prefix` goes after the dashes
+/// (`bbm shear`'s plane: `--joint-friction`).
+void add_joint_flags(CLI::App* command, JointPropertySpec& joint, std::span<const std::string_view> keys,
+                     std::string_view prefix = "", std::string_view help_prefix = "");
+/// The rules between a joint's keys (contact::check_joint_property), as an
+/// InputError naming the flag.
+void check_joint_flags(const JointPropertySpec& joint, std::string_view prefix = "");
 
 /// The lab-test options on a (sub)command; `quiet` gets -q/--quiet.
 void add_labtest_options(CLI::App* command, LabTestCli& values, bool& quiet);

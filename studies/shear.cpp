@@ -8,6 +8,7 @@
 #include "meshing/blocks.hpp"
 #include "studies/cli_checks.hpp"
 #include "studies/envelope.hpp"
+#include "studies/model_rock.hpp"
 #include "studies/ranks.hpp"
 
 #include <CLI/CLI.hpp>
@@ -257,9 +258,20 @@ ShearCli::ShearCli() {
     o.plane.friction = 30.0;
 }
 
+namespace {
+/// The plane's keys as flags (`--joint-friction`, ...); its stiffnesses default to the rock's.
+constexpr std::string_view plane_keys[] = {"friction", "residual_friction", "cohesion", "tensile",
+                                           "jrc",      "jcs",               "joint_length"};
+} // namespace
+
 void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
     auto& c = v.lab;
     auto& o = v.o;
+    sub->add_option("--rock", c.rock,
+                    "The rock's bonds, material and block pattern from a file, as the lab tests' --rock (what bbm "
+                    "calibrate writes); the rock's flags given beside it override it")
+        ->check(CLI::ExistingFile);
+    sub->parse_complete_callback([sub, &c] { apply_rock_file(*sub, c); });
     sub->add_option("--pattern", c.pattern, "Inner-block pattern (single: each half one rigid block; persistent joints only)")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick", "single"}))
         ->capture_default_str();
@@ -270,15 +282,7 @@ void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
     sub->add_option("--height", c.o.height, "Specimen height (m); the plane is at mid-height")->check(cli::positive())->capture_default_str();
     sub->add_option("--seed", c.o.seed, "Random seed of the block pattern")->check(cli::whole_at_least(0))->capture_default_str();
     sub->add_option("--lloyd", c.o.lloyd, "Lloyd relaxation iterations of the pattern")->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--kn", c.o.joint.kn, "Rock bonds: normal stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--ks", c.o.joint.ks, "Rock bonds: shear stiffness (Pa/m)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--tensile", c.o.joint.tensile, "Rock bonds: tensile strength (Pa)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--cohesion", c.o.joint.cohesion, "Rock bonds: cohesion (Pa)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--friction", c.o.joint.friction, "Rock bonds: friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
-    sub->add_option("--residual-friction", c.o.joint.residual_friction, "Rock bonds: friction after failure (degrees; default --friction)")
-        ->check(cli::in_range(0.0, 89.9));
-    sub->add_option("--weibull-m", c.o.joint.weibull_modulus, "Rock bonds: Weibull modulus of their strengths (0: uniform; as the lab tests)")
-        ->check(cli::non_negative())->capture_default_str();
+    add_joint_flags(sub, c.o.joint, labtest_joint_keys, "", "Rock bonds: ");
     sub->add_option("--tension-softening", c.tension_softening, "Rock bonds: tension softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--shear-softening", c.shear_softening, "Rock bonds: shear softening b1,a1,a2 (SPEC §4)")
@@ -288,19 +292,7 @@ void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
                     "weak bond), softening (a bond softening like the rock's) or barton_bandis (a rough joint: "
                     "--joint-jrc, --joint-jcs, --joint-length; --joint-friction is its residual friction)")
         ->check(CLI::IsMember({"coulomb", "softening", "barton_bandis"}))->capture_default_str();
-    sub->add_option("--joint-jrc", o.plane.jrc, "Barton-Bandis: the plane's joint roughness coefficient JRC")
-        ->check(cli::in_range(0.0, 20.0));
-    sub->add_option("--joint-jcs", o.plane.jcs, "Barton-Bandis: the plane's joint wall compressive strength JCS (Pa)")
-        ->check(cli::positive());
-    sub->add_option("--joint-length", o.plane.joint_length,
-                    "Barton-Bandis: joint length L (m) of the peak shear displacement (L/500)(JRC/L)^0.33 and the "
-                    "post-peak fall of JRC (default: none, the strength stays at its peak)")
-        ->check(cli::positive());
-    sub->add_option("--joint-friction", o.plane.friction, "The plane's friction angle (degrees)")->check(cli::in_range(0.0, 89.9))->capture_default_str();
-    sub->add_option("--joint-residual-friction", o.plane.residual_friction, "The plane's friction after its bond fails (degrees; default --joint-friction)")
-        ->check(cli::in_range(0.0, 89.9));
-    sub->add_option("--joint-cohesion", o.plane.cohesion, "The plane's cohesion (Pa)")->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--joint-tensile", o.plane.tensile, "The plane's tensile strength (Pa)")->check(cli::non_negative())->capture_default_str();
+    add_joint_flags(sub, o.plane, plane_keys, "joint-", "The plane's joint: ");
     sub->add_option("--joint-kn", v.joint_kn, "The plane's normal stiffness (Pa/m; default --kn)")->check(cli::positive());
     sub->add_option("--joint-ks", v.joint_ks, "The plane's shear stiffness (Pa/m; default --ks)")->check(cli::positive());
     sub->add_option("--persistence", o.persistence,
@@ -402,6 +394,7 @@ void check_shear_options(ShearCli& v) {
     if (barton_bandis != (o.plane.jrc > 0 || o.plane.jcs > 0 || o.plane.joint_length > 0) || (barton_bandis && !(o.plane.jcs > 0)))
         throw InputError(barton_bandis ? "--joint-jcs" : "--joint-jrc", 0, "",
                          "--joint-jrc, --joint-jcs (> 0 Pa, needed) and --joint-length go with --joint-law barton_bandis");
+    check_joint_flags(o.rock);
     o.plane.kn = v.joint_kn > 0 ? v.joint_kn : o.rock.kn;
     o.plane.ks = v.joint_ks > 0 ? v.joint_ks : o.rock.ks;
     if (o.plane.law == JointPropertySpec::Law::softening) {
@@ -410,6 +403,7 @@ void check_shear_options(ShearCli& v) {
         o.plane.tension_softening = o.rock.tension_softening;
         o.plane.shear_softening = o.rock.shear_softening;
     }
+    check_joint_flags(o.plane, "joint-");
     const bool single = o.pattern == meshing::PatternSpec::Kind::single;
     if (single && o.persistence < 1.0)
         throw InputError("--persistence", 0, "",

@@ -6,11 +6,11 @@ file(MAKE_DIRECTORY ${DIR})
 
 # "arguments (space-separated) | regular expression the message must match"
 set(cases
-  "ucs --kn nan|--kn: must be a finite number > 0, got nan"
-  "ucs --ks -1|--ks: must be a finite number > 0, got -1"
-  "ucs --tensile inf|--tensile: must be a finite number > 0, got inf"
-  "ucs --friction nan|--friction: must be a finite number in \\[0, 89.9\\], got nan"
-  "ucs --friction 95|--friction: must be a finite number in \\[0, 89.9\\], got 95"
+  "ucs --kn nan|--kn: must be a finite number > 0 Pa/m, got nan"
+  "ucs --ks -1|--ks: must be a finite number > 0 Pa/m, got -1"
+  "ucs --tensile inf|--tensile: must be a finite number >= 0 Pa, got inf"
+  "ucs --friction nan|--friction: must be a finite number in .0, 90. degrees, got nan"
+  "ucs --friction 95|--friction: must be a finite number in .0, 90. degrees, got 95"
   "ucs --strain-rate nan|--strain-rate: must be a finite number > 0"
   "ucs --density nan|--density: must be a finite number > 0"
   "ucs --size nan|--size: must be a finite number > 0, got nan"

@@ -1,0 +1,92 @@
+#include "contact/joint_keys.hpp"
+
+#include "contact/joint_law.hpp"
+
+#include <algorithm>
+#include <array>
+#include <tuple>
+#include <utility>
+
+namespace bbm::contact {
+
+namespace {
+/// Each law's keys, in the order of JointLaw's alternatives.
+constexpr auto keys_of_laws = []<std::size_t... I>(std::index_sequence<I...>) {
+    return std::array<std::span<const std::string_view>, sizeof...(I)>{
+        std::span<const std::string_view>(std::variant_alternative_t<I, JointLaw>::keys)...};
+}(std::make_index_sequence<std::variant_size_v<JointLaw>>{});
+
+/// Every key a law reads is declared.
+constexpr bool every_law_key_declared() {
+    for (const auto keys : keys_of_laws)
+        for (const std::string_view k : keys)
+            if (!find_joint_key(k)) return false;
+    return true;
+}
+static_assert(every_law_key_declared(), "a law reads a key joint_keys does not declare");
+
+std::string kind_text(const JointKey& k) {
+    switch (k.kind) {
+    case KeyKind::text: return "string";
+    case KeyKind::choice: return "word";
+    case KeyKind::boolean: return "true / false";
+    case KeyKind::curve: return "[[α, β], ...]";
+    case KeyKind::integer: return "whole number " + k.bounds.text();
+    case KeyKind::number: break;
+    }
+    return "number " + k.bounds.text();
+}
+} // namespace
+
+std::span<const std::string_view> law_keys(JointPropertySpec::Law law) {
+    return keys_of_laws[static_cast<std::size_t>(law)];
+}
+
+std::optional<KeyProblem> check_joint_property(const JointPropertySpec& j) {
+    using Law = JointPropertySpec::Law;
+    if (j.law == Law::softening) {
+        for (const auto& [key, value, curve] : {std::tuple{"cohesion", j.cohesion, "shear softening"},
+                                                std::tuple{"tensile", j.tensile, "tension softening"}})
+            if (!(value > 0))
+                return KeyProblem{key, "a softening law needs " + std::string(key) + " > 0 Pa, the peak the " + curve +
+                                           " curve is normalised by; got " + shortest_text(value)};
+        if ((j.confined_friction >= 0.0) != (j.confined_friction_from > 0.0))
+            return KeyProblem{j.confined_friction >= 0.0 ? "confined_friction" : "confined_friction_from",
+                              "confined_friction (the steeper friction angle, degrees) and confined_friction_from "
+                              "(the normal stress it starts at, Pa) go together"};
+    }
+    if ((j.law == Law::coulomb || j.law == Law::softening) && j.weibull_modulus > 0.0 &&
+        !(j.cohesion > 0 || j.tensile > 0))
+        return KeyProblem{"weibull_modulus", "heterogeneous strengths need a bond: cohesion or tensile > 0"};
+    return std::nullopt;
+}
+
+std::string joint_flag(std::string_view key, std::string_view prefix) {
+    std::string flag = "--";
+    std::string k(key);
+    std::ranges::replace(k, '_', '-');
+    if (!k.starts_with(prefix)) flag += prefix;
+    return flag + k;
+}
+
+std::string joint_keys_markdown() {
+    std::string md =
+        "# [[joint_property]] keys\n\n"
+        "Generated from contact/joint_keys.hpp and the laws' key lists by tests/test_reference.cpp "
+        "(`BBM_WRITE_REFERENCE=1` rewrites it; the test fails when it is stale). The lab tests', `bbm calibrate`'s and "
+        "`bbm shear`'s rock flags are the same keys (`friction` is `--friction`, with the same bounds), and so "
+        "are the Python module's keywords.\n\n"
+        "| key | value | if absent | laws | meaning |\n|---|---|---|---|---|\n";
+    for (const JointKey& k : joint_keys) {
+        std::string laws;
+        for (std::size_t l = 0; l < law_names.size(); ++l)
+            for (const std::string_view lk : keys_of_laws[l])
+                if (lk == k.key) laws += (laws.empty() ? "" : ", ") + std::string(law_names[l]);
+        md += "| `" + std::string(k.key) + "` | " + kind_text(k) + " | " +
+              (k.required ? std::string("required") : std::string(k.absent)) + " | " + laws + " | " +
+              std::string(k.meaning) + " |\n";
+    }
+    return md;
+}
+
+} // namespace bbm::contact
