@@ -25,17 +25,6 @@ constexpr bool every_law_key_declared() {
 }
 static_assert(every_law_key_declared(), "a law reads a key joint_keys does not declare");
 
-std::string kind_text(const JointKey& k) {
-    switch (k.kind) {
-    case KeyKind::text: return "string";
-    case KeyKind::choice: return "word";
-    case KeyKind::boolean: return "true / false";
-    case KeyKind::curve: return "[[α, β], ...]";
-    case KeyKind::integer: return "whole number " + k.bounds.text();
-    case KeyKind::number: break;
-    }
-    return "number " + k.bounds.text();
-}
 } // namespace
 
 std::span<const std::string_view> law_keys(JointPropertySpec::Law law) {
@@ -61,14 +50,6 @@ std::optional<KeyProblem> check_joint_property(const JointPropertySpec& j) {
     return std::nullopt;
 }
 
-std::string joint_flag(std::string_view key, std::string_view prefix) {
-    std::string flag = "--";
-    std::string k(key);
-    std::ranges::replace(k, '_', '-');
-    if (!k.starts_with(prefix)) flag += prefix;
-    return flag + k;
-}
-
 std::string joint_keys_markdown() {
     std::string md =
         "# [[joint_property]] keys\n\n"
@@ -82,7 +63,7 @@ std::string joint_keys_markdown() {
         for (std::size_t l = 0; l < law_names.size(); ++l)
             for (const std::string_view lk : keys_of_laws[l])
                 if (lk == k.key) laws += (laws.empty() ? "" : ", ") + std::string(law_names[l]);
-        md += "| `" + std::string(k.key) + "` | " + kind_text(k) + " | " +
+        md += "| `" + std::string(k.key) + "` | " + key_value_text(k.kind, k.bounds) + " | " +
               (k.required ? std::string("required") : std::string(k.absent)) + " | " + laws + " | " +
               std::string(k.meaning) + " |\n";
     }

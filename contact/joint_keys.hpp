@@ -5,13 +5,13 @@
 // Everything that describes a rock's joints is made from this one table: the model
 // file's reader (io/model_input.cpp checks, bounds and reads them from it), the
 // rock's flags of the lab tests, `bbm calibrate` and `bbm shear` (studies/
-// rock_flags.cpp: `--friction` is the key `friction`, with its bounds and words;
+// commands.hpp, add_key_flags: `--friction` is the key `friction`, with its bounds and words;
 // the Python keywords are the flags' names), and the key reference
 // docs/reference/joint_property.md (joint_keys_markdown(); a test fails when the
 // file is stale). A new key is one row here and its field in JointPropertySpec.
 #pragma once
 
-#include "base/bounds.hpp"
+#include "base/keys.hpp"
 #include "contact/joint_property.hpp"
 
 #include <cstdint>
@@ -22,33 +22,10 @@
 
 namespace bbm::contact {
 
-/// How a key's value is written in the model file.
-enum class KeyKind {
-    text,    ///< a string (the set's name)
-    choice,  ///< one of a list of words (the law)
-    number,  ///< a number within `bounds`
-    integer, ///< a whole number within `bounds`
-    boolean, ///< true or false
-    curve,   ///< an array of points [[alpha, beta], ...]
-};
+using JointKey = Key<JointPropertySpec>;
+using bbm::KeyKind;
 
-struct JointKey {
-    std::string_view key;
-    KeyKind kind = KeyKind::number;
-    Bounds bounds;
-    /// Required by every law that reads it (kn, ks; jrc, jcs of Barton-Bandis).
-    bool required = false;
-    std::string_view meaning;
-    /// What leaving it out means (the reference's "default" column).
-    std::string_view absent;
-    /// The field of a number or integer key.
-    double (*get)(const JointPropertySpec&) = nullptr;
-    void (*set)(JointPropertySpec&, double) = nullptr;
-};
-
-#define BBM_JOINT_FIELD(field)                                                                       \
-    .get = [](const JointPropertySpec& j) { return double(j.field); },                               \
-    .set = [](JointPropertySpec& j, double v) { j.field = static_cast<decltype(j.field)>(v); }
+#define BBM_JOINT_FIELD(field) BBM_KEY_FIELD(JointPropertySpec, field)
 
 // Each row names only the members it sets; the rest keep their defaults.
 #pragma GCC diagnostic push
@@ -108,11 +85,7 @@ inline constexpr JointKey joint_keys[] = {
 #undef BBM_JOINT_FIELD
 
 /// The declaration of a key; nullptr if there is none.
-constexpr const JointKey* find_joint_key(std::string_view key) {
-    for (const JointKey& k : joint_keys)
-        if (k.key == key) return &k;
-    return nullptr;
-}
+constexpr const JointKey* find_joint_key(std::string_view key) { return find_key(joint_keys, key); }
 
 /// The keys a law reads, in the order of JointPropertySpec::Law.
 std::span<const std::string_view> law_keys(JointPropertySpec::Law law);
@@ -126,10 +99,8 @@ struct KeyProblem {
 };
 std::optional<KeyProblem> check_joint_property(const JointPropertySpec& j);
 
-/// The flag of a key: `--` and the key with dashes (`residual_friction` is
-/// `--residual-friction`), after `prefix` (`bbm shear`'s plane: `joint-`) unless
-/// the key already starts with it.
-std::string joint_flag(std::string_view key, std::string_view prefix = "");
+/// The flag of a key (base/keys.hpp).
+inline std::string joint_flag(std::string_view key, std::string_view prefix = "") { return key_flag(key, prefix); }
 
 /// docs/reference/joint_property.md: the table of keys and which law reads each.
 std::string joint_keys_markdown();

@@ -11,6 +11,7 @@
 
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
+#include "core/material_keys.hpp"
 
 #include "core/verdict.hpp"
 
@@ -431,19 +432,36 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
     return s;
 }
 
+/// The names of a table's keys (base/keys.hpp), for check_keys.
+template <class Spec, std::size_t N>
+constexpr std::array<std::string_view, N> key_names(const Key<Spec> (&table)[N]) {
+    std::array<std::string_view, N> names;
+    for (std::size_t i = 0; i < N; ++i) names[i] = table[i].key;
+    return names;
+}
+
+/// A number or integer key as its table declares it: its bounds, required or left
+/// at the spec's default.
+template <class Spec>
+void read_declared_key(const Ctx& c, const toml::table& t, const Path& p, const Key<Spec>& k, Spec& spec) {
+    if (k.kind == KeyKind::integer) {
+        if (const toml::node* n = k.required ? &need(c, t, p, k.key, "a whole number " + k.bounds.text())
+                                             : find(c, t, p, k.key))
+            k.set(spec, double(to_whole_number(c, *n, p.key(k.key), k.bounds)));
+    } else if (k.required) {
+        k.set(spec, required_number(c, t, p, k.key, k.bounds));
+    } else if (const auto v = number(c, t, p, k.key, k.bounds)) {
+        k.set(spec, *v);
+    }
+}
+
 MaterialSpec read_material(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    static constexpr std::array<std::string_view, 5> keys{"name", "density", "young", "poisson",
-                                                          "deformable_fraction"};
+    static constexpr auto keys = key_names(material_keys);
     check_keys(c, t, p, keys);
     MaterialSpec m;
     m.name = read_name(c, t, p, names);
-    m.density = number(c, t, p, "density", above(0, " kg/m³")).value_or(m.density);
-    m.young = number(c, t, p, "young", above(0, pascals)).value_or(0.0);
-    m.poisson = number(c, t, p, "poisson", below(0, 0.5, "")).value_or(m.poisson);
-    m.deformable_fraction =
-        number(c, t, p, "deformable_fraction",
-               Range{.lo = 0, .hi = 1, .lo_open = true, .hi_open = true, .unit = ""})
-            .value_or(0.0);
+    for (const MaterialKey& k : material_keys)
+        if (k.kind == KeyKind::number) read_declared_key(c, t, p, k, m);
     // Without E there is no elasticity for them to describe.
     for (std::string_view key : {"poisson", "deformable_fraction"})
         if (m.young == 0 && t.contains(key))
@@ -514,28 +532,9 @@ void check_heterogeneity_keys(const Ctx& c, const toml::table& t, const Path& p,
         if (t.contains(key)) c.fail(*t.get(key), p.key(key), "goes with weibull_modulus > 0");
 }
 
-/// A number or integer key as contact/joint_keys.hpp declares it: its bounds,
-/// required or left at the spec's default.
-void read_declared_key(const Ctx& c, const toml::table& t, const Path& p, const contact::JointKey& k,
-                       JointPropertySpec& j) {
-    using contact::KeyKind;
-    if (k.kind == KeyKind::integer) {
-        if (const toml::node* n = k.required ? &need(c, t, p, k.key, "a whole number " + k.bounds.text())
-                                             : find(c, t, p, k.key))
-            k.set(j, double(to_whole_number(c, *n, p.key(k.key), k.bounds)));
-    } else if (k.required) {
-        k.set(j, required_number(c, t, p, k.key, k.bounds));
-    } else if (const auto v = number(c, t, p, k.key, k.bounds)) {
-        k.set(j, *v);
-    }
-}
-
 /// Every key a [[joint_property]] may have (contact/joint_keys.hpp).
-constexpr auto all_joint_keys = [] {
-    std::array<std::string_view, std::size(contact::joint_keys)> keys;
-    for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = contact::joint_keys[i].key;
-    return keys;
-}();
+constexpr auto all_joint_keys = key_names(contact::joint_keys);
+
 
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
     check_keys(c, t, p, all_joint_keys);

@@ -2,6 +2,7 @@
 
 #include "base/progress.hpp"
 #include "contact/joint_keys.hpp"
+#include "core/material_keys.hpp"
 #include "io/model_input.hpp"
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"
@@ -216,38 +217,53 @@ const char* const max_elements_help =
     "Largest number of blocks plus triangles the model may ask for (estimated before generating; default: what "
     "fits in half of this machine's memory)";
 
-void add_joint_flags(CLI::App* cmd, JointPropertySpec& joint, std::span<const std::string_view> keys,
-                     std::string_view prefix, std::string_view help_prefix) {
-    using contact::KeyKind;
+template <class Spec>
+void add_key_flags(CLI::App* cmd, Spec& spec, std::span<const Key<Spec>> table, std::span<const std::string_view> keys,
+                   std::string_view prefix, std::string_view help_prefix) {
+    auto find = [table](std::string_view key) -> const Key<Spec>* {
+        for (const Key<Spec>& k : table)
+            if (k.key == key) return &k;
+        return nullptr;
+    };
     for (const std::string_view key : keys) {
-        const contact::JointKey& k = *contact::find_joint_key(key);
-        if (k.kind != KeyKind::number && k.kind != KeyKind::integer)
-            throw std::logic_error("add_joint_flags: " + std::string(key) + " is not a number");
+        const Key<Spec>* k = find(key);
+        if (!k || (k->kind != KeyKind::number && k->kind != KeyKind::integer))
+            throw std::logic_error("add_key_flags: " + std::string(key) + " is not a declared number");
         // The key's meaning in the flags' words: other keys named by their flags.
         std::string meaning;
-        for (std::size_t at = 0; at < k.meaning.size();) {
+        for (std::size_t at = 0; at < k->meaning.size();) {
             std::size_t end = at;
-            while (end < k.meaning.size() && (std::islower(static_cast<unsigned char>(k.meaning[end])) || k.meaning[end] == '_'))
+            while (end < k->meaning.size() &&
+                   (std::islower(static_cast<unsigned char>(k->meaning[end])) || k->meaning[end] == '_'))
                 ++end;
-            const std::string_view word = k.meaning.substr(at, std::max(end, at + 1) - at);
-            const bool key_name = word.find('_') != std::string_view::npos && contact::find_joint_key(word);
-            meaning += key_name ? contact::joint_flag(word, prefix) : std::string(word);
+            const std::string_view word = k->meaning.substr(at, std::max(end, at + 1) - at);
+            const bool key_name = word.find('_') != std::string_view::npos && find(word);
+            meaning += key_name ? key_flag(word, prefix) : std::string(word);
             at += word.size();
         }
         std::string help = std::string(help_prefix) + meaning;
-        if (!k.bounds.unit.empty()) help += " (" + std::string(k.bounds.unit.substr(1)) + ")";
-        const double now = k.get(joint);
-        const bool has_default = k.bounds.contains(now);
-        if (!has_default && !k.absent.empty()) help += "; if not given: " + std::string(k.absent);
-        std::string names = contact::joint_flag(key, prefix);
+        if (!k->bounds.unit.empty()) help += " (" + std::string(k->bounds.unit.substr(1)) + ")";
+        const double now = k->get(spec);
+        const bool has_default = k->bounds.contains(now);
+        if (!has_default && !k->absent.empty()) help += "; if not given: " + std::string(k->absent);
+        std::string names = key_flag(key, prefix);
         if (key == "weibull_modulus" && prefix.empty()) names += ",--weibull-m"; // its name before the keys were shared
-        auto set = k.set;
-        CLI::Option* opt = cmd->add_option_function<double>(names, [&joint, set](double v) { set(joint, v); }, help);
-        const bool whole = k.kind == KeyKind::integer;
-        opt->check(whole ? cli::whole_within(k.bounds) : cli::within(k.bounds));
+        auto set = k->set;
+        CLI::Option* opt = cmd->add_option_function<double>(names, [&spec, set](double v) { set(spec, v); }, help);
+        const bool whole = k->kind == KeyKind::integer;
+        opt->check(whole ? cli::whole_within(k->bounds) : cli::within(k->bounds));
         opt->type_name(whole ? "INT" : "FLOAT");
         if (has_default) opt->default_str(shortest_text(now));
     }
+}
+template void add_key_flags(CLI::App*, JointPropertySpec&, std::span<const Key<JointPropertySpec>>,
+                            std::span<const std::string_view>, std::string_view, std::string_view);
+template void add_key_flags(CLI::App*, MaterialSpec&, std::span<const Key<MaterialSpec>>,
+                            std::span<const std::string_view>, std::string_view, std::string_view);
+
+void add_joint_flags(CLI::App* cmd, JointPropertySpec& joint, std::span<const std::string_view> keys,
+                     std::string_view prefix, std::string_view help_prefix) {
+    add_key_flags(cmd, joint, std::span<const contact::JointKey>(contact::joint_keys), keys, prefix, help_prefix);
 }
 
 void check_joint_flags(const JointPropertySpec& joint, std::string_view prefix) {
@@ -272,10 +288,6 @@ constexpr RockFlag rock_flags[] = {
     BBM_ROCK_FLAG("--lloyd", o.lloyd),
     BBM_ROCK_FLAG("--tension-softening", tension_softening),
     BBM_ROCK_FLAG("--shear-softening", shear_softening),
-    BBM_ROCK_FLAG("--density", o.density),
-    BBM_ROCK_FLAG("--deformable-fraction", o.deformable_fraction),
-    BBM_ROCK_FLAG("--young", o.young),
-    BBM_ROCK_FLAG("--poisson", o.poisson),
     BBM_ROCK_FLAG("--mesh-size", o.mesh_size),
 };
 #undef BBM_ROCK_FLAG
@@ -295,9 +307,9 @@ void apply_rock_file(const CLI::App& cmd, LabTestCli& c) {
         c.shear_softening.clear();
         if (rock.material) {
             const MaterialSpec& m = *rock.material;
-            c.o.density = m.density;
-            c.o.deformable_fraction = m.deformable_fraction;
-            if (m.deformable_fraction > 0.0) c.o.young = m.young, c.o.poisson = m.poisson;
+            c.o.material.density = m.density;
+            c.o.material.deformable_fraction = m.deformable_fraction;
+            if (m.deformable_fraction > 0.0) c.o.material.young = m.young, c.o.material.poisson = m.poisson;
         }
     }
     // The flags given beside the file (a command may lack some: bbm shear has no deformable blocks).
@@ -307,9 +319,12 @@ void apply_rock_file(const CLI::App& cmd, LabTestCli& c) {
     };
     for (const auto& f : rock_flags)
         if (given_flag(f.flag)) f.keep(c, given);
-    for (const std::string_view key : labtest_joint_keys)
-        if (const auto& k = *contact::find_joint_key(key); given_flag(contact::joint_flag(key)))
-            k.set(c.o.joint, k.get(given.o.joint));
+    auto keep_given = [&given_flag]<class Spec>(std::span<const Key<Spec>> table, auto& keys, Spec& to, const Spec& from) {
+        for (const Key<Spec>& k : table)
+            if (std::ranges::find(keys, k.key) != std::ranges::end(keys) && given_flag(key_flag(k.key))) k.set(to, k.get(from));
+    };
+    keep_given(std::span<const contact::JointKey>(contact::joint_keys), labtest_joint_keys, c.o.joint, given.o.joint);
+    keep_given(std::span<const MaterialKey>(material_keys), labtest_material_keys, c.o.material, given.o.material);
 }
 
 void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
@@ -341,15 +356,8 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
         ->delimiter(',')->expected(3)->capture_default_str();
     sub->add_option("--shear-softening", c.shear_softening, "Shear softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
-    sub->add_option("--density", o.density, "Block density (kg/m³)")->check(cli::positive())->capture_default_str();
-    sub->add_option("--deformable-fraction", o.deformable_fraction,
-                    "Deformable blocks (meshed into triangles) taking this fraction f of the deformation: blocks "
-                    "get --young / f, joints --kn, --ks / (1 - f) (SPEC §6); 0 = rigid blocks")
-        ->check(cli::in_range(0.0, 0.99));
-    sub->add_option("--young", o.young, "With --deformable-fraction: target modulus E of the rock mass (Pa)")
-        ->check(cli::positive())->capture_default_str();
-    sub->add_option("--poisson", o.poisson, "With --deformable-fraction: Poisson's ratio of the blocks")
-        ->check(cli::in_range(0.0, 0.49))->capture_default_str();
+    add_key_flags(sub, o.material, std::span<const MaterialKey>(material_keys), labtest_material_keys, "",
+                  "The rock's blocks: ");
     sub->add_option("--mesh-size", o.mesh_size, "With --deformable-fraction: triangle size (m; default size / 2)")
         ->check(cli::non_negative());
     sub->add_option("--strain-rate", o.strain_per_step,
@@ -662,7 +670,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
     // contact loop. Side by side in one process a 4 x 8 m f = 0.95 specimen gave,
     // rarely (2 runs of about 40), another answer than alone — a thread-safety
     // fault around meshing not found yet (docs/calibration.md, After the peak).
-    const bool one_at_a_time = o.deformable_fraction > 0.0;
+    const bool one_at_a_time = o.material.deformable_fraction > 0.0;
     const int threads = one_at_a_time ? 1 : std::max(1, std::min(n, available));
     const int threads_for_loop = available;
     const int shown_threads = n > 1 && !one_at_a_time ? threads : threads_for_loop;

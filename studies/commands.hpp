@@ -12,6 +12,7 @@
 // Bad options throw InputError naming the flag.
 #pragma once
 
+#include "base/keys.hpp"
 #include "studies/calibrate.hpp"
 #include "studies/labtest.hpp"
 
@@ -62,6 +63,18 @@ extern const char* const max_elements_help;
 inline constexpr std::string_view labtest_joint_keys[] = {
     "kn", "ks", "tensile", "cohesion", "friction", "residual_friction", "confined_friction",
     "confined_friction_from", "weibull_modulus", "strength_classes"};
+
+/// The [[material]] keys (core/material_keys.hpp) the lab tests take as flags.
+inline constexpr std::string_view labtest_material_keys[] = {"density", "deformable_fraction", "young", "poisson"};
+
+/// The flags of a spec's keys on a command, made from their declarations in
+/// `table` (base/keys.hpp): `--<key>` with dashes after `prefix`, bound to spec's
+/// field, checked against the key's bounds in the reader's words, its help the
+/// key's meaning (other keys named by their flags) after `help_prefix`.
+template <class Spec>
+void add_key_flags(CLI::App* command, Spec& spec, std::span<const Key<Spec>> table,
+                   std::span<const std::string_view> keys, std::string_view prefix = "",
+                   std::string_view help_prefix = "");
 
 /// The flags of a joint's keys on a command, made from their declarations
 /// (contact/joint_keys.hpp): `--residual-friction` is the key residual_friction,

@@ -492,7 +492,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     const int n = c.realizations;
     const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
-    const bool one_at_a_time = c.o.deformable_fraction > 0.0;
+    const bool one_at_a_time = c.o.material.deformable_fraction > 0.0;
     std::vector<EnvelopeRun> runs;
     EnvelopeRunner run_jobs{c, compression, tension, tension_kind, available, one_at_a_time, quiet, runs};
     if (!quiet)
@@ -528,7 +528,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                                 ? t_stats["mean"].get<double>() / ucs_stats["mean"].get<double>() : 0.0;
     nlohmann::json summary{
         {"specimen", {{"pattern", c.pattern}, {"size", c.o.size}, {"width", c.o.width}, {"height", c.o.height},
-                      {"deformable_fraction", c.o.deformable_fraction}, {"weibull_modulus", c.o.joint.weibull_modulus},
+                      {"deformable_fraction", c.o.material.deformable_fraction}, {"weibull_modulus", c.o.joint.weibull_modulus},
                       {"seed", c.o.seed}, {"realizations", n}}},
         {"ucs", ucs_stats},
         {"tension", {{"test", brazilian ? "brazilian" : "direct"}, {"strength", t_stats}, {"over_ucs", t_over_c}}},

@@ -77,7 +77,7 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
     r.pattern.size_measure = o.size_measure;
     r.pattern.lloyd_iterations = o.lloyd;
     r.pattern.seed = o.seed;
-    if (o.deformable_fraction > 0.0) {
+    if (o.material.deformable_fraction > 0.0) {
         r.mesh.enabled = true;
         r.mesh.size = o.mesh_size > 0.0 ? o.mesh_size : 0.5 * o.size;
     }
@@ -102,11 +102,11 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     AnalysisSpec an;
     MaterialSpec rock;
     rock.name = "rock";
-    rock.density = o.density;
-    if (o.deformable_fraction > 0.0) {
-        rock.young = o.young;
-        rock.poisson = o.poisson;
-        rock.deformable_fraction = o.deformable_fraction;
+    rock.density = o.material.density;
+    if (o.material.deformable_fraction > 0.0) {
+        rock.young = o.material.young;
+        rock.poisson = o.material.poisson;
+        rock.deformable_fraction = o.material.deformable_fraction;
     }
     an.materials.push_back(rock);
     an.joint_properties.push_back(o.joint);
@@ -137,7 +137,7 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     // broken joints: unbonded, with the bond's stiffness and residual friction
     // (not the solver's built-in 30°); with deformable blocks, as stiff as the
     // bonds after the split (SPEC §6).
-    const double joint_share = o.deformable_fraction > 0.0 ? 1.0 - o.deformable_fraction : 1.0;
+    const double joint_share = o.material.deformable_fraction > 0.0 ? 1.0 - o.material.deformable_fraction : 1.0;
     JointPropertySpec unbonded;
     unbonded.name = "unbonded";
     unbonded.law = JointPropertySpec::Law::coulomb;

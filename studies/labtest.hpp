@@ -70,7 +70,12 @@ struct LabTestOptions {
     int lloyd = 0;
     std::uint64_t seed = 1;
     JointPropertySpec joint;            ///< the bond (law softening by default: paper values)
-    double density = 2700.0;
+    /// The blocks' material, as a [[material]] gives it (core/material_keys.hpp):
+    /// density; with 0 < deformable_fraction < 1 every block is meshed (triangles of
+    /// mesh_size, default size / 2) and takes the fraction f of the deformation:
+    /// blocks get young / f (young: the target modulus E of the rock mass), joints kn
+    /// / (1 − f) and ks / (1 − f); 0 = rigid blocks.
+    MaterialSpec material{.name = "rock", .density = 2700.0, .young = 20.0e9, .poisson = 0.2, .deformable_fraction = 0.0};
     double confinement = 0.0;           ///< biaxial: lateral stress, Pa (positive = compression)
     /// Platen velocity over height, per step: the loading rate without the servo,
     /// the unit of its rates with it.
@@ -139,13 +144,7 @@ struct LabTestOptions {
     long frame_every = 4000;            ///< steps between frames of the failure series (0: none)
     int threads = 1;                    ///< threads of the contact loop
     double max_elements = 0;            ///< limit on blocks + triangles (0: half the machine's memory)
-    /// Deformable blocks (SPEC §6): with 0 < f < 1 every block is meshed (triangles
-    /// of mesh_size, default size / 2) and takes the fraction f of the deformation:
-    /// blocks get young / f, joints kn / (1 − f) and ks / (1 − f). 0 = rigid blocks.
-    double deformable_fraction = 0.0;
-    double young = 20.0e9;              ///< target modulus E of the rock mass, Pa
-    double poisson = 0.2;               ///< Poisson's ratio of the blocks
-    double mesh_size = 0.0;
+    double mesh_size = 0.0;             ///< deformable blocks' triangles, m (0: size / 2)
     /// A persistent joint set across a rectangular specimen (Jaeger's single
     /// plane of weakness when one joint): traces at joint_set_angle degrees from
     /// horizontal, joint_set_spacing apart along their normal, one through the

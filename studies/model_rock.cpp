@@ -101,16 +101,16 @@ LabTestCli labtest_of_model(const io::ModelFile& model, const std::string& file,
             for (const auto& m : an.materials)
                 if (m.name == material_name) material = &m;
     if (!material && an.region_material.empty() && !an.materials.empty()) material = &an.materials.front();
-    if (material) c.o.density = material->density;
-    c.o.deformable_fraction = 0.0;
+    if (material) c.o.material.density = material->density;
+    c.o.material.deformable_fraction = 0.0;
     if (rock->mesh.enabled) {
         if (!material || !(material->deformable_fraction > 0.0))
             throw InputError(file, src.line_of(r, "material"), "region[" + std::to_string(r) + "].material",
                              "meshed blocks without a deformable_fraction: a lab specimen's deformable blocks take "
                              "a fraction f of the deformation (give the material deformable_fraction)");
-        c.o.deformable_fraction = material->deformable_fraction;
-        c.o.young = material->young;
-        c.o.poisson = material->poisson;
+        c.o.material.deformable_fraction = material->deformable_fraction;
+        c.o.material.young = material->young;
+        c.o.material.poisson = material->poisson;
         c.o.mesh_size = rock->mesh.size;
     }
     return c;

@@ -2,6 +2,7 @@
 
 #include "base/error.hpp"
 #include "base/progress.hpp"
+#include "core/material_keys.hpp"
 #include "core/solver.hpp"
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"
@@ -310,7 +311,8 @@ void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--servo-gain", o.servo_gain, "Normal-force servo: fraction of the force error corrected per step")
         ->check(cli::in_range(1e-4, 1.0))->capture_default_str();
-    sub->add_option("--density", c.o.density, "Block density (kg/m³)")->check(cli::positive())->capture_default_str();
+    static constexpr std::string_view density[] = {"density"};
+    add_key_flags(sub, c.o.material, std::span<const MaterialKey>(material_keys), density, "", "The rock's blocks: ");
     sub->add_option("--frame-every", o.frame_every, "Steps between frames in result.pvd (0: the final state only)")
         ->check(cli::non_negative())->capture_default_str();
     sub->add_option("--realizations", c.realizations, "Random realizations per normal stress (seeds seed, seed+1, ...)")
@@ -387,7 +389,7 @@ void check_shear_options(ShearCli& v) {
     const auto& lo = v.lab.o;
     o.pattern = lo.pattern, o.size_measure = lo.size_measure, o.size = lo.size;
     o.width = lo.width, o.height = lo.height, o.lloyd = lo.lloyd, o.seed = lo.seed;
-    o.rock = lo.joint, o.density = lo.density, o.max_elements = lo.max_elements;
+    o.rock = lo.joint, o.density = lo.material.density, o.max_elements = lo.max_elements;
     o.plane.law = static_cast<JointPropertySpec::Law>(std::ranges::find(contact::law_names, v.joint_law) -
                                                       contact::law_names.begin());
     const bool barton_bandis = o.plane.law == JointPropertySpec::Law::barton_bandis;

@@ -197,7 +197,7 @@ inline void check_lab_tests_on(std::initializer_list<int> threads) {
         {"ucs", small(Kind::ucs)},     {"tension", small(Kind::tension)},
         {"biaxial", small(Kind::biaxial)}, {"brazilian", small(Kind::brazilian)}};
     auto deformable = small(Kind::ucs);
-    deformable.deformable_fraction = 0.5;
+    deformable.material.deformable_fraction = 0.5;
     tests.push_back({"ucs, deformable blocks f = 0.5", deformable});
     auto trigon = small(Kind::ucs);
     trigon.pattern = meshing::PatternSpec::Kind::trigon;

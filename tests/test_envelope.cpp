@@ -156,7 +156,7 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
     CHECK(rigid.pattern == "voronoi");
     CHECK(rigid.o.size == 0.3);
     CHECK(rigid.o.seed == 7);
-    CHECK(rigid.o.deformable_fraction == 0.0);
+    CHECK(rigid.o.material.deformable_fraction == 0.0);
     CHECK(rigid.o.joint.kn == 96.6e9);
     CHECK(rigid.o.joint.ks == 40.3e9);
     CHECK(rigid.o.joint.tensile == 3.0e6);
@@ -168,9 +168,9 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
 
     const auto f095 =
         labtest_of_model(io::read_model(dir + "compare_rigid_deformable/deformable_f095.toml"), "deformable_f095.toml");
-    CHECK(f095.o.deformable_fraction == 0.95);
-    CHECK(f095.o.young == 22.4e9);
-    CHECK(f095.o.poisson == 0.2);
+    CHECK(f095.o.material.deformable_fraction == 0.95);
+    CHECK(f095.o.material.young == 22.4e9);
+    CHECK(f095.o.material.poisson == 0.2);
     CHECK(f095.o.mesh_size == 0.15);
     CHECK(f095.o.joint.kn == 96.6e9); // the split (kn / (1 - f)) is the lab test's, as the model's
 

@@ -1305,10 +1305,10 @@ TEST_CASE("mesh and elasticity mistakes") {
                 "material[0].poisson", "must be in [0, 0.5), got -0.1");
     check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\ndeformable_fraction = 1.2\n"),
                 "deformable_fraction", "material[0].deformable_fraction",
-                "must be in (0, 1), got 1.2");
-    check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\ndeformable_fraction = 0\n"),
+                "must be in [0, 1), got 1.2");
+    check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\ndeformable_fraction = 1\n"),
                 "deformable_fraction", "material[0].deformable_fraction",
-                "must be in (0, 1), got 0");
+                "must be in [0, 1), got 1");
     check_error(with("[[material]]\nname = \"rock\"\nyoung = 0\n"), "young", "material[0].young",
                 "must be > 0 Pa, got 0");
     check_error(with("[[material]]\nname = \"rock\"\npoisson = 0.3\n"), "poisson",

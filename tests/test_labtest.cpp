@@ -236,7 +236,7 @@ TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, 
     // realizations one at a time: docs/calibration.md.)
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0;
-    o.deformable_fraction = 0.95;
+    o.material.deformable_fraction = 0.95;
     o.max_strain = 2e-4;
     o.strain_cap = 0.0; // the preload and a few steps are what this compares
     o.threads = 1;

@@ -153,7 +153,7 @@ TEST_CASE("residual strength, Lac du Bonnet's in-situ set: broken joints at 10 d
     // degrees (Byerlee 1978); asserted within 3 degrees.
     LabTestOptions o;
     o.kind = LabTestOptions::Kind::biaxial;
-    o.size = 0.12, o.width = 2.4, o.height = 4.8, o.density = 2650, o.seed = 1001;
+    o.size = 0.12, o.width = 2.4, o.height = 4.8, o.material.density = 2650, o.seed = 1001;
     o.joint.kn = 954.511e9, o.joint.ks = 257.441e9;
     o.joint.tensile = 15.1313e6, o.joint.cohesion = 41.843e6;
     o.joint.friction = 5, o.joint.residual_friction = 10;
@@ -182,7 +182,7 @@ TEST_CASE("confined friction, Lac du Bonnet: sigma_ci unconfined and the laborat
     // Coulomb envelope: 2c sqrt(N) + N sigma3 = 129 MPa).
     CalibrationOptions o;
     o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
-    o.base.density = 2650;
+    o.base.material.density = 2650;
     auto& j = o.base.joint;
     j.kn = 957593745133.4312, j.ks = 266384954237.1118;
     j.tensile = 15296822.579253344, j.cohesion = 39651374.19228245;
@@ -215,7 +215,7 @@ TEST_CASE("calibrate, Lac du Bonnet on crack initiation: E, nu, sigma_ci and ten
     // 5%, tension within 10%.
     CalibrationOptions o;
     o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
-    o.base.density = 2650;
+    o.base.material.density = 2650;
     o.base.joint.kn = 992e9, o.base.joint.ks = 339e9;
     o.base.joint.tensile = 17.2e6, o.base.joint.cohesion = 36e6;
     o.base.joint.friction = 5, o.base.joint.residual_friction = 35;
@@ -241,7 +241,7 @@ namespace {
 /// at a time, two threads each, as `bbm ucs --realizations` runs them (studies/commands.cpp).
 std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
     std::vector<LabTestResult> r(3);
-    if (base.deformable_fraction > 0.0) {
+    if (base.material.deformable_fraction > 0.0) {
         for (int k = 0; k < 3; ++k) {
             auto o = base;
             o.seed = std::uint64_t(k + 1);
@@ -281,7 +281,7 @@ void check_softens(const std::vector<LabTestResult>& r, const char* what) {
 LabTestOptions small(double deformable_fraction) {
     auto o = LabTestOptions::paper_ucs();
     o.width = 4.0, o.height = 8.0;
-    o.deformable_fraction = deformable_fraction;
+    o.material.deformable_fraction = deformable_fraction;
     return o;
 }
 

@@ -7,6 +7,7 @@
 #include "base/error.hpp"
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
+#include "core/material_keys.hpp"
 #include "io/model_input.hpp"
 #include "studies/commands.hpp"
 #include "studies/shear.hpp"
@@ -25,9 +26,11 @@ using namespace bbm;
 
 namespace {
 
-const std::filesystem::path reference = std::filesystem::path(BBM_SOURCE_DIR) / "docs/reference/joint_property.md";
+const std::filesystem::path reference_dir = std::filesystem::path(BBM_SOURCE_DIR) / "docs/reference";
 
 const std::string softening_bond = "name = \"b\"\nlaw = \"softening\"\nkn = 1e10\nks = 1e10\ntensile = 1e6\ncohesion = 2e6\n";
+
+const std::string softening_rock = "[[joint_property]]\n" + softening_bond;
 
 /// The softening bond with `key = value` in place of its own value of the key.
 std::string bond_with(std::string_view key, const std::string& value) {
@@ -67,17 +70,24 @@ double outside(const Bounds& b) {
 
 } // namespace
 
-TEST_CASE("docs/reference/joint_property.md is the table the code reads the keys by") {
-    const std::string generated = contact::joint_keys_markdown();
-    if (std::getenv("BBM_WRITE_REFERENCE")) std::ofstream(reference) << generated;
-    std::ifstream in(reference);
-    const std::string missing = reference.string() + " is missing: run this test with BBM_WRITE_REFERENCE=1";
+/// A generated reference file is the one in docs/reference (BBM_WRITE_REFERENCE=1 rewrites it).
+void check_reference(const std::string& name, const std::string& generated) {
+    const auto file = reference_dir / name;
+    if (std::getenv("BBM_WRITE_REFERENCE")) std::ofstream(file) << generated;
+    std::ifstream in(file);
+    const std::string missing = file.string() + " is missing: run this test with BBM_WRITE_REFERENCE=1";
     REQUIRE_MESSAGE(in.good(), missing);
     std::stringstream text;
     text << in.rdbuf();
-    const std::string stale = reference.string() + " is stale: run this test with BBM_WRITE_REFERENCE=1 and commit it";
+    const std::string stale = file.string() + " is stale: run this test with BBM_WRITE_REFERENCE=1 and commit it";
     CHECK_MESSAGE(text.str() == generated, stale);
-    for (const auto& k : contact::joint_keys) CHECK(generated.find("| `" + std::string(k.key) + "` |") != std::string::npos);
+}
+
+TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
+    const std::string joints = contact::joint_keys_markdown();
+    check_reference("joint_property.md", joints);
+    for (const auto& k : contact::joint_keys) CHECK(joints.find("| `" + std::string(k.key) + "` |") != std::string::npos);
+    check_reference("material.md", material_keys_markdown());
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {
@@ -94,6 +104,26 @@ TEST_CASE("A key and its flag refuse the same values in the same words") {
         CHECK(in_file.find("joint_property[0]." + std::string(key)) != std::string::npos);
         CHECK(in_file.find(k.bounds.text()) != std::string::npos);
         CHECK(as_flag.find(contact::joint_flag(key)) != std::string::npos);
+        CHECK(as_flag.find(k.bounds.text()) != std::string::npos);
+    }
+    for (const std::string_view key : studies::labtest_material_keys) {
+        const MaterialKey& k = *find_key(material_keys, key);
+        const std::string value = shortest_text(outside(k.bounds));
+        INFO(key, " = ", value);
+        const std::string in_file = [&]() -> std::string {
+            try {
+                (void)io::parse_rock(softening_rock + "[[material]]\nname = \"m\"\n" +
+                                         (key == "young" ? "" : "young = 1e10\n") + std::string(key) + " = " + value + "\n",
+                                     "rock.toml");
+            } catch (const InputError& e) {
+                return e.what();
+            }
+            return "";
+        }();
+        const std::string as_flag = flag_error({key_flag(key), value});
+        CHECK(in_file.find("material[0]." + std::string(key)) != std::string::npos);
+        CHECK(in_file.find(k.bounds.text()) != std::string::npos);
+        CHECK(as_flag.find(key_flag(key)) != std::string::npos);
         CHECK(as_flag.find(k.bounds.text()) != std::string::npos);
     }
     // The friction bound that had drifted: [0, 90) in both.
