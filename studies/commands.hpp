@@ -14,7 +14,11 @@
 
 #include "base/keys.hpp"
 #include "studies/calibrate.hpp"
+#include "studies/envelope.hpp"
 #include "studies/labtest.hpp"
+#include "studies/labtest_values.hpp"
+#include "studies/model_rock.hpp"
+#include "studies/shear.hpp"
 
 #include <filesystem>
 #include <functional>
@@ -28,32 +32,6 @@ class App;
 }
 
 namespace bbm::studies {
-
-/// Command-line values of the lab tests, defaults = the paper's calibration run.
-struct LabTestCli {
-    LabTestOptions o = LabTestOptions::paper_ucs();
-    std::string pattern = "voronoi";
-    std::vector<double> tension_softening{0.5, 1.7, 4.0}, shear_softening{0.5, 1.3, 2.1};
-    std::string platens = "rough";
-    std::string size_measure = "feret";
-    /// --rock: a rock file or a model file whose rock the test takes (flags given
-    /// beside it override its values; apply_rock_file).
-    std::string rock;
-    int realizations = 1;
-    int threads = 0;
-    std::string out = "out";
-    /// false: nothing is written (the Python module without `out`).
-    bool write_files = true;
-    /// Called with the state every --frame-every steps of loading (and the last
-    /// recorded point), from the thread running that realization (0, 1, ...).
-    std::function<void(const Solver&, const StressStrainPoint&, int realization)> on_frame;
-};
-
-/// The lab-test command names: "ucs", "tension", "biaxial", "brazilian".
-LabTestOptions::Kind labtest_kind(const std::string& command);
-
-/// A lab-test command's defaults (tension and brazilian load slower, the disc is 4 m).
-LabTestCli labtest_defaults(LabTestOptions::Kind kind);
 
 extern const char* const max_elements_help;
 
@@ -87,6 +65,17 @@ void add_joint_flags(CLI::App* command, JointPropertySpec& joint, std::span<cons
 /// InputError naming the flag.
 void check_joint_flags(const JointPropertySpec& joint, std::string_view prefix = "");
 
+/// The envelope options (lab-test options, confinements, fit) on a (sub)command.
+void add_envelope_options(CLI::App* command, EnvelopeOptions& options, bool& quiet);
+/// `bbm shear`'s options on a (sub)command.
+void add_shear_options(CLI::App* command, ShearCli& values, bool& quiet);
+
+/// --rock FILE on a lab-test command (add_labtest_options): the rock file's bonds
+/// and material (io::RockFile), or a model file's rock (labtest_of_model), then
+/// the rock's flags given on `cmd` beside it over them. Throws InputError naming
+/// the file, line and key.
+void apply_rock_file(const CLI::App& cmd, LabTestCli& c);
+
 /// The lab-test options on a (sub)command; `quiet` gets -q/--quiet.
 void add_labtest_options(CLI::App* command, LabTestCli& values, bool& quiet);
 
@@ -106,17 +95,6 @@ int run_labtest_command(LabTestCli& values, LabTestOptions::Kind kind, bool quie
 /// `on_frame`: as LabTestCli::on_frame (with --frame-every).
 LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,
                               const std::function<void(const Solver&, const StressStrainPoint&, int)>& on_frame = {});
-
-/// For the studies built on lab tests (calibrate, envelope): the flags' values
-/// applied to c.o for a test of this kind (pattern, softening curves, platens),
-/// and the specimen checked before anything is generated. Throws InputError
-/// naming the flag.
-void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind);
-/// --pattern, --size-measure and the softening flags applied to c.o (checked).
-void apply_specimen_flags(LabTestCli& c);
-/// A result as it travels between ranks (JSON text; doubles round-trip exactly), and back.
-std::string labtest_record_text(const LabTestResult& r);
-LabTestResult labtest_from_record_text(const std::string& text);
 
 /// `bbm calibrate`'s values.
 struct CalibrateCli {

@@ -1,5 +1,6 @@
 #include "studies/envelope.hpp"
 
+#include "studies/commands.hpp"
 #include "base/error.hpp"
 #include "io/picture.hpp"
 #include "io/vtk_output.hpp"

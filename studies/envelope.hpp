@@ -17,7 +17,7 @@
 // laboratory triaxial test has σ2 = σ3. docs/calibration.md says what that changes.
 #pragma once
 
-#include "studies/commands.hpp"
+#include "studies/labtest_values.hpp"
 
 #include <string>
 #include <vector>
@@ -87,8 +87,6 @@ int run_envelope(EnvelopeOptions& options, bool quiet, bool check_only, Envelope
 /// The same from option strings as the program takes them after `envelope`.
 EnvelopeStudy run_envelope_args(const std::vector<std::string>& args, bool quiet);
 
-/// The `bbm envelope` options (the lab-test flags and the envelope's own) on a command.
-void add_envelope_options(CLI::App* command, EnvelopeOptions& options, bool& quiet);
 
 /// Reads a σ3, σ1 record (MPa, CSV; a first line that is not numbers is a header).
 /// Returns pairs in Pa. Throws InputError naming the file and line.

@@ -14,7 +14,7 @@
 #pragma once
 
 #include "io/model_input.hpp"
-#include "studies/commands.hpp"
+#include "studies/labtest_values.hpp"
 
 #include <filesystem>
 #include <string>
@@ -28,12 +28,6 @@ namespace bbm::studies {
 /// and for meshed blocks the deformable fraction, modulus, Poisson's ratio and
 /// triangle size. Specimen size, loading and the rest keep `base`'s values.
 LabTestCli labtest_of_model(const io::ModelFile& model, const std::string& file, LabTestCli base = {});
-
-/// --rock FILE on a lab-test command (add_labtest_options): the rock file's bonds
-/// and material (io::RockFile), or a model file's rock (labtest_of_model), then
-/// the rock's flags given on `cmd` beside it over them. Throws InputError naming
-/// the file, line and key.
-void apply_rock_file(const CLI::App& cmd, LabTestCli& c);
 
 /// `bbm compare --envelope`: the strength envelope of each compared model's rock.
 struct CompareEnvelopeOptions {

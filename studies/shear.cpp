@@ -1,5 +1,6 @@
 #include "studies/shear.hpp"
 
+#include "studies/commands.hpp"
 #include "base/error.hpp"
 #include "base/progress.hpp"
 #include "core/material_keys.hpp"

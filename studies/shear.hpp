@@ -28,7 +28,7 @@
 // Coulomb line τ = c + σn tan φ is fitted to the peaks and to the residuals.
 #pragma once
 
-#include "studies/commands.hpp"
+#include "studies/labtest_values.hpp"
 
 #include <array>
 #include <functional>
@@ -113,7 +113,6 @@ struct ShearStudy {
     std::string summary_json;
 };
 
-void add_shear_options(CLI::App* command, ShearCli& values, bool& quiet);
 /// Runs the series (normal stresses × realizations spread over threads and
 /// ranks), writes summary.json, shear.csv, shear_stress.png, dilation.png and
 /// per run failure.png and VTK in --out. Returns 0. Throws InputError naming a flag.
