@@ -255,17 +255,21 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
     }
 }
 
-DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
-    const BlockView& b = in.blocks;
-    const double tol = in.tolerance;
-    const int nb = in.block_count;
-    auto is_active = [&](int k) { return (!in.active || in.active[k]) && !(in.removed && in.removed[k]); };
+namespace {
+/// A block that takes part in this pass: active (moving) and not removed.
+inline bool is_active(const DetectionInput& in, int k) {
+    return (!in.active || in.active[k]) && !(in.removed && in.removed[k]);
+}
+} // namespace
+
+/// Every thread: the pass's active blocks and cleared scratch (one thread writes).
+void Detector::start_pass(const Contacts& c, const DetectionInput& in) {
 #pragma omp single
     {
         drop_.resize(c.size(), 0);
         active_blocks_.clear();
-        for (int k = 0; k < nb; ++k)
-            if (is_active(k)) active_blocks_.push_back(k);
+        for (int k = 0; k < in.block_count; ++k)
+            if (is_active(in, k)) active_blocks_.push_back(k);
         team_.resize(std::max(1, omp_get_num_threads()));
         for (auto& t : team_) {
             t.candidates.clear();
@@ -274,19 +278,22 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
         stale_ = !grid_valid_;
         left_box_ = false;
     }
-    ThreadScratch& mine = team_[omp_get_thread_num()];
-    const int na = int(active_blocks_.size());
+}
 
-    // 1–2. Transfer along the edge block's boundary, and removal of separated
-    // unbonded contacts: the contacts of active blocks, each once (from its
-    // vertex block if that is active).
+/// 1–2. Transfer along the edge block's boundary, and removal of separated
+/// unbonded contacts: the contacts of active blocks, each once (from its vertex
+/// block if that is active).
+void Detector::transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadScratch& mine) {
+    const BlockView& b = in.blocks;
+    const double tol = in.tolerance;
+    const int na = int(active_blocks_.size());
 #pragma omp for schedule(static)
     for (int a = 0; a < na; ++a) {
         const int k = active_blocks_[a];
         for (int e = c.block_first[k]; e < c.block_first[k + 1]; ++e) {
             const int i = c.block_entry[e] >> 1;
             const int A = c.vertex_block[i], B = c.edge_block[i];
-            if (k == B && is_active(A)) continue;
+            if (k == B && is_active(in, A)) continue;
             if (c.history[i].bonded) continue; // intact joints keep their edges (contacts.hpp)
             const Vec2 x = b.vertex[c.vertex_id[i]];
             EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
@@ -312,19 +319,22 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
             }
         }
     }
+}
 
-    // 3. Broad phase from the active pieces; the grid is rebuilt first if one of
-    // them has left its stored box (with a quarter tolerance to spare: a block is
-    // checked again before it has moved that far).
-    // (stale_ is read by every thread here and not written before the single
-    // below: a thread's piece that left its box raises left_box_ instead.)
+/// 3a. The grid is rebuilt if it is invalid or one of the active pieces has left
+/// its stored box (with a quarter tolerance to spare: a block is checked again
+/// before it has moved that far). stale_ is read by every thread here and not
+/// written before the single below: a thread's piece that left its box raises
+/// left_box_ instead.
+void Detector::refresh_grid(const DetectionInput& in) {
+    const int na = int(active_blocks_.size());
     if (!stale_) {
         bool left = false;
 #pragma omp for schedule(static) nowait
         for (int a = 0; a < na; ++a) {
             const int k = active_blocks_[a];
             for (int p = block_piece_[k]; p < block_piece_[k + 1] && !left; ++p) {
-                const Box2 box = current_box(pieces_[p], b, 1.25 * tol);
+                const Box2 box = current_box(pieces_[p], in.blocks, 1.25 * in.tolerance);
                 const Box2& s = stored_[p];
                 left = box.lo.x < s.lo.x || box.lo.y < s.lo.y || box.hi.x > s.hi.x || box.hi.y > s.hi.y;
             }
@@ -337,6 +347,14 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
     }
 #pragma omp single
     if (stale_ || left_box_) build_grid(in);
+}
+
+/// 3b. Broad phase from the active pieces: the pieces near each in the grid,
+/// their vertex-edge candidates (narrow phase, add_candidates) into the thread's list.
+void Detector::broad_phase(const DetectionInput& in, ThreadScratch& mine) {
+    const BlockView& b = in.blocks;
+    const double tol = in.tolerance;
+    const int na = int(active_blocks_.size());
 #pragma omp for schedule(static)
     for (int a = 0; a < na; ++a) {
         const int k = active_blocks_[a];
@@ -355,7 +373,7 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
                         const int q = cell_piece_[e];
                         const int other = pieces_[q].block;
                         // A pair of active pieces is handled from its lower piece.
-                        if (other != k && !(is_active(other) && q < p)) near.push_back(q);
+                        if (other != k && !(is_active(in, other) && q < p)) near.push_back(q);
                     }
                 }
             std::sort(near.begin(), near.end());
@@ -375,7 +393,14 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
             }
         }
     }
+}
 
+/// 4. One thread: the threads' candidates gathered in block order, accepted pair
+/// by pair in the order they came, and the dropped contacts removed; the result
+/// for every thread (the single's barrier).
+void Detector::accept_candidates(Contacts& c, const DetectionInput& in) {
+    const BlockView& b = in.blocks;
+    const double tol = in.tolerance;
 #pragma omp single
     {
         DetectionResult res;
@@ -388,8 +413,6 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
             res.removed_tensile += t.dropped_tensile;
             res.removed_shear += t.dropped_shear;
         }
-
-        // 4. Acceptance, pair by pair in the order the candidates came.
         order_.resize(candidates_.size());
         std::iota(order_.begin(), order_.end(), 0);
         // By pair, then in the order they came (a total order: std::sort gives the same
@@ -415,14 +438,22 @@ DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
             drop_.push_back(0);
             ++res.created;
         }
-
         if (res.removed > 0) {
             c.remove_if_flagged(drop_);
             drop_.resize(c.size());
             std::fill(drop_.begin(), drop_.end(), 0);
         }
         result_ = res;
-    } // omp single (its barrier: every thread reads the result)
+    }
+}
+
+DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
+    start_pass(c, in);
+    ThreadScratch& mine = team_[omp_get_thread_num()];
+    transfer_and_drop(c, in, mine);
+    refresh_grid(in);
+    broad_phase(in, mine);
+    accept_candidates(c, in);
     return result_;
 }
 

@@ -130,6 +130,14 @@ private:
                         std::vector<Candidate>& out) const;
     bool known(const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) const;
 
+    // The stages of update(), each called by every thread of the team.
+    struct ThreadScratch;
+    void start_pass(const Contacts& c, const DetectionInput& in);
+    void transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadScratch& mine);
+    void refresh_grid(const DetectionInput& in);
+    void broad_phase(const DetectionInput& in, ThreadScratch& mine);
+    void accept_candidates(Contacts& c, const DetectionInput& in);
+
     // Broad phase. Pieces enter the grid with their box at the build inflated by
     // the tolerance and a margin; while every piece stays inside its stored box
     // (checked for the active ones, which are the ones that moved), the grid

@@ -201,52 +201,64 @@ void draw_blocks(const meshing::BlockAssembly& a, const std::filesystem::path& f
     canvas.finish();
 }
 
-void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o) {
+namespace {
+
+/// The picture's frame: the model as it was built (blocks thrown far off would
+/// shrink the rest), unless a window is given.
+Box2 failure_frame(const Solver& s, const FailurePlotOptions& o) {
     const auto& b = s.blocks();
-    // Frame the model as it was built (blocks thrown far off would shrink the rest).
     Box2 box = o.window;
-    if (box.empty()) {
+    if (!box.empty()) return box;
+    for (int i = 0; i < b.count(); ++i)
+        for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.centroid0[i] + b.local[v]);
+    const double m = 0.03 * std::max(box.width(), box.height());
+    box.lo -= Vec2{m, m};
+    box.hi += Vec2{m, m};
+    return box;
+}
+
+/// The displacement a picture shades by: of rigid blocks (centroid) and of zones
+/// (mean of their nodes). The scale ends at the 99.5th percentile: one fragment
+/// fallen far must not wash out the displacement field of the rest.
+struct DisplacementShade {
+    const Solver& s;
+    double top = 0.0, largest = 0.0;
+    explicit DisplacementShade(const Solver& solver) : s(solver) {
+        const auto& b = s.blocks();
+        const auto& z = s.zones();
+        std::vector<double> us;
         for (int i = 0; i < b.count(); ++i)
-            for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.centroid0[i] + b.local[v]);
-        const double m = 0.03 * std::max(box.width(), box.height());
-        box.lo -= Vec2{m, m};
-        box.hi += Vec2{m, m};
+            if (!b.removed[i] && !b.deformable[i]) us.push_back(norm(b.centroid[i] - b.centroid0[i]));
+        for (int k = 0; k < z.size(); ++k)
+            if (!b.removed[z.block[k]]) us.push_back(zone(k));
+        std::sort(us.begin(), us.end());
+        largest = us.empty() ? 0.0 : us.back();
+        top = us.empty() ? 0.0 : us[std::size_t(0.995 * double(us.size() - 1))];
     }
-    const double legend = 40.0;
-    const View view(box, o.width_px, legend);
-    Canvas canvas(file, view.w, view.h);
-    cairo_t* cr = canvas.cr;
-    // Displacement of rigid blocks (centroid) and of zones (mean of their nodes).
+    double zone(int k) const {
+        const auto& nodes = s.nodes();
+        Vec2 u{};
+        for (int nd : s.zones().node[k]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0;
+        return norm(u);
+    }
+    /// Light grey for still material to ochre for the most displaced.
+    void set(cairo_t* cr, double u) const {
+        const double f = top > 0 ? std::sqrt(std::min(1.0, u / top)) : 0.0;
+        cairo_set_source_rgb(cr, 0.92 - 0.05 * f, 0.92 - 0.25 * f, 0.92 - 0.6 * f);
+    }
+};
+
+/// Zones and blocks shaded by their displacement; deformable blocks outlined.
+void draw_material(cairo_t* cr, const Solver& s, const DisplacementShade& shade, double px) {
+    const auto& b = s.blocks();
     const auto& nodes = s.nodes();
     const auto& z = s.zones();
-    auto zone_displacement = [&](int k) {
-        Vec2 u{};
-        for (int nd : z.node[k]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0;
-        return norm(u);
-    };
-    // The colour scale ends at the 99.5th percentile: one fragment fallen far must
-    // not wash out the displacement field of the rest.
-    std::vector<double> us;
-    for (int i = 0; i < b.count(); ++i)
-        if (!b.removed[i] && !b.deformable[i]) us.push_back(norm(b.centroid[i] - b.centroid0[i]));
-    for (int k = 0; k < z.size(); ++k)
-        if (!b.removed[z.block[k]]) us.push_back(zone_displacement(k));
-    std::sort(us.begin(), us.end());
-    const double umax_all = us.empty() ? 0.0 : us.back();
-    const double umax = us.empty() ? 0.0 : us[std::size_t(0.995 * double(us.size() - 1))];
-    view.apply(cr, box, legend);
-    const double px = 1.0 / view.scale;
-    // Light grey for still material to ochre for the most displaced.
-    auto shade = [&](double u) {
-        const double f = umax > 0 ? std::sqrt(std::min(1.0, u / umax)) : 0.0;
-        cairo_set_source_rgb(cr, 0.92 - 0.05 * f, 0.92 - 0.25 * f, 0.92 - 0.6 * f);
-    };
     for (int k = 0; k < z.size(); ++k) {
         if (b.removed[z.block[k]]) continue;
         const auto& t = z.node[k];
         const Vec2 corners[3] = {nodes.position[t[0]], nodes.position[t[1]], nodes.position[t[2]]};
         polygon_path(cr, corners);
-        shade(zone_displacement(k));
+        shade.set(cr, shade.zone(k));
         cairo_fill_preserve(cr);
         cairo_set_source_rgba(cr, 0.7, 0.7, 0.7, 0.5);
         cairo_set_line_width(cr, 0.25 * px);
@@ -261,12 +273,17 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
             cairo_stroke(cr);
             continue;
         }
-        shade(norm(b.centroid[i] - b.centroid0[i]));
+        shade.set(cr, norm(b.centroid[i] - b.centroid0[i]));
         cairo_fill_preserve(cr);
         cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 0.7);
         cairo_set_line_width(cr, 0.4 * px);
         cairo_stroke(cr);
     }
+}
+
+/// Each broken contact as a short line along its joint: red tensile, blue shear.
+void draw_cracks(cairo_t* cr, const Solver& s, double px) {
+    const auto& b = s.blocks();
     const auto& c = s.contacts();
     cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
     for (int i = 0; i < c.size(); ++i) {
@@ -283,10 +300,13 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
         cairo_line_to(cr, y.x, y.y);
         cairo_stroke(cr);
     }
-    // Supports (core/support.hpp), each line cell shaded by its headline force
-    // against the largest now. Bars (bolts, dowels): green (none) to purple,
-    // yielded segments thicker, broken ones dashed black. Linings: a thick line
-    // along the wall, darker blue the higher its thrust.
+}
+
+/// Supports (core/support.hpp), each line cell shaded by its headline force
+/// against the largest now. Bars (bolts, dowels): green (none) to purple, yielded
+/// segments thicker, broken ones dashed black. Linings: a thick line along the
+/// wall, darker blue the higher its thrust. Returns their legend.
+std::string draw_supports(cairo_t* cr, const Solver& s, double px) {
     std::string support_legend;
     for (const auto& support : s.supports()) {
         if (support->tie_count() == 0) continue;
@@ -321,17 +341,38 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
             cairo_set_dash(cr, nullptr, 0, 0.0);
         }
     }
-    if (!o.outline.empty()) {
-        cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-        cairo_set_line_width(cr, 2.0 * px);
-        const double dash[2] = {8.0 * px, 5.0 * px};
-        cairo_set_dash(cr, dash, 2, 0.0);
-        cairo_move_to(cr, o.outline.front().x, o.outline.front().y);
-        for (const Vec2& p : o.outline) cairo_line_to(cr, p.x, p.y);
-        cairo_close_path(cr);
-        cairo_stroke(cr);
-        cairo_set_dash(cr, nullptr, 0, 0.0);
-    }
+    return support_legend;
+}
+
+/// The failed zone's outline, dashed.
+void draw_outline(cairo_t* cr, const std::vector<Vec2>& outline, double px) {
+    if (outline.empty()) return;
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    cairo_set_line_width(cr, 2.0 * px);
+    const double dash[2] = {8.0 * px, 5.0 * px};
+    cairo_set_dash(cr, dash, 2, 0.0);
+    cairo_move_to(cr, outline.front().x, outline.front().y);
+    for (const Vec2& p : outline) cairo_line_to(cr, p.x, p.y);
+    cairo_close_path(cr);
+    cairo_stroke(cr);
+    cairo_set_dash(cr, nullptr, 0, 0.0);
+}
+
+} // namespace
+
+void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o) {
+    const Box2 box = failure_frame(s, o);
+    const double legend = 40.0;
+    const View view(box, o.width_px, legend);
+    Canvas canvas(file, view.w, view.h);
+    cairo_t* cr = canvas.cr;
+    const DisplacementShade shade(s);
+    view.apply(cr, box, legend);
+    const double px = 1.0 / view.scale;
+    draw_material(cr, s, shade, px);
+    draw_cracks(cr, s, px);
+    const std::string support_legend = draw_supports(cr, s, px);
+    draw_outline(cr, o.outline, px);
     cairo_restore(cr);
     // Legend.
     const double y0 = view.h - 0.5 * legend + 5;
@@ -346,7 +387,7 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
     std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s%s",
-                  s.cracks(contact::JointState::broken_shear), 1e3 * umax, 1e3 * umax_all,
+                  s.cracks(contact::JointState::broken_shear), 1e3 * shade.top, 1e3 * shade.largest,
                   o.outline.empty() ? "" : "   dashed: failed zone", support_legend.c_str(), o.title.empty() ? "" : "   ",
                   o.title.c_str());
     text(cr, 292, y0, buf);

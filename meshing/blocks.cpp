@@ -564,72 +564,81 @@ detail::FaceFill cut_face(const detail::RegionCut& cut, int k, const PatternSpec
 }
 } // namespace
 
-BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats) {
-    using clock = std::chrono::steady_clock;
-    const auto t0 = clock::now();
+namespace {
+
+/// The index of the region named `name` other than r, or -1.
+int other_region(const ModelGeometrySpec& spec, int r, const std::string& name) {
+    const auto it = std::find_if(spec.regions.begin(), spec.regions.end(),
+                                 [&](const RegionSpec& o) { return o.name == name; });
+    return it == spec.regions.end() || it - spec.regions.begin() == r ? -1 : int(it - spec.regions.begin());
+}
+
+/// A region's outline with its holes, checked: simple, with area, holes inside.
+Domain outline_domain(const ModelGeometrySpec& spec, int r) {
+    const RegionSpec& reg = spec.regions[r];
+    const auto outer = outline_polygon(reg.outline, spec.max_segment);
+    if (outer.size() >= 3 && !cgal::is_simple(outer))
+        throw GeometryError(r, "outline", "outline of region '" + reg.name + "' intersects itself");
+    if (outer.size() < 3 || std::abs(signed_area(outer)) <= 0)
+        throw GeometryError(r, "outline", "outline of region '" + reg.name + "' has no area");
+    std::vector<std::vector<Vec2>> holes;
+    const Domain outer_domain = cgal::make_domain(outer, {});
+    for (int h = 0; h < int(reg.holes.size()); ++h) {
+        const std::string key = "holes[" + std::to_string(h) + "]";
+        auto hole = outline_polygon(reg.holes[h], spec.max_segment);
+        if (hole.size() < 3 || !cgal::is_simple(hole))
+            throw GeometryError(r, key, "hole " + std::to_string(h) + " of region '" + reg.name +
+                                            "' is not a simple polygon");
+        const double outside = cgal::area(cgal::difference(cgal::make_domain(hole, {}), outer_domain));
+        if (outside > 1e-9 * std::abs(signed_area(hole)))
+            throw GeometryError(r, key, "hole " + std::to_string(h) + " of region '" + reg.name +
+                                            "' lies outside its outline by " + fmt(outside) + " m²");
+        holes.push_back(std::move(hole));
+    }
+    return cgal::make_domain(outer, holes);
+}
+
+/// The mesh of a deformable region: sizes and the regions it is refined toward.
+void check_region_mesh(const ModelGeometrySpec& spec, int r) {
+    const RegionSpec& reg = spec.regions[r];
+    const MeshSpec& mesh = reg.mesh;
+    if (!mesh.enabled) return;
+    if (!(mesh.size > 0))
+        throw GeometryError(r, "mesh.size",
+                            "the mesh size of region '" + reg.name + "' must be > 0 m, got " + fmt(mesh.size));
+    if (mesh.size_far != 0 && !(mesh.size_far >= mesh.size))
+        throw GeometryError(r, "mesh.size_far",
+                            "the far mesh size of region '" + reg.name + "' must be >= its size " + fmt(mesh.size) +
+                                " m, got " + fmt(mesh.size_far));
+    if (!(mesh.grading >= 0))
+        throw GeometryError(r, "mesh.grading",
+                            "the mesh grading of region '" + reg.name + "' must be >= 0, got " + fmt(mesh.grading));
+    for (const auto& name : mesh.toward)
+        if (other_region(spec, r, name) < 0)
+            throw GeometryError(r, "mesh.toward",
+                                "the mesh of region '" + reg.name + "' is refined toward '" + name +
+                                    "', which is not another region");
+}
+
+/// Step 1: each region's domain (its outline and holes less the regions it
+/// subtracts), with the checks a user needs to hear about; no two overlap.
+std::vector<Domain> region_domains(const ModelGeometrySpec& spec) {
     const int nr = int(spec.regions.size());
     std::vector<Domain> base(nr), domain(nr);
-
-    // 1. Region domains, with the checks a user needs to hear about.
-    for (int r = 0; r < nr; ++r) {
-        const RegionSpec& reg = spec.regions[r];
-        const auto outer = outline_polygon(reg.outline, spec.max_segment);
-        if (outer.size() >= 3 && !cgal::is_simple(outer))
-            throw GeometryError(r, "outline", "outline of region '" + reg.name + "' intersects itself");
-        if (outer.size() < 3 || std::abs(signed_area(outer)) <= 0)
-            throw GeometryError(r, "outline", "outline of region '" + reg.name + "' has no area");
-        std::vector<std::vector<Vec2>> holes;
-        const Domain outer_domain = cgal::make_domain(outer, {});
-        for (int h = 0; h < int(reg.holes.size()); ++h) {
-            const std::string key = "holes[" + std::to_string(h) + "]";
-            auto hole = outline_polygon(reg.holes[h], spec.max_segment);
-            if (hole.size() < 3 || !cgal::is_simple(hole))
-                throw GeometryError(r, key, "hole " + std::to_string(h) + " of region '" + reg.name +
-                                                "' is not a simple polygon");
-            const double outside = cgal::area(cgal::difference(cgal::make_domain(hole, {}), outer_domain));
-            if (outside > 1e-9 * std::abs(signed_area(hole)))
-                throw GeometryError(r, key, "hole " + std::to_string(h) + " of region '" + reg.name +
-                                                "' lies outside its outline by " + fmt(outside) + " m²");
-            holes.push_back(std::move(hole));
-        }
-        base[r] = cgal::make_domain(outer, holes);
-    }
+    for (int r = 0; r < nr; ++r) base[r] = outline_domain(spec, r);
     for (int r = 0; r < nr; ++r) {
         const RegionSpec& reg = spec.regions[r];
         domain[r] = base[r];
         for (const auto& name : reg.minus) {
-            const auto it = std::find_if(spec.regions.begin(), spec.regions.end(),
-                                         [&](const RegionSpec& o) { return o.name == name; });
-            if (it == spec.regions.end() || it - spec.regions.begin() == r)
+            const int other = other_region(spec, r, name);
+            if (other < 0)
                 throw GeometryError(r, "minus", "region '" + reg.name + "' subtracts '" + name +
                                                     "', which is not another region");
-            domain[r] = cgal::difference(domain[r], base[it - spec.regions.begin()]);
+            domain[r] = cgal::difference(domain[r], base[other]);
         }
         if (cgal::area(domain[r]) <= 1e-12 * cgal::area(base[r]))
             throw GeometryError(r, "minus", "nothing is left of region '" + reg.name + "' after subtraction");
-        const MeshSpec& mesh = reg.mesh;
-        if (!mesh.enabled) continue;
-        if (!(mesh.size > 0))
-            throw GeometryError(r, "mesh.size",
-                                "the mesh size of region '" + reg.name + "' must be > 0 m, got " +
-                                    fmt(mesh.size));
-        if (mesh.size_far != 0 && !(mesh.size_far >= mesh.size))
-            throw GeometryError(r, "mesh.size_far",
-                                "the far mesh size of region '" + reg.name +
-                                    "' must be >= its size " + fmt(mesh.size) + " m, got " +
-                                    fmt(mesh.size_far));
-        if (!(mesh.grading >= 0))
-            throw GeometryError(r, "mesh.grading",
-                                "the mesh grading of region '" + reg.name + "' must be >= 0, got " +
-                                    fmt(mesh.grading));
-        for (const auto& name : mesh.toward) {
-            const auto it = std::find_if(spec.regions.begin(), spec.regions.end(),
-                                         [&](const RegionSpec& o) { return o.name == name; });
-            if (it == spec.regions.end() || it - spec.regions.begin() == r)
-                throw GeometryError(r, "mesh.toward",
-                                    "the mesh of region '" + reg.name + "' is refined toward '" +
-                                        name + "', which is not another region");
-        }
+        check_region_mesh(spec, r);
     }
     for (int r = 0; r < nr; ++r)
         for (int q = 0; q < r; ++q) {
@@ -640,6 +649,125 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
                                         spec.regions[q].name + "' by " + fmt(overlap) +
                                         " m² (subtract one from the other with `minus`)");
         }
+    return domain;
+}
+
+/// A region's real joints: its segments, its joint sets' traces and its DFN's
+/// fractures (recorded in the assembly's fracture sets, traces and statistics).
+struct RegionJoints {
+    std::vector<SegmentSpec> segments;
+    FractureNetwork network;
+    bool any() const { return !segments.empty() || !network.fractures.empty(); }
+};
+
+RegionJoints region_joints(const RegionSpec& reg, int r, const Domain& domain, BlockAssembly& a) {
+    Box2 box;
+    for (const auto& p : domain)
+        for (Vec2 q : p.outer) box.add(q);
+    RegionJoints j;
+    j.segments = reg.joints;
+    for (const auto& js : reg.joint_sets) {
+        const auto traces = joint_set_traces(js, box);
+        j.segments.insert(j.segments.end(), traces.begin(), traces.end());
+    }
+    if (reg.dfn.empty()) return j;
+    try {
+        j.network = generate_fracture_network(reg.dfn, domain);
+    } catch (const std::invalid_argument& e) {
+        throw GeometryError(r, "dfn", e.what());
+    }
+    const int set_base = int(a.fracture_sets.size());
+    for (const auto& s : reg.dfn) a.fracture_sets.push_back({s.name, s.property, r});
+    for (std::size_t i = 0; i < j.network.traces.size(); ++i) {
+        a.fracture_traces.push_back(j.network.traces[i]);
+        a.fracture_trace_set.push_back(set_base + j.network.trace_set[i]);
+    }
+    a.fracture_stats.insert(a.fracture_stats.end(), j.network.stats.begin(), j.network.stats.end());
+    return j;
+}
+
+/// Steps 2-4 for one region: its rock blocks cut by the real joints, each filled
+/// with the inner pattern.
+RegionBlocks fill_region(const RegionSpec& reg, const Domain& domain, const RegionJoints& joints, double tol,
+                         BlockAssembly& a, GenerationStats& st) {
+    detail::Random rng(reg.pattern.seed);
+    const PatternSpec pattern = detail::generator_pattern(reg.pattern);
+    RegionBlocks rb;
+    auto add = [&](detail::FaceFill& fill) {
+        st.collapsed_edges += fill.collapsed_edges;
+        const int offset = rb.parent.empty() ? 0 : *std::max_element(rb.parent.begin(), rb.parent.end()) + 1;
+        for (std::size_t k = 0; k < fill.polygons.size(); ++k) {
+            rb.polygons.push_back(std::move(fill.polygons[k]));
+            rb.parent.push_back(offset + fill.parent[k]);
+        }
+    };
+    if (!joints.any()) {
+        for (const auto& face : domain) {
+            auto fill = detail::fill_face(face, pattern, rng);
+            add(fill);
+        }
+        remove_spikes(rb, tol);
+        return rb;
+    }
+    // Blocks under 1e-6 of a block's area (size²; a millimetre across in 0.5 m
+    // blocks, cut off where a pattern's edge passes near a trace's crossing or
+    // tip) run away in the first steps: merged across a pattern's edge, which
+    // loses no trace. A rock block bounded by traces alone is merged at 1e-8
+    // (where three traces cross nearly at one point), losing micrometres of trace.
+    const double size2 = reg.pattern.size * reg.pattern.size;
+    const detail::RegionCut cut(domain, cut_traces(joints.segments, joints.network), 1e-6 * size2, 1e-8 * size2, tol);
+    const auto real = cut.real_segments();
+    a.real_segments.insert(a.real_segments.end(), real.begin(), real.end());
+    detail::CutStats cs;
+    for (int k = 0; k < cut.face_count(); ++k) {
+        auto fill = cut_face(cut, k, pattern, rng, cs);
+        add(fill);
+    }
+    // A sliver the exact cut kept (thinner than the rounding, with no cell
+    // edge to merge across) can round to a polygon of no area: no block.
+    std::vector<char> flat(rb.polygons.size(), 0);
+    for (std::size_t k = 0; k < rb.polygons.size(); ++k)
+        flat[k] = rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol;
+    cs.slivers_left += int(std::count(flat.begin(), flat.end(), char(1)));
+    drop_blocks(rb, flat);
+    st.merged_slivers += cut.merged_faces() + cs.merged_slivers;
+    st.merged_trace_length += cut.merged_trace_length();
+    st.slivers_left += cs.slivers_left;
+    st.rock_bridges += cs.rock_bridges;
+    st.hole_cuts += cs.hole_cuts;
+    return rb;
+}
+
+/// The checks of a region's blocks once added: an exact cut tiles the region (else
+/// a bug of bbm, never of the input); edges shorter than the pattern's minimum
+/// are counted.
+void check_region_blocks(const BlockAssembly& a, const RegionSpec& reg, int first_block, const Domain& domain,
+                         bool cut_by_joints, GenerationStats& st) {
+    if (cut_by_joints) {
+        double covered = 0.0;
+        for (int b = first_block; b < a.block_count(); ++b) covered += a.area[b];
+        const double want = cgal::area(domain);
+        if (!(std::abs(covered - want) <= 1e-9 * want))
+            throw std::logic_error("bbm's cutting of region '" + reg.name + "' left " + fmt(covered) + " m² of " +
+                                   fmt(want) + " m² covered (a bug)");
+    }
+    if (reg.pattern.kind == PatternSpec::Kind::single) return;
+    const PatternSpec pattern = detail::generator_pattern(reg.pattern);
+    const double min_edge = pattern.min_edge >= 0 ? pattern.min_edge : 0.1 * pattern.size;
+    for (int b = first_block; b < a.block_count(); ++b) {
+        const auto poly = a.block(b);
+        for (std::size_t i = 0; i < poly.size(); ++i)
+            if (norm(poly[(i + 1) % poly.size()] - poly[i]) < min_edge * (1.0 - 1e-12)) ++st.short_edges_left;
+    }
+}
+
+} // namespace
+
+BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* stats) {
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    // 1. Region domains.
+    const std::vector<Domain> domain = region_domains(spec);
     const std::vector<SizeEstimate> estimate = check_model_size(spec, domain);
     const auto t1 = clock::now();
 
@@ -651,103 +779,18 @@ BlockAssembly generate_blocks(const ModelGeometrySpec& spec, GenerationStats* st
         for (const auto& p : d)
             for (Vec2 q : p.outer) all.add(q);
     const double tol = 1e-9 * std::max(all.width(), all.height());
-    for (int r = 0; r < nr; ++r) {
+    for (int r = 0; r < int(spec.regions.size()); ++r) {
         const RegionSpec& reg = spec.regions[r];
         a.region_names.push_back(reg.name);
         a.region_size.push_back(reg.pattern.size);
-        Box2 box;
-        for (const auto& p : domain[r])
-            for (Vec2 q : p.outer) box.add(q);
-        std::vector<SegmentSpec> segments = reg.joints;
-        for (const auto& js : reg.joint_sets) {
-            const auto traces = joint_set_traces(js, box);
-            segments.insert(segments.end(), traces.begin(), traces.end());
-        }
-        FractureNetwork net;
-        if (!reg.dfn.empty()) {
-            try {
-                net = generate_fracture_network(reg.dfn, domain[r]);
-            } catch (const std::invalid_argument& e) {
-                throw GeometryError(r, "dfn", e.what());
-            }
-            const int set_base = int(a.fracture_sets.size());
-            for (const auto& s : reg.dfn) a.fracture_sets.push_back({s.name, s.property, r});
-            for (std::size_t i = 0; i < net.traces.size(); ++i) {
-                a.fracture_traces.push_back(net.traces[i]);
-                a.fracture_trace_set.push_back(set_base + net.trace_set[i]);
-            }
-            a.fracture_stats.insert(a.fracture_stats.end(), net.stats.begin(), net.stats.end());
-        }
-
-        detail::Random rng(reg.pattern.seed);
-        const PatternSpec pattern = detail::generator_pattern(reg.pattern);
-        RegionBlocks rb;
-        auto add = [&](detail::FaceFill& fill) {
-            st.collapsed_edges += fill.collapsed_edges;
-            const int offset = rb.parent.empty() ? 0 : *std::max_element(rb.parent.begin(), rb.parent.end()) + 1;
-            for (std::size_t k = 0; k < fill.polygons.size(); ++k) {
-                rb.polygons.push_back(std::move(fill.polygons[k]));
-                rb.parent.push_back(offset + fill.parent[k]);
-            }
-        };
-        const bool cut_by_traces = !segments.empty() || !net.fractures.empty();
-        if (!cut_by_traces) {
-            for (const auto& face : domain[r]) {
-                auto fill = detail::fill_face(face, pattern, rng);
-                add(fill);
-            }
-            remove_spikes(rb, tol);
-        } else {
-            // Blocks under 1e-6 of a block's area (size²; a millimetre across in 0.5 m
-            // blocks, cut off where a pattern's edge passes near a trace's crossing or
-            // tip) run away in the first steps: merged across a pattern's edge, which
-            // loses no trace. A rock block bounded by traces alone is merged at 1e-8
-            // (where three traces cross nearly at one point), losing micrometres of trace.
-            const double size2 = reg.pattern.size * reg.pattern.size;
-            const detail::RegionCut cut(domain[r], cut_traces(segments, net), 1e-6 * size2, 1e-8 * size2, tol);
-            const auto real = cut.real_segments();
-            a.real_segments.insert(a.real_segments.end(), real.begin(), real.end());
-            detail::CutStats cs;
-            for (int k = 0; k < cut.face_count(); ++k) {
-                auto fill = cut_face(cut, k, pattern, rng, cs);
-                add(fill);
-            }
-            // A sliver the exact cut kept (thinner than the rounding, with no cell
-            // edge to merge across) can round to a polygon of no area: no block.
-            std::vector<char> flat(rb.polygons.size(), 0);
-            for (std::size_t k = 0; k < rb.polygons.size(); ++k)
-                flat[k] = rb.polygons[k].size() < 3 || std::abs(signed_area(rb.polygons[k])) <= tol * tol;
-            cs.slivers_left += int(std::count(flat.begin(), flat.end(), char(1)));
-            drop_blocks(rb, flat);
-            st.merged_slivers += cut.merged_faces() + cs.merged_slivers;
-            st.merged_trace_length += cut.merged_trace_length();
-            st.slivers_left += cs.slivers_left;
-            st.rock_bridges += cs.rock_bridges;
-            st.hole_cuts += cs.hole_cuts;
-        }
+        const RegionJoints joints = region_joints(reg, r, domain[r], a);
+        RegionBlocks rb = fill_region(reg, domain[r], joints, tol, a, st);
         order_along_curve(rb);
         const int parent_base = a.block_count();
         for (std::size_t k = 0; k < rb.polygons.size(); ++k)
             a.add_block(rb.polygons[k], r, reg.pattern.kind, parent_base + rb.parent[k]);
         check_region_filled(reg, r, a.block_count() - parent_base, estimate[r], cgal::area(domain[r]));
-        if (cut_by_traces) {
-            // The cut is exact, so its blocks tile the region to the rounding of
-            // their vertices; anything else is a defect of bbm, never of the input.
-            double covered = 0.0;
-            for (int b = parent_base; b < a.block_count(); ++b) covered += a.area[b];
-            const double want = cgal::area(domain[r]);
-            if (!(std::abs(covered - want) <= 1e-9 * want))
-                throw std::logic_error("bbm's cutting of region '" + reg.name + "' left " + fmt(covered) + " m² of " +
-                                       fmt(want) + " m² covered (a bug)");
-        }
-        if (reg.pattern.kind != PatternSpec::Kind::single) {
-            const double min_edge = pattern.min_edge >= 0 ? pattern.min_edge : 0.1 * pattern.size;
-            for (int b = parent_base; b < a.block_count(); ++b) {
-                const auto poly = a.block(b);
-                for (std::size_t i = 0; i < poly.size(); ++i)
-                    if (norm(poly[(i + 1) % poly.size()] - poly[i]) < min_edge * (1.0 - 1e-12)) ++st.short_edges_left;
-            }
-        }
+        check_region_blocks(a, reg, parent_base, domain[r], joints.any(), st);
     }
     const auto t2 = clock::now();
 

@@ -70,25 +70,44 @@ std::uint64_t edge_key(int u, int v) {
 
 } // namespace
 
-int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::PolygonWithHoles& face,
-                         double min_edge) {
-    if (min_edge <= 0 || polygons.empty()) return 0;
-    // Weld: bit-identical coordinates are one vertex (the Voronoi and clipping
-    // steps guarantee shared vertices are bit-identical).
+namespace {
+
+/// Cells welded into shared vertices (bit-identical coordinates are one vertex:
+/// the Voronoi and clipping steps guarantee shared vertices are bit-identical),
+/// with how many cells use each edge.
+struct WeldedCells {
     std::unordered_map<Vec2, int, PointHash> index;
     std::vector<Vec2> pos;
-    std::vector<std::vector<int>> polys(polygons.size());
-    for (std::size_t k = 0; k < polygons.size(); ++k)
-        for (Vec2 p : polygons[k]) {
-            auto [it, fresh] = index.try_emplace(p, int(pos.size()));
-            if (fresh) pos.push_back(p);
-            polys[k].push_back(it->second);
-        }
-    // Classes: 0 free, 1 on the face outline, 2 an outline vertex (fixed).
-    std::vector<int> cls(pos.size(), 0);
+    std::vector<std::vector<int>> polys;
     std::unordered_map<std::uint64_t, int> uses;
-    for (const auto& p : polys)
-        for (std::size_t i = 0; i < p.size(); ++i) ++uses[edge_key(p[i], p[(i + 1) % p.size()])];
+
+    explicit WeldedCells(const std::vector<std::vector<Vec2>>& polygons) : polys(polygons.size()) {
+        for (std::size_t k = 0; k < polygons.size(); ++k)
+            for (Vec2 p : polygons[k]) {
+                auto [it, fresh] = index.try_emplace(p, int(pos.size()));
+                if (fresh) pos.push_back(p);
+                polys[k].push_back(it->second);
+            }
+        for (const auto& p : polys)
+            for (std::size_t i = 0; i < p.size(); ++i) ++uses[edge_key(p[i], p[(i + 1) % p.size()])];
+    }
+    /// Twice the signed area of p with vertex `moved` at `at`.
+    double area(const std::vector<int>& p, int moved, Vec2 at) const {
+        double a2 = 0.0;
+        for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++) {
+            const Vec2 a = p[j] == moved ? at : pos[p[j]], b = p[i] == moved ? at : pos[p[i]];
+            a2 += cross(a, b);
+        }
+        return 0.5 * a2;
+    }
+};
+
+/// Which vertices may move: 0 free, 1 on the face outline (slides along it), 2
+/// fixed (an outline corner, or the end of a T-junction's edge). `t_junction`
+/// gets the edges used once that are not on the outline.
+std::vector<int> vertex_classes(const WeldedCells& w, const cgal::PolygonWithHoles& face, double min_edge,
+                                std::unordered_set<std::uint64_t>& t_junction) {
+    std::vector<int> cls(w.pos.size(), 0);
     // An edge used once lies on the face's outline, or is one side of a T-junction
     // (a brick's edge with the corners of the bricks of the next course on it): the
     // ends of such an edge stay put, as moving them would open the tiling.
@@ -101,11 +120,10 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
     for (const auto& h : face.holes) add_ring(h);
     const double tol = 1e-9 * std::max(box.width(), box.height());
     const SegmentGrid outline(rings, std::max(min_edge, tol));
-    std::unordered_set<std::uint64_t> t_junction;
-    for (const auto& [key, n] : uses) {
+    for (const auto& [key, n] : w.uses) {
         if (n != 1) continue;
         const int u = int(key >> 32), v = int(key & 0xffffffffu);
-        if (outline.distance_within(0.5 * (pos[u] + pos[v]), tol) <= tol) {
+        if (outline.distance_within(0.5 * (w.pos[u] + w.pos[v]), tol) <= tol) {
             cls[u] = std::max(cls[u], 1), cls[v] = std::max(cls[v], 1);
         } else {
             t_junction.insert(key);
@@ -114,74 +132,84 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
     for (std::uint64_t key : t_junction) cls[key >> 32] = cls[key & 0xffffffffu] = 2;
     auto mark_fixed = [&](const std::vector<Vec2>& ring) {
         for (Vec2 q : ring)
-            if (auto it = index.find(q); it != index.end()) cls[it->second] = 2;
+            if (auto it = w.index.find(q); it != w.index.end()) cls[it->second] = 2;
     };
     mark_fixed(face.outer);
     for (const auto& h : face.holes) mark_fixed(h);
     // A vertex on the outline within the rounding of one of its corners (a cell's
     // edge cut the outline there: the cut ends a rounding away from the corner) is
     // that corner: sliding it along one edge of the outline would cut the corner off.
-    for (std::size_t v = 0; v < pos.size(); ++v) {
+    for (std::size_t v = 0; v < w.pos.size(); ++v) {
         if (cls[v] != 1) continue;
         Box2 b;
-        b.add(pos[v] - Vec2{tol, tol});
-        b.add(pos[v] + Vec2{tol, tol});
+        b.add(w.pos[v] - Vec2{tol, tol});
+        b.add(w.pos[v] + Vec2{tol, tol});
         outline.for_each_near(b, [&](int s) {
             const auto& [p, q] = outline.segments()[std::size_t(s)];
-            if (norm(p - pos[v]) <= tol || norm(q - pos[v]) <= tol) cls[v] = 2;
+            if (norm(p - w.pos[v]) <= tol || norm(q - w.pos[v]) <= tol) cls[v] = 2;
         });
     }
+    return cls;
+}
 
-    std::vector<std::vector<int>> incident(pos.size());
-    for (int k = 0; k < int(polys.size()); ++k)
-        for (int v : polys[k]) incident[v].push_back(k);
+/// A polygon with vertex `from` replaced by `to` (repeats dropped).
+std::vector<int> merged_polygon(const std::vector<int>& p, int from, int to) {
+    std::vector<int> r;
+    for (int v : p) {
+        const int w = (v == from) ? to : v;
+        if (r.empty() || r.back() != w) r.push_back(w);
+    }
+    while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+    return r;
+}
 
-    struct Candidate { double length; int u, v; };
-    std::vector<Candidate> cand;
-    for (const auto& [key, n] : uses) {
+struct ShortEdge {
+    double length;
+    int u, v;
+};
+
+/// The edges shorter than min_edge, shortest first (ties by their vertices).
+std::vector<ShortEdge> short_edges(const WeldedCells& w, double min_edge) {
+    std::vector<ShortEdge> cand;
+    for (const auto& [key, n] : w.uses) {
         const int u = int(key >> 32), v = int(key & 0xffffffffu);
-        const double l = norm(pos[u] - pos[v]);
+        const double l = norm(w.pos[u] - w.pos[v]);
         if (l < min_edge) cand.push_back({l, u, v});
     }
-    std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
+    std::sort(cand.begin(), cand.end(), [](const ShortEdge& a, const ShortEdge& b) {
         return a.length < b.length || (a.length == b.length && (a.u < b.u || (a.u == b.u && a.v < b.v)));
     });
+    return cand;
+}
 
-    std::vector<int> alias(pos.size());
+} // namespace
+
+int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::PolygonWithHoles& face,
+                         double min_edge) {
+    if (min_edge <= 0 || polygons.empty()) return 0;
+    WeldedCells w(polygons);
+    std::unordered_set<std::uint64_t> t_junction;
+    const std::vector<int> cls = vertex_classes(w, face, min_edge, t_junction);
+    std::vector<std::vector<int>> incident(w.pos.size());
+    for (int k = 0; k < int(w.polys.size()); ++k)
+        for (int v : w.polys[k]) incident[v].push_back(k);
+    std::vector<int> alias(w.pos.size());
     std::iota(alias.begin(), alias.end(), 0);
     auto root = [&](int v) {
         while (alias[v] != v) v = alias[v] = alias[alias[v]];
         return v;
     };
-    auto merged_polygon = [&](const std::vector<int>& p, int from, int to) {
-        std::vector<int> r;
-        for (int v : p) {
-            const int w = (v == from) ? to : v;
-            if (r.empty() || r.back() != w) r.push_back(w);
-        }
-        while (r.size() > 1 && r.front() == r.back()) r.pop_back();
-        return r;
-    };
-    auto area_of = [&](const std::vector<int>& p, int moved, Vec2 at) {
-        double a2 = 0.0;
-        for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++) {
-            const Vec2 a = p[j] == moved ? at : pos[p[j]], b = p[i] == moved ? at : pos[p[i]];
-            a2 += cross(a, b);
-        }
-        return 0.5 * a2;
-    };
-
     int collapsed = 0;
-    for (const Candidate& c : cand) {
+    for (const ShortEdge& c : short_edges(w, min_edge)) {
         int u = root(c.u), v = root(c.v);
-        if (u == v || norm(pos[u] - pos[v]) >= min_edge) continue;
+        if (u == v || norm(w.pos[u] - w.pos[v]) >= min_edge) continue;
         if (cls[u] < cls[v]) std::swap(u, v); // u keeps its place unless both are free
-        const bool on_outline = uses[edge_key(u, v)] == 1 && !t_junction.count(edge_key(u, v));
+        const bool on_outline = w.uses[edge_key(u, v)] == 1 && !t_junction.count(edge_key(u, v));
         if (cls[u] == 2 && cls[v] == 2) continue;
         if (cls[v] >= 1 && !on_outline) continue; // an outline vertex slides only along the outline
         const Vec2 target = (cls[u] == 0 && cls[v] == 0) || (cls[u] == 1 && cls[v] == 1)
-                                ? 0.5 * (pos[u] + pos[v])
-                                : pos[u];
+                                ? 0.5 * (w.pos[u] + w.pos[v])
+                                : w.pos[u];
         // Every polygon touching u or v must stay a polygon with positive area.
         bool ok = true;
         std::vector<int> touched = incident[u];
@@ -189,29 +217,29 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
         std::sort(touched.begin(), touched.end());
         touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
         for (int k : touched) {
-            const auto m = merged_polygon(polys[k], v, u);
-            if (m.size() < 3) { ok = false; break; }
-            const double before = area_of(polys[k], -1, {});
-            const double after = area_of(m, u, target);
-            if (!(after > 0.25 * before)) { ok = false; break; }
+            const auto m = merged_polygon(w.polys[k], v, u);
+            if (m.size() < 3 || !(w.area(m, u, target) > 0.25 * w.area(w.polys[k], -1, {}))) {
+                ok = false;
+                break;
+            }
         }
         if (!ok) continue;
         auto count_edges = [&](int delta) {
             for (int k : touched)
-                for (std::size_t i = 0; i < polys[k].size(); ++i)
-                    uses[edge_key(polys[k][i], polys[k][(i + 1) % polys[k].size()])] += delta;
+                for (std::size_t i = 0; i < w.polys[k].size(); ++i)
+                    w.uses[edge_key(w.polys[k][i], w.polys[k][(i + 1) % w.polys[k].size()])] += delta;
         };
         count_edges(-1);
-        for (int k : touched) polys[k] = merged_polygon(polys[k], v, u);
+        for (int k : touched) w.polys[k] = merged_polygon(w.polys[k], v, u);
         count_edges(+1);
-        pos[u] = target;
+        w.pos[u] = target;
         alias[v] = u;
         incident[u] = touched;
         ++collapsed;
     }
     for (std::size_t k = 0; k < polygons.size(); ++k) {
         polygons[k].clear();
-        for (int v : polys[k]) polygons[k].push_back(pos[v]);
+        for (int v : w.polys[k]) polygons[k].push_back(w.pos[v]);
     }
     return collapsed;
 }

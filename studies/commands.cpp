@@ -551,6 +551,8 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
     io::write_text_atomically(dir / "summary.json", labtest_json(r).dump(2) + "\n");
 }
 
+} // namespace
+
 /// --pattern and --size-measure -> the options' pattern.
 void apply_pattern_flags(LabTestCli& c) {
     const std::map<std::string, meshing::PatternSpec::Kind> kinds{
@@ -583,23 +585,15 @@ std::string fmt_number(double v) {
     return b;
 }
 
-/// The shortest text that reads back as exactly v. A calibrated set must: the
-/// confined strength of a brittle specimen can jump at a relative change of
-/// 1e-6 in its joints (Lac du Bonnet, docs/calibration.md), so a set rounded to
-/// 6 digits measured 458 MPa where the calibration had measured 654.
-std::string exact_number(double v) {
-    char b[64];
-    const auto [end, ec] = std::to_chars(b, b + sizeof b, v);
-    if (ec != std::errc()) throw std::logic_error("exact_number: no room");
-    return std::string(b, end);
-}
 
+namespace {
 /// The flag behind a key of the specimen's region (GeometryError from the generator).
 std::string labtest_flag(const std::string& key) {
     if (key == "pattern.size") return "--size";
     if (key == "mesh.size") return "--mesh-size";
     return "--width/--height";
 }
+} // namespace
 
 /// Refuses, before anything is generated, a specimen narrower than a few blocks or
 /// asking for more blocks and triangles than the limit.
@@ -627,7 +621,6 @@ void check_specimen_size(const LabTestCli& c) {
     }
 }
 
-} // namespace
 
 void apply_specimen_flags(LabTestCli& c) {
     apply_pattern_flags(c);
@@ -655,6 +648,82 @@ std::string labtest_record_text(const LabTestResult& r) { return labtest_record(
 LabTestResult labtest_from_record_text(const std::string& text) {
     return labtest_from_record(nlohmann::json::parse(text));
 }
+
+namespace {
+
+/// One realization's result on the console, with what a reader needs to know
+/// about it (a preload skipped, still loading at the strain cap, hardened past
+/// yield, reloads, the residual strength, post-peak locking).
+void print_realization(Progress& lines, const LabTestOptions& ok, const LabTestResult& r) {
+    lines.result("  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
+                 "sigma_ci %.2f  sigma_cd %.2f MPa  cracks %d T %d S  %ld steps  %.1f s",
+                 static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.E50 / 1e9, r.nu, r.peak_stress / 1e6,
+                 r.strain_at_peak, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6,
+                 r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
+    if (r.preload_skipped)
+        std::fprintf(stderr, "  seed %llu: the confinement left blocks the implicit preload cannot solve "
+                             "(held at one point, or loose): loaded explicitly from the start\n",
+                     static_cast<unsigned long long>(ok.seed));
+    if (r.still_loading)
+        std::fprintf(stderr, "  seed %llu: still loading at the strain cap %g, not failed: the peak is a "
+                             "lower bound of the strength (jammed blocks, or raise --strain-cap)\n",
+                     static_cast<unsigned long long>(ok.seed), std::max(ok.max_strain, ok.strain_cap));
+    else if (r.loaded_past_max_strain)
+        std::fprintf(stderr, "  seed %llu: not failed at --max-strain %g: loaded on, failed at strain %.4g\n",
+                     static_cast<unsigned long long>(ok.seed), ok.max_strain, r.strain_at_peak);
+    if (ok.confinement > 0.0 && r.hardened_past_yield())
+        std::fprintf(stderr, "  seed %llu: yielded at %.2f MPa (the stress's first stall) and hardened to its "
+                             "peak, %.0f%% higher: broken blocks interlocking (a residual friction below "
+                             "the joints' lets them slide; docs/calibration.md, The confined peak)\n",
+                     static_cast<unsigned long long>(ok.seed), r.first_stall_stress / 1e6,
+                     100.0 * (r.peak_stress / r.first_stall_stress - 1.0));
+    if (r.reloads > 0)
+        std::fprintf(stderr, "  seed %llu: the stress dropped by --failure-drop and climbed back above its "
+                             "peak %d time%s (bursts of cracks): loaded on to the peak that lasted\n",
+                     static_cast<unsigned long long>(ok.seed), r.reloads, r.reloads == 1 ? "" : "s");
+    if (r.residual_stress > 0.0) {
+        std::fprintf(stderr, "  seed %llu: residual strength %.2f MPa (the last %.1f%% of axial strain, %.2g%% "
+                             "to %.2g%%)",
+                     static_cast<unsigned long long>(ok.seed), r.residual_stress / 1e6,
+                     100.0 * residual_window_strain, 100.0 * (r.curve.back().axial_strain - residual_window_strain),
+                     100.0 * r.curve.back().axial_strain);
+        if (r.residual_friction_angle > 0.0)
+            std::fprintf(stderr, "; with no cohesion left it mobilises a friction of %.1f degrees",
+                         r.residual_friction_angle);
+        std::fprintf(stderr, "\n");
+    }
+    if (r.post_peak_locking)
+        std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
+                             "jammed between the platens): stopped there; peak is the strength before failure\n",
+                     static_cast<unsigned long long>(ok.seed));
+}
+
+/// The summary of several realizations: the mean and standard deviation of each
+/// figure, and every realization's own.
+nlohmann::json realizations_summary(const char* name, const std::vector<LabTestResult>& results) {
+    const int n = int(results.size());
+    auto stats = [&](auto get) {
+        double m = 0, v = 0;
+        for (const auto& r : results) m += get(r);
+        m /= n;
+        for (const auto& r : results) v += (get(r) - m) * (get(r) - m);
+        return nlohmann::json{{"mean", m}, {"std", n > 1 ? std::sqrt(v / (n - 1)) : 0.0}};
+    };
+    nlohmann::json per = nlohmann::json::array();
+    for (const auto& r : results) per.push_back(labtest_json(r));
+    return nlohmann::json{{"test", name},
+                          {"realizations", n},
+                          {"E", stats([](const LabTestResult& r) { return r.E; })},
+                          {"nu", stats([](const LabTestResult& r) { return r.nu; })},
+                          {"E50", stats([](const LabTestResult& r) { return r.E50; })},
+                          {"peak_stress", stats([](const LabTestResult& r) { return r.peak_stress; })},
+                          {"strain_at_peak", stats([](const LabTestResult& r) { return r.strain_at_peak; })},
+                          {"crack_initiation_stress", stats([](const LabTestResult& r) { return r.crack_initiation_stress; })},
+                          {"crack_damage_stress", stats([](const LabTestResult& r) { return r.crack_damage_stress; })},
+                          {"per_realization", per}};
+}
+
+} // namespace
 
 int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bool check_only, LabTestStudy* study) {
     const char* name = labtest_name(kind);
@@ -714,47 +783,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
                                     : Frame());
             if (!quiet) {
                 std::lock_guard lock(print);
-                lines.result("  seed %llu: E %.2f GPa (E50 %.2f)  nu %.3f  peak %.2f MPa at strain %.3e  "
-                             "sigma_ci %.2f  sigma_cd %.2f MPa  cracks %d T %d S  %ld steps  %.1f s",
-                             static_cast<unsigned long long>(ok.seed), r.E / 1e9, r.E50 / 1e9, r.nu, r.peak_stress / 1e6,
-                             r.strain_at_peak, r.crack_initiation_stress / 1e6, r.crack_damage_stress / 1e6,
-                             r.cracks_tensile, r.cracks_shear, r.steps, r.wall_seconds);
-                if (r.preload_skipped)
-                    std::fprintf(stderr, "  seed %llu: the confinement left blocks the implicit preload cannot solve "
-                                         "(held at one point, or loose): loaded explicitly from the start\n",
-                                 static_cast<unsigned long long>(ok.seed));
-                if (r.still_loading)
-                    std::fprintf(stderr, "  seed %llu: still loading at the strain cap %g, not failed: the peak is a "
-                                         "lower bound of the strength (jammed blocks, or raise --strain-cap)\n",
-                                 static_cast<unsigned long long>(ok.seed), std::max(ok.max_strain, ok.strain_cap));
-                else if (r.loaded_past_max_strain)
-                    std::fprintf(stderr, "  seed %llu: not failed at --max-strain %g: loaded on, failed at strain %.4g\n",
-                                 static_cast<unsigned long long>(ok.seed), ok.max_strain, r.strain_at_peak);
-                if (ok.confinement > 0.0 && r.hardened_past_yield())
-                    std::fprintf(stderr, "  seed %llu: yielded at %.2f MPa (the stress's first stall) and hardened to its "
-                                         "peak, %.0f%% higher: broken blocks interlocking (a residual friction below "
-                                         "the joints' lets them slide; docs/calibration.md, The confined peak)\n",
-                                 static_cast<unsigned long long>(ok.seed), r.first_stall_stress / 1e6,
-                                 100.0 * (r.peak_stress / r.first_stall_stress - 1.0));
-                if (r.reloads > 0)
-                    std::fprintf(stderr, "  seed %llu: the stress dropped by --failure-drop and climbed back above its "
-                                         "peak %d time%s (bursts of cracks): loaded on to the peak that lasted\n",
-                                 static_cast<unsigned long long>(ok.seed), r.reloads, r.reloads == 1 ? "" : "s");
-                if (r.residual_stress > 0.0) {
-                    std::fprintf(stderr, "  seed %llu: residual strength %.2f MPa (the last %.1f%% of axial strain, %.2g%% "
-                                         "to %.2g%%)",
-                                 static_cast<unsigned long long>(ok.seed), r.residual_stress / 1e6,
-                                 100.0 * residual_window_strain, 100.0 * (r.curve.back().axial_strain - residual_window_strain),
-                                 100.0 * r.curve.back().axial_strain);
-                    if (r.residual_friction_angle > 0.0)
-                        std::fprintf(stderr, "; with no cohesion left it mobilises a friction of %.1f degrees",
-                                     r.residual_friction_angle);
-                    std::fprintf(stderr, "\n");
-                }
-                if (r.post_peak_locking)
-                    std::fprintf(stderr, "  seed %llu: after failing, the stress climbed back above the peak (fragments "
-                                         "jammed between the platens): stopped there; peak is the strength before failure\n",
-                                 static_cast<unsigned long long>(ok.seed));
+                print_realization(lines, ok, r);
             }
             return labtest_record(r).dump();
         } catch (const GeometryError& e) {
@@ -767,25 +796,7 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
         results.push_back(labtest_from_record(nlohmann::json::parse(text)));
     nlohmann::json summary = n == 1 ? labtest_json(results[0]) : nlohmann::json();
     if (n > 1) {
-        auto stats = [&](auto get) {
-            double m = 0, v = 0;
-            for (const auto& r : results) m += get(r);
-            m /= n;
-            for (const auto& r : results) v += (get(r) - m) * (get(r) - m);
-            return nlohmann::json{{"mean", m}, {"std", n > 1 ? std::sqrt(v / (n - 1)) : 0.0}};
-        };
-        nlohmann::json per = nlohmann::json::array();
-        for (const auto& r : results) per.push_back(labtest_json(r));
-        summary = nlohmann::json{{"test", name},
-                                     {"realizations", n},
-                                     {"E", stats([](const LabTestResult& r) { return r.E; })},
-                                     {"nu", stats([](const LabTestResult& r) { return r.nu; })},
-                                     {"E50", stats([](const LabTestResult& r) { return r.E50; })},
-                                     {"peak_stress", stats([](const LabTestResult& r) { return r.peak_stress; })},
-                                     {"strain_at_peak", stats([](const LabTestResult& r) { return r.strain_at_peak; })},
-                                     {"crack_initiation_stress", stats([](const LabTestResult& r) { return r.crack_initiation_stress; })},
-                                     {"crack_damage_stress", stats([](const LabTestResult& r) { return r.crack_damage_stress; })},
-                                     {"per_realization", per}};
+        summary = realizations_summary(name, results);
         if (write && Ranks::root()) io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
         if (!quiet)
             std::fprintf(stderr, "mean of %d: E %.2f GPa, nu %.3f, peak %.2f MPa%s%s\n", n,
@@ -798,292 +809,6 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
         study->summary_json = summary.dump();
     }
     return 0;
-}
-
-namespace {
-
-/// The confined targets of `bbm calibrate` (one biaxial test, a CSV record or a
-/// Hoek–Brown mi: one of them) as targets.envelope, checked.
-void confined_targets(CalibrateCli& v) {
-    auto& t = v.targets;
-    if ((v.biaxial > 0.0) != (v.confinement > 0.0))
-        throw InputError(v.biaxial > 0.0 ? "--target-biaxial" : "--target-confinement", 0, "",
-                         "--target-biaxial and --target-confinement go together (the strength and the lateral stress "
-                         "of one biaxial test)");
-    const int given = int(v.biaxial > 0.0) + int(!v.record.empty()) + int(v.mi > 0.0);
-    if (given > 1)
-        throw InputError("--target-record", 0, "",
-                         "give one confined target: --target-biaxial, --target-record or --target-mi");
-    if (!v.mi_confinements.empty() && !(v.mi > 0.0))
-        throw InputError("--target-mi-confinements", 0, "", "goes with --target-mi");
-    t.envelope.clear();
-    if (v.biaxial > 0.0) t.envelope.push_back({v.confinement, v.biaxial});
-    if (!v.record.empty()) {
-        for (const auto& p : read_strength_record(v.record))
-            if (p.first > 0.0) t.envelope.push_back(p); // σ3 = 0 is the UCS target's
-        if (t.envelope.empty()) throw InputError(v.record, 0, "", "no confined test (sigma3 > 0) in the record");
-    }
-    if (v.mi > 0.0) {
-        const auto s3 = v.mi_confinements.empty() ? std::vector<double>{t.ucs / 6.0, t.ucs / 3.0} : v.mi_confinements;
-        t.envelope = hoek_brown_targets(t.ucs, v.mi, s3);
-    }
-    for (const auto& [s3, s1] : t.envelope)
-        if (s1 <= t.ucs)
-            throw InputError(!v.record.empty() ? v.record : "--target-biaxial", 0, "",
-                             "a confined strength must exceed the UCS target (" + fmt_number(t.ucs) + " Pa); got " +
-                                 fmt_number(s1) + " Pa at sigma3 " + fmt_number(s3) + " Pa");
-}
-
-} // namespace
-
-/// `bbm calibrate`: iterates the micro-properties and writes the joint property
-/// set as a TOML fragment, with the iteration table as JSON.
-int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string* calibration_json) {
-    quiet = quiet || !Ranks::root(); // under mpirun, rank 0 reports and writes
-    LabTestCli& c = values.lab;
-    CalibrationTargets& targets = values.targets;
-    const int iterations = values.iterations;
-    const fs::path out = c.out;
-    confined_targets(values);
-    CalibrationOptions o;
-    o.base = c.o;
-    // Joint values given on the command line (or in --config) are the starting point.
-    o.start_kn = values.given_kn;
-    o.start_ks = values.given_ks;
-    o.start_tensile = values.given_tensile;
-    o.start_cohesion = values.given_cohesion;
-    apply_softening_flags(c);
-    apply_pattern_flags(c);
-    o.base.pattern = c.o.pattern;
-    o.base.size_measure = c.o.size_measure;
-    o.realizations = c.realizations;
-    o.threads = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    o.max_iterations = iterations;
-    o.fit_ci = values.fit_ci;
-    o.fit_confined_friction = values.fit_confined_friction;
-    if (o.fit_confined_friction && targets.envelope.empty())
-        throw InputError("--fit-confined-friction", 0, "",
-                         "needs a confined target (--target-biaxial, --target-record or --target-mi) for phi2");
-    if (o.fit_ci && !(targets.ci_ratio > 0))
-        throw InputError("--fit-ci", 0, "", "needs the record's sigma_ci / UCS (--target-ci-ratio)");
-    check_specimen_size(c);
-    if (check_only) return 0;
-    // SPEC §8's first estimates, kn = E/d and ks = G/d, for reference; the iteration
-    // starts from the lattice inversion on the generated blocks (calibrate.hpp).
-    const double first_kn = targets.E / o.base.size, first_ks = targets.E / (2.0 * (1.0 + targets.nu)) / o.base.size;
-    const JointPropertySpec start = calibration_start(targets, o);
-    if (c.write_files) io::make_output_directory(out);
-    const bool with_phi = !targets.envelope.empty();
-    auto confined_json = [](const std::vector<double>& v) { return nlohmann::json(v); };
-    std::vector<double> sigma3;
-    for (const auto& p : targets.envelope) sigma3.push_back(p.first);
-    if (!quiet) {
-        std::fprintf(stderr,
-                     "bbm calibrate: %s blocks of %.3g m, %g m x %g m, %d realizations of UCS and direct tension per "
-                     "iteration\ntargets: E %.4g GPa, nu %.3g, UCS %.4g MPa, tensile %.4g MPa\n",
-                     c.pattern.c_str(), o.base.size, o.base.width, o.base.height, o.realizations, targets.E / 1e9,
-                     targets.nu, targets.ucs / 1e6, targets.tensile / 1e6);
-        if (with_phi) {
-            std::fprintf(stderr, "and the confined strengths sigma1 at sigma3 (MPa):");
-            for (const auto& [s3, s1] : targets.envelope) std::fprintf(stderr, " %.4g at %.4g,", s1 / 1e6, s3 / 1e6);
-            std::fprintf(stderr, o.fit_confined_friction
-                                     ? " the confined friction phi2 calibrated (phi and sigma* held; sigma*, phi2 and the "
-                                       "sigma1 at the end of each row)\n"
-                                     : " the friction angle calibrated too (phi and the sigma1 at the end of each row)\n");
-        }
-        if (targets.ci_ratio > 0 && o.fit_ci)
-            std::fprintf(stderr, "and sigma_ci/UCS %.3g (within %.2g), by the bonds' strength heterogeneity (Weibull "
-                                 "modulus m, at the end of each row)\n",
-                         targets.ci_ratio, o.tolerance_ci);
-        else if (targets.ci_ratio > 0)
-            std::fprintf(stderr, "the record's sigma_ci/UCS %.3g is reported beside the model's, not calibrated "
-                                 "(--fit-ci calibrates it)\n",
-                         targets.ci_ratio);
-        std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start kn %.2f, ks %.2f GPa/m (%s)\n",
-                     first_kn / 1e9, first_ks / 1e9, start.kn / 1e9, start.ks / 1e9,
-                     o.start_kn || o.start_ks ? "as given" : "lattice inversion on the generated blocks");
-        std::fprintf(stderr, "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n", "iter", "kn GPa/m", "ks GPa/m",
-                     "st MPa", "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
-    }
-    nlohmann::json table = nlohmann::json::array();
-    int k = 0;
-    const auto iterations_done = calibrate(targets, o, [&](const CalibrationIteration& it) {
-        ++k;
-        if (!quiet) {
-            std::fprintf(stderr, "%4d %10.2f %10.2f %9.3f %9.3f | %9.2f %9.2f %7.3f %10.2f %10.3f %8.0f", k,
-                         it.joint.kn / 1e9, it.joint.ks / 1e9, it.joint.tensile / 1e6, it.joint.cohesion / 1e6,
-                         it.E / 1e9, it.E_test / 1e9, it.nu, it.ucs / 1e6, it.tensile / 1e6, it.seconds);
-            std::fprintf(stderr, " ci/UCS %.2f", it.ci_ratio);
-            if (o.fit_ci) std::fprintf(stderr, " (m %s)", it.joint.weibull_modulus > 0 ? fmt_number(it.joint.weibull_modulus).c_str() : "uniform");
-            if (with_phi) {
-                if (o.fit_confined_friction)
-                    std::fprintf(stderr, "   sigma* %.4g MPa phi2 %5.2f", it.joint.confined_friction_from / 1e6,
-                                 it.joint.confined_friction);
-                std::fprintf(stderr, "   phi %5.2f  sigma1", it.joint.friction);
-                for (double s1 : it.confined) std::fprintf(stderr, " %7.2f", s1 / 1e6);
-            }
-            std::fprintf(stderr, "  misfit %.3f%s\n", it.misfit, it.converged ? "  converged" : "");
-            if (it.still_loading > 0)
-                std::fprintf(stderr, "     %d test%s still loading at the strain cap %g: lower bounds, not strengths "
-                                     "(blocks jammed)\n",
-                             it.still_loading, it.still_loading == 1 ? "" : "s",
-                             std::max(o.base.max_strain, o.base.strain_cap));
-        }
-        table.push_back({{"kn", it.joint.kn}, {"ks", it.joint.ks}, {"tensile", it.joint.tensile},
-                         {"cohesion", it.joint.cohesion}, {"E", it.E}, {"E_std", it.E_std}, {"E_ucs_curve", it.E_test}, {"nu", it.nu},
-                         {"nu_std", it.nu_std}, {"ucs", it.ucs}, {"ucs_std", it.ucs_std}, {"tensile_strength", it.tensile},
-                         {"tensile_strength_std", it.tensile_std}, {"friction", it.joint.friction},
-                         {"confined_friction", it.joint.confined_friction},
-                         {"confined_friction_from", it.joint.confined_friction_from},
-                         {"confined_strength", confined_json(it.confined)},
-                         {"confined_strength_std", confined_json(it.confined_std)}, {"ci_ratio", it.ci_ratio},
-                         {"ci_ratio_std", it.ci_ratio_std}, {"weibull_modulus", it.joint.weibull_modulus},
-                         {"misfit", it.misfit}, {"seconds", it.seconds},
-                         {"converged", it.converged}, {"still_loading", it.still_loading}});
-    });
-    // The converged set, or else the best one (the smallest misfit).
-    const auto& last = best_iteration(iterations_done);
-    const auto& j = last.joint;
-    // The calibrated set on seeds it has not seen: what a new model will get.
-    auto fresh = measure_macro_properties(j, o, o.base.seed + 1000, sigma3);
-    fresh.misfit = calibration_misfit(fresh, targets, o.fit_ci);
-    if (!quiet) {
-        std::fprintf(stderr, "fresh seeds %llu..: E %.2f GPa (curve %.2f), nu %.3f, UCS %.2f MPa (std %.2f), T %.3f MPa "
-                             "(std %.3f)",
-                     static_cast<unsigned long long>(o.base.seed + 1000), fresh.E / 1e9, fresh.E_test / 1e9, fresh.nu,
-                     fresh.ucs / 1e6, fresh.ucs_std / 1e6, fresh.tensile / 1e6, fresh.tensile_std / 1e6);
-        for (std::size_t i = 0; i < sigma3.size(); ++i)
-            std::fprintf(stderr, ", sigma1 %.2f MPa (std %.2f; target %.2f) at %.3g", fresh.confined[i] / 1e6,
-                         fresh.confined_std[i] / 1e6, targets.envelope[i].second / 1e6, sigma3[i] / 1e6);
-        std::fprintf(stderr, ", ci/UCS %.2f (std %.2f%s), misfit %.3f\n", fresh.ci_ratio, fresh.ci_ratio_std,
-                     targets.ci_ratio > 0 ? ("; record " + fmt_number(targets.ci_ratio)).c_str() : "", fresh.misfit);
-        if (!last.converged)
-            std::fprintf(stderr, "not converged: the best set is iteration %d (misfit %.3f)\n",
-                         int(&last - iterations_done.data()) + 1, last.misfit);
-        if (o.fit_ci && !(last.joint.weibull_modulus > 0.0) && last.ci_ratio < targets.ci_ratio - o.tolerance_ci)
-            std::fprintf(stderr, "sigma_ci/UCS is below the record's with uniform bonds: heterogeneous bonds only lower "
-                                 "it (docs/calibration.md, \"Calibrating sigma_ci/UCS\")\n");
-    }
-    // The set holds for this pattern only: say which, as a model file writes it.
-    const std::string pattern_line = "pattern = { type = \"" + c.pattern + "\", size = " + fmt_number(o.base.size) +
-                                     ", size_measure = \"" + c.size_measure + "\", lloyd = " +
-                                     std::to_string(o.base.lloyd) + " }";
-    std::string toml = "# bbm calibrate: " + c.pattern + " blocks of " + fmt_number(o.base.size) + " m (" +
-                       (c.size_measure == "area" ? "equal-area diameter" : "mean Feret diameter") + "), Lloyd " +
-                       std::to_string(o.base.lloyd) + ", in a " + fmt_number(o.base.width) + " m x " +
-                       fmt_number(o.base.height) + " m specimen; for regions with\n#   " + pattern_line +
-                       "\n# Targets E " +
-                       fmt_number(targets.E) + " Pa, nu " + fmt_number(targets.nu) + ", UCS " + fmt_number(targets.ucs) +
-                       " Pa, tensile " + fmt_number(targets.tensile) + " Pa" +
-                       (with_phi ? ", " + std::to_string(targets.envelope.size()) + " confined strengths" : std::string()) +
-                       ".\n# Calibrated set, iteration " + std::to_string(int(&last - iterations_done.data()) + 1) + " (mean of " +
-                       std::to_string(o.realizations) + "): E " + fmt_number(last.E) + " Pa, nu " + fmt_number(last.nu) +
-                       ", UCS " + fmt_number(last.ucs) + " Pa, tensile " + fmt_number(last.tensile) + " Pa" +
-                       ", largest misfit " + fmt_number(last.misfit) +
-                       (last.converged ? "" : " (NOT converged: the best set; see calibration.json)") + ".\n";
-    auto pts = [](const std::vector<std::pair<double, double>>& v) {
-        std::string s = "[";
-        for (std::size_t i = 0; i < v.size(); ++i)
-            s += (i ? ", [" : "[") + exact_number(v[i].first) + ", " + exact_number(v[i].second) + "]";
-        return s + "]";
-    };
-    toml += "[[joint_property]]\nname = \"calibrated\"\nlaw = \"softening\"\nkn = " + exact_number(j.kn) +
-            "\nks = " + exact_number(j.ks) + "\ntensile = " + exact_number(j.tensile) + "\ncohesion = " +
-            exact_number(j.cohesion) + "\nfriction = " + exact_number(j.friction) +
-            (j.residual_friction >= 0.0 ? "\nresidual_friction = " + exact_number(j.residual_friction) : std::string()) +
-            (j.confined_friction >= 0.0 ? "\nconfined_friction = " + exact_number(j.confined_friction) +
-                                              "\nconfined_friction_from = " + exact_number(j.confined_friction_from)
-                                        : std::string()) +
-            "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
-    // The set's heterogeneity is part of it: without these lines the file would
-    // describe a uniform rock the calibration never measured.
-    if (j.weibull_modulus > 0.0)
-        toml += "weibull_modulus = " + exact_number(j.weibull_modulus) +
-                "\nstrength_classes = " + std::to_string(j.strength_classes) + "\n";
-    const nlohmann::json calibration{{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
-                                                          {"tensile", targets.tensile}, {"envelope", targets.envelope},
-                                                          {"ci_ratio", targets.ci_ratio}, {"fit_ci", o.fit_ci},
-                                                          {"fit_confined_friction", o.fit_confined_friction}}},
-                                             {"pattern", c.pattern},
-                                             {"size", o.base.size},
-                                             {"size_measure", c.size_measure},
-                                             {"lloyd", o.base.lloyd},
-                                             {"realizations", o.realizations},
-                                             {"converged", last.converged},
-                                             {"calibrated_iteration", int(&last - iterations_done.data()) + 1},
-                                             {"first_estimate", {{"kn", first_kn}, {"ks", first_ks}}},
-                                             {"start", {{"kn", start.kn}, {"ks", start.ks}, {"tensile", start.tensile},
-                                                        {"cohesion", start.cohesion}}},
-                                             {"fresh_seeds", {{"first_seed", o.base.seed + 1000}, {"E", fresh.E},
-                                                              {"E_ucs_curve", fresh.E_test}, {"nu", fresh.nu},
-                                                              {"ucs", fresh.ucs}, {"ucs_std", fresh.ucs_std},
-                                                              {"tensile_strength", fresh.tensile},
-                                                              {"tensile_strength_std", fresh.tensile_std},
-                                                              {"confined_strength", confined_json(fresh.confined)},
-                                                              {"confined_strength_std", confined_json(fresh.confined_std)},
-                                                              {"ci_ratio", fresh.ci_ratio},
-                                                              {"ci_ratio_std", fresh.ci_ratio_std},
-                                                              {"misfit", fresh.misfit}}},
-                                             {"iterations", table},
-                                             {"joint_property_toml", toml}};
-    if (calibration_json) *calibration_json = calibration.dump();
-    if (c.write_files && Ranks::root()) {
-        io::write_text_atomically(out / "joint_property.toml", toml);
-        io::write_text_atomically(out / "calibration.json", calibration.dump(2) + "\n");
-        if (!quiet)
-            std::fprintf(stderr, "wrote %s/joint_property.toml and calibration.json%s\n", out.string().c_str(),
-                         last.converged ? "" : " (not converged within the iteration limit)");
-    }
-    return last.converged ? 0 : 4;
-}
-
-void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
-    add_labtest_options(cmd, v.lab, quiet);
-    auto& t = v.targets;
-    cmd->add_option("--target-E", t.E, "Target Young's modulus (Pa)")->check(cli::positive())->capture_default_str();
-    cmd->add_option("--target-nu", t.nu, "Target Poisson's ratio")->check(cli::in_range(0.01, 0.33))->capture_default_str();
-    cmd->add_option("--target-ucs", t.ucs, "Target uniaxial compressive strength (Pa)")->check(cli::positive())->capture_default_str();
-    cmd->add_option("--target-tensile", t.tensile, "Target direct tensile strength (Pa)")->check(cli::positive())->capture_default_str();
-    cmd->add_option("--target-biaxial", v.biaxial,
-                    "Optional: target strength sigma1 of a biaxial test at --target-confinement (Pa); calibrates the "
-                    "friction angle too")
-        ->check(cli::positive());
-    cmd->add_option("--target-confinement", v.confinement,
-                    "Lateral stress of the --target-biaxial test (Pa, compression positive)")
-        ->check(cli::positive());
-    cmd->add_option("--target-record", v.record,
-                    "Optional: the record's triaxial strengths, a CSV of sigma3, sigma1 in MPa (a header line "
-                    "allowed); calibrates the friction angle to their mean slope")
-        ->check(CLI::ExistingFile);
-    cmd->add_option("--target-mi", v.mi,
-                    "Optional: the record's Hoek-Brown mi (sigma_ci = --target-ucs); its curve at "
-                    "--target-mi-confinements is the confined target")
-        ->check(cli::positive());
-    cmd->add_option("--target-mi-confinements", v.mi_confinements,
-                    "sigma3 of the Hoek-Brown targets (Pa, comma-separated; default UCS/6 and UCS/3)")
-        ->delimiter(',')
-        ->check(cli::positive());
-    cmd->add_option("--target-ci-ratio", t.ci_ratio,
-                    "Optional: the record's crack-initiation stress over its UCS (reported beside the model's; "
-                    "calibrated with --fit-ci)")
-        ->check(cli::in_range(0.01, 1.0));
-    cmd->add_flag("--fit-ci", v.fit_ci,
-                  "Calibrate sigma_ci/UCS (--target-ci-ratio) too, within 0.05, by the heterogeneity of the bond "
-                  "strengths (their Weibull modulus m; --weibull-m is the start)");
-    cmd->add_flag("--fit-confined-friction", v.fit_confined_friction,
-                  "Calibrate the bonds' confined friction phi2 (docs/input.md, confined_friction) on the confined "
-                  "targets, the friction and sigma* held (--confined-friction-from; default --target-ucs) and the "
-                  "cohesion steered by the UCS alone (--confined-friction is the start; default 55)");
-    cmd->add_option("--iterations", v.iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
-}
-
-void note_given_joint_values(const CLI::App& cmd, CalibrateCli& v) {
-    // A --rock file gives them too: the calibration starts from its bonds.
-    const bool rock = !v.lab.rock.empty();
-    v.given_kn = rock || cmd.count("--kn") > 0;
-    v.given_ks = rock || cmd.count("--ks") > 0;
-    v.given_tensile = rock || cmd.count("--tensile") > 0;
-    v.given_cohesion = rock || cmd.count("--cohesion") > 0;
 }
 
 LabTestStudy run_labtest_args(const std::string& command, const std::vector<std::string>& args, bool quiet,
@@ -1104,19 +829,6 @@ LabTestStudy run_labtest_args(const std::string& command, const std::vector<std:
     LabTestStudy study;
     run_labtest_command(values, kind, quiet_flag, false, &study);
     return study;
-}
-
-std::string run_calibrate_args(const std::vector<std::string>& args, bool quiet) {
-    CalibrateCli values;
-    CLI::App app{"calibrate", "calibrate"};
-    bool quiet_flag = quiet;
-    add_calibrate_options(&app, values, quiet_flag);
-    cli::parse_args(app, "calibrate", args);
-    note_given_joint_values(app, values);
-    values.lab.write_files = app.count("--out") > 0;
-    std::string json;
-    run_calibrate(values, quiet_flag, false, &json);
-    return json;
 }
 
 } // namespace bbm::studies

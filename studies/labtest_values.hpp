@@ -46,6 +46,16 @@ LabTestCli labtest_defaults(LabTestOptions::Kind kind);
 void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind);
 /// --pattern, --size-measure and the softening flags applied to c.o (checked).
 void apply_specimen_flags(LabTestCli& c);
+/// --pattern and --size-measure applied to c.o.
+void apply_pattern_flags(LabTestCli& c);
+/// --tension-softening / --shear-softening b1,a1,a2 -> the points (a1, b1), (a2,
+/// 0) of the joint's curves, checked with the rules between the joint's keys.
+void apply_softening_flags(LabTestCli& c);
+/// Refuses, before anything is generated, a specimen narrower than a few blocks or
+/// asking for more blocks and triangles than the limit.
+void check_specimen_size(const LabTestCli& c);
+/// A number to 6 significant digits, for messages and reports.
+std::string fmt_number(double v);
 /// A result as it travels between ranks (JSON text; doubles round-trip exactly), and back.
 std::string labtest_record_text(const LabTestResult& r);
 LabTestResult labtest_from_record_text(const std::string& text);

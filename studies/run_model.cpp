@@ -651,6 +651,139 @@ int run_model(const RunOptions& opt) {
     return stop_signal != 0 ? 130 : 0;
 }
 
+namespace {
+
+/// What `bbm compare` tabulates of one run, read from its summary.json.
+struct ComparedRun {
+    nlohmann::json j, op;
+    std::string kind;
+    double crack_rate = 0.0, rock_ratio = 0.0, zone_springline = 0.0, zone_crown = 0.0;
+    int fragments = 0;
+    bool at_edge = false;
+    // Support, over its sets: how many bolts, the largest load, how many yielded or broke.
+    int bolts = 0, yielded = 0, broken = 0;
+    double bolt_load = 0.0, liner_thrust = 0.0, liner_moment = 0.0;
+    bool lined = false;
+
+    explicit ComparedRun(const fs::path& summary) {
+        std::ifstream f(summary);
+        j = nlohmann::json::parse(f);
+        op = j.contains("opening") ? j["opening"] : nlohmann::json::object();
+        const auto verdict = j.contains("verdict") ? j["verdict"] : nlohmann::json::object();
+        kind = verdict.value("kind", std::string("-"));
+        crack_rate = verdict.value("cracks_per_1000_steps", 0.0), rock_ratio = verdict.value("rock_mass_ratio", 0.0);
+        fragments = verdict.value("fragments", 0);
+        const auto zone = op.contains("failed_zone") ? op["failed_zone"] : nlohmann::json::object();
+        zone_springline = zone.value("depth_springline", 0.0), zone_crown = zone.value("depth_crown", 0.0);
+        at_edge = zone.value("reaches_region_edge", false) || zone.value("region_edge_cells_damaged", 0) >= 2;
+        if (j.contains("bolts"))
+            for (const auto& b : j["bolts"]) {
+                bolts += b["bolts"].get<int>(), yielded += b["yielded"].get<int>(), broken += b["broken"].get<int>();
+                bolt_load = std::max(bolt_load, b["max_axial_kN"].get<double>());
+            }
+        lined = j.contains("liners");
+        if (lined)
+            for (const auto& l : j["liners"]) {
+                liner_thrust = std::max(liner_thrust, l["max_thrust_kN_per_m"].get<double>());
+                liner_moment = std::max(liner_moment, l["max_moment_kNm_per_m"].get<double>());
+            }
+    }
+    double opening(const char* k) const { return op.contains(k) ? op[k].get<double>() : 0.0; }
+
+    std::string csv_row(const std::string& name) const {
+        char row[1024];
+        std::snprintf(row, sizeof row,
+                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d,%.1f,"
+                      "%.2f,%d\n",
+                      name.c_str(), j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
+                      j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
+                      j["cracks"]["tensile"].get<int>(), j["cracks"]["shear"].get<int>(),
+                      1e3 * opening("springline_convergence"), 1e3 * opening("crown_convergence"),
+                      opening("failed_depth_springline"), opening("failed_depth_crown"),
+                      int(opening("cracks_springline_sector")), int(opening("cracks_crown_sector")), zone_springline,
+                      zone_crown, kind.c_str(), crack_rate, fragments, rock_ratio, bolts, bolt_load, yielded, broken,
+                      liner_thrust, liner_moment, int(at_edge));
+        return row;
+    }
+
+    std::string markdown_row(const std::string& name) const {
+        char liner_cell[96] = "-";
+        if (lined) std::snprintf(liner_cell, sizeof liner_cell, "%.0f, %.1f", liner_thrust, liner_moment);
+        char bolt_cell[96] = "-";
+        if (bolts > 0) std::snprintf(bolt_cell, sizeof bolt_cell, "%d: %.0f (%d / %d)", bolts, bolt_load, yielded, broken);
+        const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
+        char row[1024];
+        std::snprintf(row, sizeof row,
+                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f%s | %s | %.2f | %d | "
+                      "%.2e | %s | %s |\n",
+                      shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
+                      j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
+                      j["cracks"]["shear"].get<int>(), 1e3 * opening("springline_convergence"),
+                      1e3 * opening("crown_convergence"), opening("failed_depth_springline"),
+                      opening("failed_depth_crown"), int(opening("cracks_springline_sector")),
+                      int(opening("cracks_crown_sector")), zone_springline, zone_crown,
+                      at_edge ? " (damage at the region's edge)" : "", kind.c_str(), crack_rate, fragments, rock_ratio,
+                      bolt_cell, liner_cell);
+        return row;
+    }
+};
+
+/// Cracks against step from a run's history.csv (the columns whose quantity is a
+/// crack count, summed); none if it has no such column.
+std::optional<Series> crack_curve(const std::string& name, const fs::path& history) {
+    Series ser{name, {}, {}};
+    std::ifstream h(history);
+    std::string line;
+    std::getline(h, line);
+    std::vector<int> crack_columns;
+    {
+        std::stringstream head(line);
+        std::string col;
+        for (int k = 0; std::getline(head, col, ','); ++k)
+            if (col.find("crack") != std::string::npos) crack_columns.push_back(k);
+    }
+    if (crack_columns.empty()) return std::nullopt;
+    while (std::getline(h, line)) {
+        std::stringstream row_in(line);
+        std::string cell;
+        double step = 0, cracks = 0;
+        for (int k = 0; std::getline(row_in, cell, ','); ++k) {
+            if (k == 0) step = std::stod(cell);
+            if (std::find(crack_columns.begin(), crack_columns.end(), k) != crack_columns.end())
+                cracks += std::stod(cell);
+        }
+        ser.x.push_back(step), ser.y.push_back(cracks);
+    }
+    return ser;
+}
+
+/// Runs the models over ranks under mpirun (one after another within a rank, each
+/// on `threads` threads): each one's exit status, or "not started" once
+/// interrupted (Ctrl-C, a scheduler's signal: the model running checkpoints and
+/// the rest of this rank's models are not started; `bbm run --resume --out
+/// DIR/<model>` continues each). `stopped`: whether that happened.
+std::vector<std::string> run_compared_models(const std::vector<std::string>& models, const fs::path& out, int threads,
+                                             bool quiet, bool& stopped) {
+    const bool parallel = Ranks::size() > 1;
+    stopped = false;
+    return run_spread(int(models.size()), 1, [&](int k) {
+        if (stopped) return std::string("not started");
+        const std::string name = fs::path(models[k]).stem().string();
+        RunOptions o;
+        o.model = models[k];
+        o.out = out / name;
+        o.threads = threads;
+        o.quiet = quiet || parallel;
+        if (!o.quiet) std::fprintf(stderr, "== %s\n", name.c_str());
+        const int rc = run_model(o);
+        // Stopped in this model, or by a signal that came after it had finished.
+        stopped = stopped || rc == 130 || interrupted.load() != 0;
+        return std::to_string(rc);
+    });
+}
+
+} // namespace
+
 int compare_models(const std::vector<std::string>& models, const fs::path& out, int threads, bool quiet,
                    const CompareEnvelopeOptions* envelope) {
     // A rock a specimen cannot carry is refused before any model runs.
@@ -668,123 +801,28 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
           "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio | "
           "bolts: largest load kN (yielded / broken) | liner: thrust kN/m, moment kNm/m |\n"
        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    std::vector<Series> curves;
-    int status = 0;
-    // The models over ranks under mpirun (one after another within a rank, each on
-    // `threads` threads); rank 0 tabulates them.
-    const bool parallel = Ranks::size() > 1;
-    // Interrupted (Ctrl-C, a scheduler's signal): the model running checkpoints and
-    // the rest of this rank's models are not started; `bbm run --resume --out
-    // DIR/<model>` continues each.
     bool stopped = false;
-    const auto codes = run_spread(int(models.size()), 1, [&](int k) {
-        if (stopped) return std::string("not started");
-        const std::string name = fs::path(models[k]).stem().string();
-        RunOptions o;
-        o.model = models[k];
-        o.out = out / name;
-        o.threads = threads;
-        o.quiet = quiet || parallel;
-        if (!o.quiet) std::fprintf(stderr, "== %s\n", name.c_str());
-        const int rc = run_model(o);
-        // Stopped in this model, or by a signal that came after it had finished.
-        stopped = stopped || rc == 130 || interrupted.load() != 0;
-        return std::to_string(rc);
-    });
+    const auto codes = run_compared_models(models, out, threads, quiet, stopped);
     // The rocks' envelopes after the models (each spreads its own runs over the ranks).
     std::string envelope_table;
     if (envelope && envelope->enabled && !stopped && interrupted.load() == 0)
         envelope_table = compare_envelopes(models, out, threads, quiet, *envelope);
     if (!Ranks::root()) return 0;
+    std::vector<Series> curves;
+    int status = 0;
     for (std::size_t m = 0; m < models.size(); ++m) {
-        const auto& model = models[m];
-        const std::string name = fs::path(model).stem().string();
-        RunOptions o;
-        o.out = out / name;
+        const std::string name = fs::path(models[m]).stem().string();
+        const fs::path dir = out / name;
         if (codes[m] == "not started") { // the comparison was interrupted before it
             if (status == 0) status = 130;
             continue;
         }
         const int rc = std::stoi(codes[m]);
         if (rc != 0 && status == 0) status = rc;
-        std::ifstream f(o.out / "summary.json");
-        const auto j = nlohmann::json::parse(f);
-        const auto op = j.contains("opening") ? j["opening"] : nlohmann::json::object();
-        auto get = [&](const char* k) { return op.contains(k) ? op[k].get<double>() : 0.0; };
-        const auto verdict = j.contains("verdict") ? j["verdict"] : nlohmann::json::object();
-        const std::string kind = verdict.value("kind", std::string("-"));
-        const double crack_rate = verdict.value("cracks_per_1000_steps", 0.0), rock_ratio = verdict.value("rock_mass_ratio", 0.0);
-        const int fragments = verdict.value("fragments", 0);
-        const auto zone = op.contains("failed_zone") ? op["failed_zone"] : nlohmann::json::object();
-        const double zone_springline = zone.value("depth_springline", 0.0), zone_crown = zone.value("depth_crown", 0.0);
-        const bool at_edge = zone.value("reaches_region_edge", false) || zone.value("region_edge_cells_damaged", 0) >= 2;
-        // Support, over its sets: how many bolts, the largest load, how many yielded or broke.
-        int bolts = 0, yielded = 0, broken = 0;
-        double bolt_load = 0.0;
-        if (j.contains("bolts"))
-            for (const auto& b : j["bolts"]) {
-                bolts += b["bolts"].get<int>(), yielded += b["yielded"].get<int>(), broken += b["broken"].get<int>();
-                bolt_load = std::max(bolt_load, b["max_axial_kN"].get<double>());
-            }
-        double liner_thrust = 0.0, liner_moment = 0.0;
-        const bool lined = j.contains("liners");
-        if (lined)
-            for (const auto& l : j["liners"]) {
-                liner_thrust = std::max(liner_thrust, l["max_thrust_kN_per_m"].get<double>());
-                liner_moment = std::max(liner_moment, l["max_moment_kNm_per_m"].get<double>());
-            }
-        char liner_cell[96] = "-";
-        if (lined) std::snprintf(liner_cell, sizeof liner_cell, "%.0f, %.1f", liner_thrust, liner_moment);
-        char bolt_cell[96] = "-";
-        if (bolts > 0) std::snprintf(bolt_cell, sizeof bolt_cell, "%d: %.0f (%d / %d)", bolts, bolt_load, yielded, broken);
-        char row[1024];
-        std::snprintf(row, sizeof row,
-                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d,%.1f,"
-                      "%.2f,%d\n",
-                      name.c_str(),
-                      j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
-                      j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
-                      j["cracks"]["tensile"].get<int>(), j["cracks"]["shear"].get<int>(),
-                      1e3 * get("springline_convergence"), 1e3 * get("crown_convergence"),
-                      get("failed_depth_springline"), get("failed_depth_crown"), int(get("cracks_springline_sector")),
-                      int(get("cracks_crown_sector")), zone_springline, zone_crown, kind.c_str(), crack_rate, fragments,
-                      rock_ratio, bolts, bolt_load, yielded, broken, liner_thrust, liner_moment, int(at_edge));
-        csv << row;
-        const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
-        std::snprintf(row, sizeof row,
-                      "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f%s | %s | %.2f | %d | "
-                      "%.2e | %s | %s |\n",
-                      shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
-                      j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
-                      j["cracks"]["shear"].get<int>(), 1e3 * get("springline_convergence"),
-                      1e3 * get("crown_convergence"), get("failed_depth_springline"), get("failed_depth_crown"),
-                      int(get("cracks_springline_sector")), int(get("cracks_crown_sector")), zone_springline, zone_crown,
-                      at_edge ? " (damage at the region's edge)" : "", kind.c_str(), crack_rate, fragments, rock_ratio, bolt_cell, liner_cell);
-        md << row;
-        // Cracks against step from the run's history (columns whose quantity is a crack count).
-        Series ser{name, {}, {}};
-        std::ifstream h(o.out / "history.csv");
-        std::string line;
-        std::getline(h, line);
-        std::vector<int> crack_columns;
-        {
-            std::stringstream head(line);
-            std::string col;
-            for (int k = 0; std::getline(head, col, ','); ++k)
-                if (col.find("crack") != std::string::npos) crack_columns.push_back(k);
-        }
-        while (std::getline(h, line)) {
-            std::stringstream row_in(line);
-            std::string cell;
-            double step = 0, cracks = 0;
-            for (int k = 0; std::getline(row_in, cell, ','); ++k) {
-                if (k == 0) step = std::stod(cell);
-                if (std::find(crack_columns.begin(), crack_columns.end(), k) != crack_columns.end())
-                    cracks += std::stod(cell);
-            }
-            ser.x.push_back(step), ser.y.push_back(cracks);
-        }
-        if (!crack_columns.empty()) curves.push_back(std::move(ser));
+        const ComparedRun run(dir / "summary.json");
+        csv << run.csv_row(name);
+        md << run.markdown_row(name);
+        if (auto ser = crack_curve(name, dir / "history.csv")) curves.push_back(std::move(*ser));
     }
     md << envelope_table;
     write_text_atomically(out / "comparison.csv", csv.str());

@@ -448,6 +448,86 @@ void write_run_files(const ShearTestResult& r, const Solver& s, const std::files
 
 } // namespace
 
+namespace {
+
+/// summary.json of a series: per normal stress the mean and spread of the peak,
+/// residual and dilation; the Coulomb lines through the peaks (at the normal
+/// stress there, which constant normal stiffness moves) and the residuals; every run.
+nlohmann::json shear_summary(const ShearCli& v, const std::vector<ShearTestResult>& results) {
+    const int per = v.lab.realizations;
+    // The Coulomb lines over the normal stresses (at the peak: σn there, which CNS moves).
+    std::vector<double> sn_peak, tau_peak, sn_res, tau_res;
+    nlohmann::json runs = nlohmann::json::array();
+    for (const auto& r : results) {
+        sn_peak.push_back(r.normal_stress_at_peak), tau_peak.push_back(r.peak_shear_stress);
+        sn_res.push_back(r.residual_normal_stress), tau_res.push_back(r.residual_shear_stress);
+        runs.push_back(shear_json(r));
+    }
+    auto stats = [&](std::size_t level, auto get) {
+        double m = 0, s2 = 0;
+        for (int k = 0; k < per; ++k) m += get(results[level * per + k]);
+        m /= per;
+        for (int k = 0; k < per; ++k) s2 += std::pow(get(results[level * per + k]) - m, 2);
+        return nlohmann::json{{"mean", m}, {"std", per > 1 ? std::sqrt(s2 / (per - 1)) : 0.0}};
+    };
+    nlohmann::json levels = nlohmann::json::array();
+    for (std::size_t l = 0; l < v.normal_stresses.size(); ++l)
+        levels.push_back({{"normal_stress", v.normal_stresses[l]},
+                          {"peak_shear_stress", stats(l, [](const auto& r) { return r.peak_shear_stress; })},
+                          {"residual_shear_stress", stats(l, [](const auto& r) { return r.residual_shear_stress; })},
+                          {"dilation_at_peak", stats(l, [](const auto& r) { return r.dilation_at_peak; })},
+                          {"peak_dilation_angle_deg", stats(l, [](const auto& r) { return r.peak_dilation_angle; })}});
+    return nlohmann::json{{"test", "shear"},
+                           {"boundary", v.o.normal_stiffness > 0 ? "constant normal stiffness" : "constant normal load"},
+                           {"normal_stiffness", v.o.normal_stiffness},
+                           {"persistence", v.o.persistence},
+                           {"bridges", v.o.bridges},
+                           {"width", v.o.width},
+                           {"realizations", per},
+                           {"levels", levels},
+                           {"peak_coulomb", coulomb_fit(sn_peak, tau_peak)},
+                           {"residual_coulomb", coulomb_fit(sn_res, tau_res)},
+                           {"runs", runs}};
+}
+
+/// shear.csv (every run's curve), shear_stress.png and dilation.png.
+void write_shear_curves(const std::vector<ShearTestResult>& results, const std::filesystem::path& out) {
+    std::ostringstream csv;
+    csv.precision(10);
+    csv << "normal_stress_Pa,seed,step,shear_displacement_m,shear_stress_Pa,normal_stress_now_Pa,dilation_m,"
+           "cracks_tensile,cracks_shear\n";
+    std::vector<io::Series> tau, dil;
+    for (const auto& r : results) {
+        io::Series a{run_name(r.normal_stress, r.seed), {}, {}}, b = a;
+        for (const auto& p : r.curve) {
+            csv << r.normal_stress << ',' << r.seed << ',' << p.step << ',' << p.displacement << ',' << p.shear_stress
+                << ',' << p.normal_stress << ',' << p.dilation << ',' << p.cracks_tensile << ',' << p.cracks_shear << '\n';
+            a.x.push_back(1e3 * p.displacement), a.y.push_back(1e-6 * p.shear_stress);
+            b.x.push_back(1e3 * p.displacement), b.y.push_back(1e3 * p.dilation);
+        }
+        tau.push_back(std::move(a)), dil.push_back(std::move(b));
+    }
+    io::write_text_atomically(out / "shear.csv", csv.str());
+    io::draw_curves(tau, "shear displacement (mm)", "shear stress (MPa)", out / "shear_stress.png", "direct shear");
+    io::draw_curves(dil, "shear displacement (mm)", "dilation (mm)", out / "dilation.png", "direct shear: dilation");
+}
+
+/// The series' figures on the console.
+void print_shear_summary(const nlohmann::json& summary) {
+    for (const auto& l : summary["levels"])
+        std::fprintf(stderr, "sigma_n %6.2f MPa: peak %.3f +- %.3f MPa, residual %.3f MPa\n",
+                     l["normal_stress"].get<double>() / 1e6, l["peak_shear_stress"]["mean"].get<double>() / 1e6,
+                     l["peak_shear_stress"]["std"].get<double>() / 1e6, l["residual_shear_stress"]["mean"].get<double>() / 1e6);
+    if (!summary["peak_coulomb"].is_null())
+        std::fprintf(stderr, "peak: c %.3f MPa, phi %.2f deg; residual: c %.3f MPa, phi %.2f deg\n",
+                     summary["peak_coulomb"]["cohesion"].get<double>() / 1e6,
+                     summary["peak_coulomb"]["friction_deg"].get<double>(),
+                     summary["residual_coulomb"]["cohesion"].get<double>() / 1e6,
+                     summary["residual_coulomb"]["friction_deg"].get<double>());
+}
+
+} // namespace
+
 int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
     check_shear_options(v);
     if (check_only) return 0;
@@ -515,71 +595,13 @@ int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
                          "(normal_stress_error in summary.json): the peak is at another normal stress than asked; "
                          "lower --shear-rate or raise --servo-gain\n",
                          r.normal_stress / 1e6, 100.0 * r.normal_stress_error);
-    // The Coulomb lines over the normal stresses (at the peak: σn there, which CNS moves).
-    std::vector<double> sn_peak, tau_peak, sn_res, tau_res;
-    nlohmann::json runs = nlohmann::json::array();
-    for (const auto& r : results) {
-        sn_peak.push_back(r.normal_stress_at_peak), tau_peak.push_back(r.peak_shear_stress);
-        sn_res.push_back(r.residual_normal_stress), tau_res.push_back(r.residual_shear_stress);
-        runs.push_back(shear_json(r));
-    }
-    auto stats = [&](std::size_t level, auto get) {
-        double m = 0, s2 = 0;
-        for (int k = 0; k < per; ++k) m += get(results[level * per + k]);
-        m /= per;
-        for (int k = 0; k < per; ++k) s2 += std::pow(get(results[level * per + k]) - m, 2);
-        return nlohmann::json{{"mean", m}, {"std", per > 1 ? std::sqrt(s2 / (per - 1)) : 0.0}};
-    };
-    nlohmann::json levels = nlohmann::json::array();
-    for (std::size_t l = 0; l < v.normal_stresses.size(); ++l)
-        levels.push_back({{"normal_stress", v.normal_stresses[l]},
-                          {"peak_shear_stress", stats(l, [](const auto& r) { return r.peak_shear_stress; })},
-                          {"residual_shear_stress", stats(l, [](const auto& r) { return r.residual_shear_stress; })},
-                          {"dilation_at_peak", stats(l, [](const auto& r) { return r.dilation_at_peak; })},
-                          {"peak_dilation_angle_deg", stats(l, [](const auto& r) { return r.peak_dilation_angle; })}});
-    nlohmann::json summary{{"test", "shear"},
-                           {"boundary", v.o.normal_stiffness > 0 ? "constant normal stiffness" : "constant normal load"},
-                           {"normal_stiffness", v.o.normal_stiffness},
-                           {"persistence", v.o.persistence},
-                           {"bridges", v.o.bridges},
-                           {"width", v.o.width},
-                           {"realizations", per},
-                           {"levels", levels},
-                           {"peak_coulomb", coulomb_fit(sn_peak, tau_peak)},
-                           {"residual_coulomb", coulomb_fit(sn_res, tau_res)},
-                           {"runs", runs}};
+    const nlohmann::json summary = shear_summary(v, results);
     if (write && Ranks::root()) {
-        std::ostringstream csv;
-        csv.precision(10);
-        csv << "normal_stress_Pa,seed,step,shear_displacement_m,shear_stress_Pa,normal_stress_now_Pa,dilation_m,"
-               "cracks_tensile,cracks_shear\n";
-        std::vector<io::Series> tau, dil;
-        for (const auto& r : results) {
-            io::Series a{run_name(r.normal_stress, r.seed), {}, {}}, b = a;
-            for (const auto& p : r.curve) {
-                csv << r.normal_stress << ',' << r.seed << ',' << p.step << ',' << p.displacement << ',' << p.shear_stress
-                    << ',' << p.normal_stress << ',' << p.dilation << ',' << p.cracks_tensile << ',' << p.cracks_shear << '\n';
-                a.x.push_back(1e3 * p.displacement), a.y.push_back(1e-6 * p.shear_stress);
-                b.x.push_back(1e3 * p.displacement), b.y.push_back(1e3 * p.dilation);
-            }
-            tau.push_back(std::move(a)), dil.push_back(std::move(b));
-        }
-        io::write_text_atomically(out / "shear.csv", csv.str());
-        io::draw_curves(tau, "shear displacement (mm)", "shear stress (MPa)", out / "shear_stress.png", "direct shear");
-        io::draw_curves(dil, "shear displacement (mm)", "dilation (mm)", out / "dilation.png", "direct shear: dilation");
+        write_shear_curves(results, out);
         io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
     }
     if (!quiet) {
-        for (const auto& l : levels)
-            std::fprintf(stderr, "sigma_n %6.2f MPa: peak %.3f +- %.3f MPa, residual %.3f MPa\n",
-                         l["normal_stress"].get<double>() / 1e6, l["peak_shear_stress"]["mean"].get<double>() / 1e6,
-                         l["peak_shear_stress"]["std"].get<double>() / 1e6, l["residual_shear_stress"]["mean"].get<double>() / 1e6);
-        if (!summary["peak_coulomb"].is_null())
-            std::fprintf(stderr, "peak: c %.3f MPa, phi %.2f deg; residual: c %.3f MPa, phi %.2f deg\n",
-                         summary["peak_coulomb"]["cohesion"].get<double>() / 1e6,
-                         summary["peak_coulomb"]["friction_deg"].get<double>(),
-                         summary["residual_coulomb"]["cohesion"].get<double>() / 1e6,
-                         summary["residual_coulomb"]["friction_deg"].get<double>());
+        print_shear_summary(summary);
         if (write) std::fprintf(stderr, "wrote %s\n", (out / "summary.json").string().c_str());
     }
     if (study) {
