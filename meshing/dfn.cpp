@@ -328,6 +328,100 @@ SetSize expected_size(const DfnSetSpec& s, const cgal::Domain& domain) {
 }
 } // namespace dfn
 
+namespace {
+
+/// The centres of a set's fractures in the box `grown`: n Poisson points, or a
+/// Thomas process (cluster centres uniform over the box grown by 4σ more, each
+/// fracture about a random cluster's centre; those landing outside the grown box
+/// are dropped, which keeps the density stationary inside).
+std::vector<Vec2> set_centres(const DfnSetSpec& s, const Box2& grown, long n, detail::Random& rng) {
+    std::vector<Vec2> centre(n);
+    if (s.centres == DfnSetSpec::Centres::poisson) {
+        for (auto& c : centre) c = {rng.uniform(grown.lo.x, grown.hi.x), rng.uniform(grown.lo.y, grown.hi.y)};
+        return centre;
+    }
+    const double r = s.cluster_radius;
+    Box2 wide = grown;
+    wide.lo = wide.lo - Vec2{4 * r, 4 * r};
+    wide.hi = wide.hi + Vec2{4 * r, 4 * r};
+    const double scale = wide.width() * wide.height() / (grown.width() * grown.height());
+    const long clusters = std::max(1L, std::lround(double(n) * scale / s.cluster_size));
+    std::vector<Vec2> parent(clusters);
+    for (auto& p : parent) p = {rng.uniform(wide.lo.x, wide.hi.x), rng.uniform(wide.lo.y, wide.hi.y)};
+    centre.clear();
+    const long total = std::lround(double(n) * scale);
+    for (long i = 0; i < total; ++i) {
+        const Vec2 p = parent[std::min<long>(clusters - 1, long(rng.uniform() * double(clusters)))];
+        const Vec2 c = p + r * Vec2{standard_normal(rng), standard_normal(rng)};
+        if (c.x >= grown.lo.x && c.x <= grown.hi.x && c.y >= grown.lo.y && c.y <= grown.hi.y) centre.push_back(c);
+    }
+    return centre;
+}
+
+/// Set k's fractures [first, end) terminated at the earlier sets it names: out
+/// from each fracture's centre along each half, the crossings in order; at each,
+/// the fracture ends there with probability p.
+void terminate_at_older_sets(FractureNetwork& net, const DfnSetSpec& s, const std::vector<int>& set_first, int first,
+                             double cell, detail::Random& rng) {
+    std::vector<std::pair<Vec2, Vec2>> older;
+    std::vector<int> older_index; // each one's index in net.fractures
+    for (int j : s.terminate_at)
+        for (int i = set_first[j]; i < set_first[j + 1]; ++i) {
+            older.push_back({net.fractures[i].a, net.fractures[i].b});
+            older_index.push_back(i);
+        }
+    if (older.empty()) return;
+    const detail::SegmentGrid grid(std::move(older), cell);
+    std::vector<int> near;
+    std::vector<std::pair<double, int>> ts; // crossing parameter, the fracture crossed
+    for (int i = first; i < int(net.fractures.size()); ++i) {
+        Fracture& f = net.fractures[i];
+        Box2 fb;
+        fb.add(f.a);
+        fb.add(f.b);
+        near.clear();
+        grid.for_each_near(fb, [&](int j) { near.push_back(j); });
+        std::sort(near.begin(), near.end());
+        near.erase(std::unique(near.begin(), near.end()), near.end());
+        ts.clear();
+        for (int j : near) {
+            const auto& [p, q] = grid.segments()[j];
+            if (const double t = crossing(f.a, f.b, p, q); t >= 0.0) ts.push_back({t, older_index[j]});
+        }
+        std::sort(ts.begin(), ts.end());
+        double hi = 1.0, lo = 0.0;
+        for (const auto& [t, j] : ts) // the half towards b, outwards from the centre
+            if (t > 0.5 && rng.uniform() < s.terminate_probability) { hi = t, f.b_at = j; break; }
+        for (auto it = ts.rbegin(); it != ts.rend(); ++it) // the half towards a
+            if (it->first < 0.5 && rng.uniform() < s.terminate_probability) { lo = it->first, f.a_at = it->second; break; }
+        const Vec2 a = f.a, d = f.b - f.a;
+        f.a = a + lo * d, f.b = a + hi * d;
+    }
+}
+
+/// The traces: each fracture clipped to the region (one crossing no part of it
+/// leaves none); per set, its traces.
+std::vector<std::vector<SegmentSpec>> clip_network(FractureNetwork& net, std::size_t set_count, const Box2& box,
+                                                   const cgal::Domain& domain) {
+    std::vector<std::vector<SegmentSpec>> per_set(set_count);
+    for (int i = 0; i < int(net.fractures.size()); ++i) {
+        const Fracture& f = net.fractures[std::size_t(i)];
+        Box2 fb;
+        fb.add(f.a);
+        fb.add(f.b);
+        if (fb.hi.x < box.lo.x || fb.lo.x > box.hi.x || fb.hi.y < box.lo.y || fb.lo.y > box.hi.y) continue;
+        for (const auto& piece : dfn::clip_to_domain(f.a, f.b, domain)) {
+            net.traces.push_back(piece);
+            net.trace_set.push_back(f.set);
+            net.trace_fracture.push_back(i);
+            per_set[f.set].push_back(piece);
+        }
+    }
+    return per_set;
+}
+
+} // namespace
+
 FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, const cgal::Domain& domain) {
     FractureNetwork net;
     const Box2 box = box_of(domain);
@@ -353,89 +447,16 @@ FractureNetwork generate_fracture_network(std::span<const DfnSetSpec> sets, cons
         grown.lo = grown.lo - Vec2{0.5 * longest, 0.5 * longest};
         grown.hi = grown.hi + Vec2{0.5 * longest, 0.5 * longest};
         const long n = std::lround(density * grown.width() * grown.height()); // dfn::expected_size
-        std::vector<Vec2> centre(n);
-        if (s.centres == DfnSetSpec::Centres::poisson) {
-            for (auto& c : centre) c = {rng.uniform(grown.lo.x, grown.hi.x), rng.uniform(grown.lo.y, grown.hi.y)};
-        } else {
-            // Thomas process: cluster centres uniform over the box grown by 4σ more,
-            // each fracture about a random cluster's centre; those landing outside
-            // the grown box are dropped, which keeps the density stationary inside.
-            const double r = s.cluster_radius;
-            Box2 wide = grown;
-            wide.lo = wide.lo - Vec2{4 * r, 4 * r};
-            wide.hi = wide.hi + Vec2{4 * r, 4 * r};
-            const double scale = wide.width() * wide.height() / (grown.width() * grown.height());
-            const long clusters = std::max(1L, std::lround(double(n) * scale / s.cluster_size));
-            std::vector<Vec2> parent(clusters);
-            for (auto& p : parent) p = {rng.uniform(wide.lo.x, wide.hi.x), rng.uniform(wide.lo.y, wide.hi.y)};
-            centre.clear();
-            const long total = std::lround(double(n) * scale);
-            for (long i = 0; i < total; ++i) {
-                const Vec2 p = parent[std::min<long>(clusters - 1, long(rng.uniform() * double(clusters)))];
-                const Vec2 c = p + r * Vec2{standard_normal(rng), standard_normal(rng)};
-                if (c.x >= grown.lo.x && c.x <= grown.hi.x && c.y >= grown.lo.y && c.y <= grown.hi.y) centre.push_back(c);
-            }
-        }
-        for (const Vec2 c : centre) {
+        for (const Vec2 c : set_centres(s, grown, n, rng)) {
             const double th = sample_angle(s.orientation, rng) * deg, l = sample_length(s.length, diagonal, rng);
             const Vec2 h = 0.5 * l * Vec2{std::cos(th), std::sin(th)};
             net.fractures.push_back({c - h, c + h, k, c - h, c + h});
         }
-        // Termination at earlier sets: out from the centre along each half, the
-        // crossings in order; at each, the fracture ends there with probability p.
-        if (s.terminate_probability > 0.0 && !s.terminate_at.empty()) {
-            std::vector<std::pair<Vec2, Vec2>> older;
-            std::vector<int> older_index; // each one's index in net.fractures
-            for (int j : s.terminate_at)
-                for (int i = set_first[j]; i < set_first[j + 1]; ++i) {
-                    older.push_back({net.fractures[i].a, net.fractures[i].b});
-                    older_index.push_back(i);
-                }
-            if (older.empty()) continue;
-            const detail::SegmentGrid grid(std::move(older), std::max(mean, 1e-6 * diagonal));
-            std::vector<int> near;
-            std::vector<std::pair<double, int>> ts; // crossing parameter, the fracture crossed
-            for (int i = set_first[k]; i < int(net.fractures.size()); ++i) {
-                Fracture& f = net.fractures[i];
-                Box2 fb;
-                fb.add(f.a);
-                fb.add(f.b);
-                near.clear();
-                grid.for_each_near(fb, [&](int j) { near.push_back(j); });
-                std::sort(near.begin(), near.end());
-                near.erase(std::unique(near.begin(), near.end()), near.end());
-                ts.clear();
-                for (int j : near) {
-                    const auto& [p, q] = grid.segments()[j];
-                    if (const double t = crossing(f.a, f.b, p, q); t >= 0.0) ts.push_back({t, older_index[j]});
-                }
-                std::sort(ts.begin(), ts.end());
-                double hi = 1.0, lo = 0.0;
-                for (const auto& [t, j] : ts) // the half towards b, outwards from the centre
-                    if (t > 0.5 && rng.uniform() < s.terminate_probability) { hi = t, f.b_at = j; break; }
-                for (auto it = ts.rbegin(); it != ts.rend(); ++it) // the half towards a
-                    if (it->first < 0.5 && rng.uniform() < s.terminate_probability) { lo = it->first, f.a_at = it->second; break; }
-                const Vec2 a = f.a, d = f.b - f.a;
-                f.a = a + lo * d, f.b = a + hi * d;
-            }
-        }
+        if (s.terminate_probability > 0.0 && !s.terminate_at.empty())
+            terminate_at_older_sets(net, s, set_first, set_first[k], std::max(mean, 1e-6 * diagonal), rng);
     }
     set_first.push_back(int(net.fractures.size()));
-    // Clip to the region; a fracture crossing no part of it leaves no trace.
-    std::vector<std::vector<SegmentSpec>> per_set(sets.size());
-    for (int i = 0; i < int(net.fractures.size()); ++i) {
-        const Fracture& f = net.fractures[std::size_t(i)];
-        Box2 fb;
-        fb.add(f.a);
-        fb.add(f.b);
-        if (fb.hi.x < box.lo.x || fb.lo.x > box.hi.x || fb.hi.y < box.lo.y || fb.lo.y > box.hi.y) continue;
-        for (const auto& piece : dfn::clip_to_domain(f.a, f.b, domain)) {
-            net.traces.push_back(piece);
-            net.trace_set.push_back(f.set);
-            net.trace_fracture.push_back(i);
-            per_set[f.set].push_back(piece);
-        }
-    }
+    const auto per_set = clip_network(net, sets.size(), box, domain);
     for (int k = 0; k < int(sets.size()); ++k)
         net.stats.push_back(measure(sets[k], net.fractures, k, per_set[k], domain, area, diagonal));
     return net;

@@ -98,8 +98,12 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
     return g;
 }
 
-AnalysisSpec labtest_analysis(const LabTestOptions& o) {
-    AnalysisSpec an;
+namespace {
+
+/// The specimen's material and joint properties: the rock's bonds (drawn with
+/// the specimen's seed), the platens' contacts, a joint set, and the unbonded
+/// contacts that form during the test.
+void add_labtest_materials(AnalysisSpec& an, const LabTestOptions& o) {
     MaterialSpec rock;
     rock.name = "rock";
     rock.density = o.material.density;
@@ -112,8 +116,7 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     an.joint_properties.push_back(o.joint);
     // Heterogeneous bonds are a property of the specimen: drawn with its seed.
     an.joint_properties.back().strength_seed = o.seed;
-    const bool platen_blocks = uses_platen_blocks(o);
-    if (platen_blocks) {
+    if (uses_platen_blocks(o)) {
         JointPropertySpec platen;
         platen.name = "platen";
         platen.law = JointPropertySpec::Law::coulomb;
@@ -146,6 +149,14 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     unbonded.friction = o.joint.residual_friction >= 0 ? o.joint.residual_friction : o.joint.friction;
     an.joint_properties.push_back(unbonded);
     an.solver.new_contact_property = unbonded.name;
+}
+
+} // namespace
+
+AnalysisSpec labtest_analysis(const LabTestOptions& o) {
+    AnalysisSpec an;
+    add_labtest_materials(an, o);
+    const bool platen_blocks = uses_platen_blocks(o);
     const double h = specimen_height(o), band = 0.5 * o.size, v = o.strain_per_step * h;
     const double big = 10.0 * (o.width + h);
     // Rectangular specimens: every block with an edge on the loaded face moves with

@@ -98,6 +98,78 @@ nlohmann::json verdict_json(const Verdict& v) {
             {"fragment_mass_t_per_m", v.fragment_mass / 1000.0}};
 }
 
+namespace {
+
+/// summary.json's "opening": the wall's displacements and convergences, the
+/// cracked depth, the failed zone with its lobes, and hoop stress profiles.
+nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
+    const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);
+    nlohmann::json opening = {
+        {"springline_displacement", {m.springline_displacement.x, m.springline_displacement.y}},
+        {"crown_displacement", {m.crown_displacement.x, m.crown_displacement.y}},
+        {"springline_convergence", m.springline_convergence},
+        {"crown_convergence", m.crown_convergence},
+        {"failed_depth_springline", m.failed_depth_springline},
+        {"failed_depth_crown", m.failed_depth_crown},
+        {"cracks_springline_sector", m.cracks_springline_sector},
+        {"cracks_crown_sector", m.cracks_crown_sector},
+        {"springline_sector_tensile", m.tensile_springline_sector},
+        {"springline_sector_shear", m.shear_springline_sector}};
+    const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
+    opening["failed_zone"] = {{"cell_m", zone.cell},
+                                         {"threshold_broken_fraction", zone.threshold},
+                                         {"sector_deg", 360.0 / double(zone.depth.size())},
+                                         {"depth_by_sector_m", zone.depth},
+                                         {"depth_springline", zone.depth_springline},
+                                         {"depth_crown", zone.depth_crown},
+                                         {"extent_springline_deg", zone.extent_springline_deg},
+                                         {"extent_crown_deg", zone.extent_crown_deg},
+                                         {"area_m2", zone.area},
+                                         {"reaches_region_edge", zone.reaches_region_edge},
+                                         {"region_edge_cells", zone.edge_cells},
+                                         {"region_edge_cells_damaged", zone.edge_cells_damaged}};
+    nlohmann::json lobes = nlohmann::json::array();
+    for (const auto& l : zone.lobes())
+        lobes.push_back({{"centre_deg", l.centre_deg}, {"depth_m", l.depth}, {"width_deg", l.width_deg}, {"area_m2", l.area}});
+    opening["failed_zone"]["lobes"] = lobes;
+    if (zone.reaches_region_edge)
+        opening["failed_zone"]["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
+    // Hoop stress profiles from the wall outwards (compression positive, MPa).
+    const auto stress = solver.block_stresses();
+    const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
+    nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
+    for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
+        const double hs = hoop_stress_at(solver, stress, rep.center, rep.springline, f * a_s, 0.3);
+        const double hc = hoop_stress_at(solver, stress, rep.center, rep.crown, f * a_c, 0.3);
+        spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
+        crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
+    }
+    opening["hoop_stress_springline"] = spring;
+    opening["hoop_stress_crown"] = crown;
+    return opening;
+}
+
+/// Per installed set of each support type, the figures an engineer reads
+/// ("bolts": loads per bolt; "liners": thrust and moment per metre; …).
+void add_support_summaries(nlohmann::json& summary, const Solver& solver) {
+    for (const auto& support : solver.supports()) {
+        const auto sets = support->summary();
+        if (sets.empty()) continue;
+        nlohmann::json out = nlohmann::json::array();
+        for (const auto& set : sets) {
+            nlohmann::json entry{{"name", set.name}};
+            for (const auto& f : set.figures) {
+                if (f.count) entry[f.key] = static_cast<long>(f.value);
+                else entry[f.key] = f.value;
+            }
+            out.push_back(entry);
+        }
+        summary[support->name()] = out;
+    }
+}
+
+} // namespace
+
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
                            const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
                            const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,
@@ -143,68 +215,9 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             summary["verdict"]["stage"] = r->name;
             break;
         }
-    // Support: per installed set of each type, the figures an engineer reads
-    // ("bolts": loads per bolt; "liners": thrust and moment per metre; …).
-    for (const auto& support : solver.supports()) {
-        const auto sets = support->summary();
-        if (sets.empty()) continue;
-        nlohmann::json out = nlohmann::json::array();
-        for (const auto& set : sets) {
-            nlohmann::json entry{{"name", set.name}};
-            for (const auto& f : set.figures) {
-                if (f.count) entry[f.key] = static_cast<long>(f.value);
-                else entry[f.key] = f.value;
-            }
-            out.push_back(entry);
-        }
-        summary[support->name()] = out;
-    }
+    add_support_summaries(summary, solver);
     const auto& rep = file.analysis.report;
-    if (rep.opening) {
-        const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);
-        summary["opening"] = {
-            {"springline_displacement", {m.springline_displacement.x, m.springline_displacement.y}},
-            {"crown_displacement", {m.crown_displacement.x, m.crown_displacement.y}},
-            {"springline_convergence", m.springline_convergence},
-            {"crown_convergence", m.crown_convergence},
-            {"failed_depth_springline", m.failed_depth_springline},
-            {"failed_depth_crown", m.failed_depth_crown},
-            {"cracks_springline_sector", m.cracks_springline_sector},
-            {"cracks_crown_sector", m.cracks_crown_sector},
-            {"springline_sector_tensile", m.tensile_springline_sector},
-            {"springline_sector_shear", m.shear_springline_sector}};
-        const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
-        summary["opening"]["failed_zone"] = {{"cell_m", zone.cell},
-                                             {"threshold_broken_fraction", zone.threshold},
-                                             {"sector_deg", 360.0 / double(zone.depth.size())},
-                                             {"depth_by_sector_m", zone.depth},
-                                             {"depth_springline", zone.depth_springline},
-                                             {"depth_crown", zone.depth_crown},
-                                             {"extent_springline_deg", zone.extent_springline_deg},
-                                             {"extent_crown_deg", zone.extent_crown_deg},
-                                             {"area_m2", zone.area},
-                                             {"reaches_region_edge", zone.reaches_region_edge},
-                                             {"region_edge_cells", zone.edge_cells},
-                                             {"region_edge_cells_damaged", zone.edge_cells_damaged}};
-        nlohmann::json lobes = nlohmann::json::array();
-        for (const auto& l : zone.lobes())
-            lobes.push_back({{"centre_deg", l.centre_deg}, {"depth_m", l.depth}, {"width_deg", l.width_deg}, {"area_m2", l.area}});
-        summary["opening"]["failed_zone"]["lobes"] = lobes;
-        if (zone.reaches_region_edge)
-            summary["opening"]["failed_zone"]["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
-        // Hoop stress profiles from the wall outwards (compression positive, MPa).
-        const auto stress = solver.block_stresses();
-        const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
-        nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
-        for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
-            const double hs = hoop_stress_at(solver, stress, rep.center, rep.springline, f * a_s, 0.3);
-            const double hc = hoop_stress_at(solver, stress, rep.center, rep.crown, f * a_c, 0.3);
-            spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
-            crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
-        }
-        summary["opening"]["hoop_stress_springline"] = spring;
-        summary["opening"]["hoop_stress_crown"] = crown;
-    }
+    if (rep.opening) summary["opening"] = opening_summary(solver, rep);
     return summary;
 }
 

@@ -1,6 +1,7 @@
 #include "studies/opening.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -66,86 +67,82 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
     return m;
 }
 
-FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
-                               double threshold, int sectors) {
-    constexpr double pi = 3.141592653589793;
-    FailedZone z;
-    z.cell = cell, z.threshold = threshold, z.center = center;
-    z.radius = std::min(norm(springline - center), norm(crown - center));
-    z.depth.assign(std::size_t(sectors), 0.0);
+namespace {
+
+constexpr double pi = 3.141592653589793;
+
+/// Cells of `cell` width in rings around the opening from the smaller radius out,
+/// `sectors` to a ring, ring-major.
+struct PolarCells {
+    Vec2 center;
+    double radius, cell;
+    int sectors, rings = 0;
+    /// The ring and sector of a point, or ring −1 inside the radius.
+    std::pair<int, int> of(Vec2 p) const {
+        const Vec2 r = p - center;
+        const double d = norm(r);
+        if (d < radius) return {-1, 0};
+        double angle = std::atan2(r.y, r.x);
+        if (angle < 0) angle += 2 * pi;
+        return {int((d - radius) / cell), std::min(sectors - 1, int(angle / (2 * pi) * sectors))};
+    }
+    int size() const { return rings * sectors; }
+};
+
+/// The length of the rock's joints in each cell, all and broken, at their initial
+/// positions; and the cells that hold the edge of the opening's region (an
+/// interface with a deformable region: the elastic far field).
+struct CellJoints {
+    std::vector<double> all, broken;
+    std::vector<std::uint8_t> edge;
+};
+
+CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
     const auto& b = s.blocks();
     const auto& n = s.nodes();
     const auto& c = s.contacts();
-    // Joint length, all and broken, per cell (ring-major) at the joints' initial position.
     auto initial = [&](int v, int blk) {
         const int node = b.vertex_node[v];
         return node >= 0 ? n.position0[node] : b.centroid0[blk] + b.local[v];
     };
-    int rings = 0;
     std::vector<std::pair<int, bool>> where(std::size_t(c.size()), {-1, false});
-    std::vector<double> all, broken;
+    std::vector<std::pair<int, int>> at(std::size_t(c.size()), {-1, 0});
     for (int i = 0; i < c.size(); ++i) {
-        const Vec2 r = initial(c.vertex_id[i], c.vertex_block[i]) - center;
-        const double d = norm(r);
-        if (d < z.radius) continue;
-        const int ring = int((d - z.radius) / cell);
-        double angle = std::atan2(r.y, r.x);
-        if (angle < 0) angle += 2 * pi;
-        const int sector = std::min(sectors - 1, int(angle / (2 * pi) * sectors));
-        rings = std::max(rings, ring + 1);
+        const auto [ring, sector] = g.of(initial(c.vertex_id[i], c.vertex_block[i]));
+        if (ring < 0) continue;
+        g.rings = std::max(g.rings, ring + 1);
         // Joints of the rock only: a contact formed unbonded during the run (between
         // fragments, or a fragment and the wall) is neither intact rock nor a crack.
         const auto& h = c.history[i];
         const bool is_broken = h.broken == contact::JointState::broken_tension || h.broken == contact::JointState::broken_shear;
         if (!h.bonded && !is_broken) continue;
-        where[std::size_t(i)] = {ring * sectors + sector, is_broken};
+        where[std::size_t(i)] = {ring * g.sectors + sector, is_broken};
     }
-    all.assign(std::size_t(rings * sectors), 0.0), broken.assign(all.size(), 0.0);
-    // Cells that hold the edge of the opening's region (an interface with a
-    // deformable region: the elastic far field).
-    std::vector<std::uint8_t> edge(all.size(), 0);
+    CellJoints j;
+    j.all.assign(std::size_t(g.size()), 0.0), j.broken.assign(j.all.size(), 0.0);
+    j.edge.assign(j.all.size(), 0);
     for (int i = 0; i < c.size(); ++i) {
         const int ba = c.vertex_block[i], bb = c.edge_block[i];
         if (b.region[ba] == b.region[bb] || b.removed[ba] || b.removed[bb] || !(b.deformable[ba] || b.deformable[bb]))
             continue;
-        const Vec2 r = initial(c.vertex_id[i], ba) - center;
-        const double d = norm(r);
-        if (d < z.radius) continue;
-        double angle = std::atan2(r.y, r.x);
-        if (angle < 0) angle += 2 * pi;
-        const int ring = int((d - z.radius) / cell), sector = std::min(sectors - 1, int(angle / (2 * pi) * sectors));
-        if (ring < rings) edge[std::size_t(ring * sectors + sector)] = 1;
+        const auto [ring, sector] = g.of(initial(c.vertex_id[i], ba));
+        if (ring >= 0 && ring < g.rings) j.edge[std::size_t(ring * g.sectors + sector)] = 1;
     }
     for (int i = 0; i < c.size(); ++i) {
         const auto [cell_index, is_broken] = where[std::size_t(i)];
         if (cell_index < 0) continue;
-        all[std::size_t(cell_index)] += c.length[i];
-        if (is_broken) broken[std::size_t(cell_index)] += c.length[i];
+        j.all[std::size_t(cell_index)] += c.length[i];
+        if (is_broken) j.broken[std::size_t(cell_index)] += c.length[i];
     }
-    auto damaged = [&](int k) { return all[std::size_t(k)] > 0 && broken[std::size_t(k)] >= threshold * all[std::size_t(k)]; };
-    // The wall in each sector: its innermost ring that holds rock (rings start at
-    // the smaller radius; an opening that is not a circle leaves the first rings of
-    // its longer directions empty). Flood from the damaged cells at the wall.
-    std::vector<int> wall(std::size_t(sectors), rings);
-    for (int sector = 0; sector < sectors; ++sector)
-        for (int ring = 0; ring < rings; ++ring)
-            if (all[std::size_t(ring * sectors + sector)] > 0) {
-                wall[std::size_t(sector)] = ring;
-                break;
-            }
-    // The band along that edge: its cells and their neighbours, inside it.
-    auto near_edge = [&](int k) {
-        const int ring = k / sectors, sector = k % sectors;
-        for (int dr = -1; dr <= 1; ++dr)
-            for (int ds = -1; ds <= 1; ++ds) {
-                const int rr = ring + dr, ss = (sector + ds + sectors) % sectors;
-                if (rr >= 0 && rr < rings && edge[std::size_t(rr * sectors + ss)]) return true;
-            }
-        return false;
-    };
-    for (int k = 0; k < int(all.size()); ++k)
-        if (all[std::size_t(k)] > 0 && near_edge(k)) ++z.edge_cells, z.edge_cells_damaged += damaged(k);
-    std::vector<std::uint8_t> in_zone(all.size(), 0);
+    return j;
+}
+
+/// The damaged cells connected to the wall: flooded from the damaged cells of
+/// each sector's innermost ring that holds rock (`wall`), across rings and sectors.
+std::vector<std::uint8_t> flood_from_wall(const PolarCells& g, const std::vector<int>& wall,
+                                          const std::function<bool(int)>& damaged) {
+    const int sectors = g.sectors, rings = g.rings;
+    std::vector<std::uint8_t> in_zone(std::size_t(g.size()), 0);
     std::vector<int> stack;
     for (int sector = 0; sector < sectors; ++sector) {
         const int k = wall[std::size_t(sector)] * sectors + sector;
@@ -160,6 +157,56 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
         for (int m : next)
             if (m >= 0 && !in_zone[std::size_t(m)] && damaged(m)) in_zone[std::size_t(m)] = 1, stack.push_back(m);
     }
+    return in_zone;
+}
+
+/// Toward a point of the wall: the deepest sector whose centre is within 15 deg,
+/// and the angular width of the zone within 45 deg.
+void zone_toward(const FailedZone& z, int sectors, Vec2 towards, double& depth, double& extent) {
+    const Vec2 dir = (towards - z.center) / norm(towards - z.center);
+    for (int k = 0; k < sectors; ++k) {
+        const double mid = (k + 0.5) * 2 * pi / sectors;
+        const double off = std::acos(std::clamp(dir.x * std::cos(mid) + dir.y * std::sin(mid), -1.0, 1.0)) * 180 / pi;
+        if (off <= 15.0 + 1e-9) depth = std::max(depth, z.depth[std::size_t(k)]);
+        if (off <= 45.0 + 1e-9 && z.depth[std::size_t(k)] > 0) extent += 360.0 / sectors;
+    }
+}
+
+} // namespace
+
+FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
+                               double threshold, int sectors) {
+    FailedZone z;
+    z.cell = cell, z.threshold = threshold, z.center = center;
+    z.radius = std::min(norm(springline - center), norm(crown - center));
+    z.depth.assign(std::size_t(sectors), 0.0);
+    PolarCells g{center, z.radius, cell, sectors};
+    const CellJoints j = joints_per_cell(s, g);
+    const int rings = g.rings;
+    auto damaged = [&](int k) { return j.all[std::size_t(k)] > 0 && j.broken[std::size_t(k)] >= threshold * j.all[std::size_t(k)]; };
+    // The wall in each sector: its innermost ring that holds rock (rings start at
+    // the smaller radius; an opening that is not a circle leaves the first rings of
+    // its longer directions empty).
+    std::vector<int> wall(std::size_t(sectors), rings);
+    for (int sector = 0; sector < sectors; ++sector)
+        for (int ring = 0; ring < rings; ++ring)
+            if (j.all[std::size_t(ring * sectors + sector)] > 0) {
+                wall[std::size_t(sector)] = ring;
+                break;
+            }
+    // The band along the region's edge: its cells and their neighbours, inside it.
+    auto near_edge = [&](int k) {
+        const int ring = k / sectors, sector = k % sectors;
+        for (int dr = -1; dr <= 1; ++dr)
+            for (int ds = -1; ds <= 1; ++ds) {
+                const int rr = ring + dr, ss = (sector + ds + sectors) % sectors;
+                if (rr >= 0 && rr < rings && j.edge[std::size_t(rr * sectors + ss)]) return true;
+            }
+        return false;
+    };
+    for (int k = 0; k < g.size(); ++k)
+        if (j.all[std::size_t(k)] > 0 && near_edge(k)) ++z.edge_cells, z.edge_cells_damaged += damaged(k);
+    const std::vector<std::uint8_t> in_zone = flood_from_wall(g, wall, damaged);
     for (std::size_t k = 0; k < in_zone.size(); ++k) {
         if (!in_zone[k]) continue;
         const int ring = int(k) / sectors, sector = int(k) % sectors;
@@ -172,22 +219,11 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
         const double r0 = z.radius + ring * cell, r1 = r0 + cell;
         z.area += pi * (r1 * r1 - r0 * r0) / sectors;
     }
-    // Per direction: the deepest sector whose centre is within 15 deg, and the
-    // angular width of the zone within 45 deg.
-    auto about = [&](Vec2 towards, double& depth, double& extent) {
-        const Vec2 dir = (towards - center) / norm(towards - center);
-        for (int k = 0; k < sectors; ++k) {
-            const double mid = (k + 0.5) * 2 * pi / sectors;
-            const double off = std::acos(std::clamp(dir.x * std::cos(mid) + dir.y * std::sin(mid), -1.0, 1.0)) * 180 / pi;
-            if (off <= 15.0 + 1e-9) depth = std::max(depth, z.depth[std::size_t(k)]);
-            if (off <= 45.0 + 1e-9 && z.depth[std::size_t(k)] > 0) extent += 360.0 / sectors;
-        }
-    };
     z.wall_offset.assign(std::size_t(sectors), 0.0);
     for (int sector = 0; sector < sectors; ++sector)
         if (wall[std::size_t(sector)] < rings) z.wall_offset[std::size_t(sector)] = wall[std::size_t(sector)] * cell;
-    about(springline, z.depth_springline, z.extent_springline_deg);
-    about(crown, z.depth_crown, z.extent_crown_deg);
+    zone_toward(z, sectors, springline, z.depth_springline, z.extent_springline_deg);
+    zone_toward(z, sectors, crown, z.depth_crown, z.extent_crown_deg);
     return z;
 }
 

@@ -140,6 +140,36 @@ struct ShearBox {
 
 } // namespace
 
+namespace {
+
+/// A run's figures from its curve and its peak: peak, residual (the mean over the
+/// last tenth of the displacement), dilation and the steepest dilation angle.
+void shear_figures(ShearTestResult& r, const ShearPoint& peak) {
+    const auto& c = r.curve;
+    r.peak_shear_stress = peak.shear_stress;
+    r.displacement_at_peak = peak.displacement;
+    r.normal_stress_at_peak = peak.normal_stress;
+    r.dilation_at_peak = peak.dilation;
+    r.final_dilation = c.back().dilation;
+    const double u_end = c.back().displacement;
+    int n = 0;
+    for (const auto& p : c)
+        if (p.displacement >= 0.9 * u_end) r.residual_shear_stress += p.shear_stress, r.residual_normal_stress += p.normal_stress, ++n;
+    if (n > 0) r.residual_shear_stress /= n, r.residual_normal_stress /= n;
+    // Dilation angle: the steepest least-squares slope dv/du over windows of 5% of the run.
+    double steepest = 0.0;
+    for (std::size_t a = 0, b = 0; a < c.size(); ++a) {
+        while (b < c.size() && c[b].displacement < c[a].displacement + 0.05 * u_end) ++b;
+        if (b >= c.size()) break;
+        std::vector<double> x, y;
+        for (std::size_t k = a; k <= b; ++k) x.push_back(c[k].displacement), y.push_back(c[k].dilation);
+        steepest = std::max(steepest, fit_slope(x, y));
+    }
+    r.peak_dilation_angle = std::atan(steepest) * 180.0 / std::numbers::pi;
+}
+
+} // namespace
+
 ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<void(const ShearPoint&)>& progress,
                                const std::function<void(const Solver&, const ShearTestResult&)>& on_finish,
                                const std::function<void(const Solver&, const ShearPoint&)>& on_frame) {
@@ -219,28 +249,7 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
         if (progress) progress(p);
         if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
     }
-    // Peak, residual (the last tenth of the displacement), dilation.
-    const auto& c = r.curve;
-    r.peak_shear_stress = peak.shear_stress;
-    r.displacement_at_peak = peak.displacement;
-    r.normal_stress_at_peak = peak.normal_stress;
-    r.dilation_at_peak = peak.dilation;
-    r.final_dilation = c.back().dilation;
-    const double u_end = c.back().displacement;
-    int n = 0;
-    for (const auto& p : c)
-        if (p.displacement >= 0.9 * u_end) r.residual_shear_stress += p.shear_stress, r.residual_normal_stress += p.normal_stress, ++n;
-    if (n > 0) r.residual_shear_stress /= n, r.residual_normal_stress /= n;
-    // Dilation angle: the steepest least-squares slope dv/du over windows of 5% of the run.
-    double steepest = 0.0;
-    for (std::size_t a = 0, b = 0; a < c.size(); ++a) {
-        while (b < c.size() && c[b].displacement < c[a].displacement + 0.05 * u_end) ++b;
-        if (b >= c.size()) break;
-        std::vector<double> x, y;
-        for (std::size_t k = a; k <= b; ++k) x.push_back(c[k].displacement), y.push_back(c[k].dilation);
-        steepest = std::max(steepest, fit_slope(x, y));
-    }
-    r.peak_dilation_angle = std::atan(steepest) * 180.0 / std::numbers::pi;
+    shear_figures(r, peak);
     r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
     r.cracks_shear = s.cracks(contact::JointState::broken_shear);
     r.steps = s.steps();
