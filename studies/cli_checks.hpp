@@ -89,19 +89,7 @@ inline CLI::Validator whole_within(const Bounds& b) {
 /// A whole number >= lo (for counts and seeds held in unsigned or int options:
 /// refuses "-3" before an unsigned parse wraps it around).
 inline CLI::Validator whole_at_least(long long lo) {
-    return CLI::Validator(
-        [lo](std::string& text) -> std::string {
-            std::size_t used = 0;
-            long long v = 0;
-            try {
-                v = std::stoll(text, &used);
-            } catch (const std::exception&) {
-                return "must be a whole number >= " + std::to_string(lo) + ", got " + text;
-            }
-            if (used != text.size() || v < lo) return "must be a whole number >= " + std::to_string(lo) + ", got " + text;
-            return {};
-        },
-        ">= " + std::to_string(lo));
+    return whole_within(at_least(double(lo), ""));
 }
 
 /// Parses option strings (the Python module's keywords) with a command's option

@@ -117,17 +117,17 @@ nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
         {"springline_sector_shear", m.shear_springline_sector}};
     const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
     opening["failed_zone"] = {{"cell_m", zone.cell},
-                                         {"threshold_broken_fraction", zone.threshold},
-                                         {"sector_deg", 360.0 / double(zone.depth.size())},
-                                         {"depth_by_sector_m", zone.depth},
-                                         {"depth_springline", zone.depth_springline},
-                                         {"depth_crown", zone.depth_crown},
-                                         {"extent_springline_deg", zone.extent_springline_deg},
-                                         {"extent_crown_deg", zone.extent_crown_deg},
-                                         {"area_m2", zone.area},
-                                         {"reaches_region_edge", zone.reaches_region_edge},
-                                         {"region_edge_cells", zone.edge_cells},
-                                         {"region_edge_cells_damaged", zone.edge_cells_damaged}};
+                              {"threshold_broken_fraction", zone.threshold},
+                              {"sector_deg", 360.0 / double(zone.depth.size())},
+                              {"depth_by_sector_m", zone.depth},
+                              {"depth_springline", zone.depth_springline},
+                              {"depth_crown", zone.depth_crown},
+                              {"extent_springline_deg", zone.extent_springline_deg},
+                              {"extent_crown_deg", zone.extent_crown_deg},
+                              {"area_m2", zone.area},
+                              {"reaches_region_edge", zone.reaches_region_edge},
+                              {"region_edge_cells", zone.edge_cells},
+                              {"region_edge_cells_damaged", zone.edge_cells_damaged}};
     nlohmann::json lobes = nlohmann::json::array();
     for (const auto& l : zone.lobes())
         lobes.push_back({{"centre_deg", l.centre_deg}, {"depth_m", l.depth}, {"width_deg", l.width_deg}, {"area_m2", l.area}});
