@@ -523,8 +523,6 @@ std::vector<std::pair<double, double>> read_curve(const Ctx& c, const toml::tabl
     return pts;
 }
 
-/// Peak strength of a softening law: > 0, the curves are normalised by it.
-
 /// strength_classes and strength_seed go with a Weibull modulus.
 void check_heterogeneity_keys(const Ctx& c, const toml::table& t, const Path& p, const JointPropertySpec& j) {
     if (j.weibull_modulus > 0.0) return;
