@@ -22,7 +22,7 @@ LabTestOptions deformable(std::uint64_t seed, double width, double max_strain) {
     auto o = LabTestOptions::paper_ucs();
     o.width = width, o.height = 2.0 * width;
     o.material.deformable_fraction = 0.95;
-    o.max_strain = max_strain;
+    o.stop.max_strain = max_strain;
     o.threads = 1;
     o.seed = seed;
     return o;

@@ -349,18 +349,15 @@ void write_text_atomically(const fs::path& file, std::string_view text) {
     tmp.commit();
 }
 
-void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
+namespace {
+
+/// The state's cells in one grid: rigid blocks (polygons) first, then the zones
+/// of deformable blocks (triangles), with their points' displacement.
+void add_state_cells(vtkUnstructuredGrid* grid, const Solver& s, const std::vector<int>& kept,
+                     const std::vector<int>& zones) {
     const auto& b = s.blocks();
     const auto& nodes = s.nodes();
     const auto& z = s.zones();
-    const auto stress = s.block_stresses();
-    // Cells: rigid blocks (polygons) first, then the zones of deformable blocks
-    // (triangles), so one grid shows the whole model.
-    std::vector<int> kept, zones;
-    for (int i = 0; i < b.count(); ++i)
-        if (!b.removed[i] && !b.deformable[i]) kept.push_back(i);
-    for (int k = 0; k < z.size(); ++k)
-        if (!b.removed[z.block[k]]) zones.push_back(k);
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     auto point_disp = double_array("displacement", 0);
@@ -394,10 +391,25 @@ void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
     }
     vtkNew<vtkCellArray> cells;
     cells->SetData(offsets, connectivity);
-    vtkNew<vtkUnstructuredGrid> grid;
     grid->SetPoints(points);
     grid->SetCells(types, cells);
     grid->GetPointData()->AddArray(point_disp);
+}
+
+} // namespace
+
+void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
+    const auto& b = s.blocks();
+    const auto& nodes = s.nodes();
+    const auto& z = s.zones();
+    const auto stress = s.block_stresses();
+    std::vector<int> kept, zones; // the rigid blocks and the zones not removed
+    for (int i = 0; i < b.count(); ++i)
+        if (!b.removed[i] && !b.deformable[i]) kept.push_back(i);
+    for (int k = 0; k < z.size(); ++k)
+        if (!b.removed[z.block[k]]) zones.push_back(k);
+    vtkNew<vtkUnstructuredGrid> grid;
+    add_state_cells(grid, s, kept, zones);
     const auto nk = static_cast<vtkIdType>(kept.size());
     const auto n = nk + static_cast<vtkIdType>(zones.size());
     auto id = int_array("block_id", n), region = int_array("region", n), material = int_array("material", n);

@@ -245,6 +245,60 @@ int collapse_short_edges(std::vector<std::vector<Vec2>>& polygons, const cgal::P
 }
 
 // ---------------------------------------------------------------------------
+namespace {
+
+/// Names what a joint between two blocks is: an interface between regions, a
+/// fracture of a set or a real joint (it lies on one of their traces), else by
+/// the blocks' pattern.
+class JointClassifier {
+public:
+    JointClassifier(const BlockAssembly& a, double tol, double cell)
+        : a_(a), tol_(tol), real_(segments(a.real_segments), cell), fracture_(segments(a.fracture_traces), cell) {}
+
+    void classify(JointRecord& j) const {
+        if (a_.region[j.block_a] != a_.region[j.block_b]) {
+            j.tag = JointTag::interface;
+        } else if (const int hit = on_segment(fracture_, j.p0, j.p1); hit >= 0) {
+            j.tag = JointTag::fracture;
+            j.fracture_set = a_.fracture_trace_set[hit];
+        } else if (on_segment(real_, j.p0, j.p1) >= 0) {
+            j.tag = JointTag::real_joint;
+        } else if (a_.pattern[j.block_a] == PatternSpec::Kind::trigon) {
+            j.tag = a_.parent[j.block_a] == a_.parent[j.block_b] ? JointTag::radial : JointTag::peripheral;
+        } else {
+            j.tag = JointTag::inner;
+        }
+    }
+
+private:
+    template <class Segments>
+    static std::vector<std::pair<Vec2, Vec2>> segments(const Segments& from) {
+        std::vector<std::pair<Vec2, Vec2>> out;
+        for (const auto& s : from) out.push_back({s.a, s.b});
+        return out;
+    }
+    /// The segment of `g` that the joint p0p1 lies on (its middle on it, parallel), or −1.
+    int on_segment(const SegmentGrid& g, Vec2 p0, Vec2 p1) const {
+        const Vec2 m = 0.5 * (p0 + p1);
+        int hit = -1;
+        Box2 b;
+        b.add(m);
+        g.for_each_near(b, [&](int s) {
+            const auto& [ra, rb] = g.segments()[s];
+            if (hit < 0 && distance_to_segment(m, ra, rb) <= tol_ &&
+                std::abs(cross(rb - ra, p1 - p0)) <= tol_ * norm(rb - ra))
+                hit = s;
+        });
+        return hit;
+    }
+
+    const BlockAssembly& a_;
+    double tol_;
+    SegmentGrid real_, fracture_;
+};
+
+} // namespace
+
 void build_joints(BlockAssembly& a) {
     a.joints.clear();
     const int nb = a.block_count();
@@ -270,24 +324,7 @@ void build_joints(BlockAssembly& a) {
     const double cell = 2.0 * total / double(edges.size());
     const SegmentGrid grid(std::move(segs), cell);
 
-    std::vector<std::pair<Vec2, Vec2>> real, fracture;
-    for (const auto& s : a.real_segments) real.push_back({s.a, s.b});
-    for (const auto& s : a.fracture_traces) fracture.push_back({s.a, s.b});
-    const SegmentGrid real_grid(std::move(real), cell), fracture_grid(std::move(fracture), cell);
-    // The segment of `grid` that the joint p0p1 lies on (its middle on it, parallel), or −1.
-    auto on_segment = [&](const SegmentGrid& g, Vec2 p0, Vec2 p1) {
-        const Vec2 m = 0.5 * (p0 + p1);
-        int hit = -1;
-        Box2 b;
-        b.add(m);
-        g.for_each_near(b, [&](int s) {
-            const auto& [ra, rb] = g.segments()[s];
-            if (hit < 0 && distance_to_segment(m, ra, rb) <= tol &&
-                std::abs(cross(rb - ra, p1 - p0)) <= tol * norm(rb - ra))
-                hit = s;
-        });
-        return hit;
-    };
+    const JointClassifier classifier(a, tol, cell);
 
     for (int e1 = 0; e1 < int(edges.size()); ++e1) {
         const Edge& E = edges[e1];
@@ -320,18 +357,7 @@ void build_joints(BlockAssembly& a) {
             j.edge_b = F.index;
             j.p0 = (sq > 0.0) ? F.q : E.p; // actual vertices, never re-rounded projections
             j.p1 = (sp < len) ? F.p : E.q;
-            if (a.region[E.block] != a.region[F.block]) {
-                j.tag = JointTag::interface;
-            } else if (const int hit = on_segment(fracture_grid, j.p0, j.p1); hit >= 0) {
-                j.tag = JointTag::fracture;
-                j.fracture_set = a.fracture_trace_set[hit];
-            } else if (on_segment(real_grid, j.p0, j.p1) >= 0) {
-                j.tag = JointTag::real_joint;
-            } else if (a.pattern[E.block] == PatternSpec::Kind::trigon) {
-                j.tag = a.parent[E.block] == a.parent[F.block] ? JointTag::radial : JointTag::peripheral;
-            } else {
-                j.tag = JointTag::inner;
-            }
+            classifier.classify(j);
             a.joints.push_back(j);
         });
     }

@@ -142,7 +142,7 @@ void print_iteration(int k, const CalibrationIteration& it, const CalibrationOpt
     if (it.still_loading > 0)
         std::fprintf(stderr, "     %d test%s still loading at the strain cap %g: lower bounds, not strengths "
                              "(blocks jammed)\n",
-                     it.still_loading, it.still_loading == 1 ? "" : "s", std::max(o.base.max_strain, o.base.strain_cap));
+                     it.still_loading, it.still_loading == 1 ? "" : "s", std::max(o.base.stop.max_strain, o.base.stop.strain_cap));
 }
 
 /// One row of calibration.json's iteration table.

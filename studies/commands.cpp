@@ -327,7 +327,10 @@ void apply_rock_file(const CLI::App& cmd, LabTestCli& c) {
     keep_given(std::span<const MaterialKey>(material_keys), labtest_material_keys, c.o.material, given.o.material);
 }
 
-void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
+namespace {
+
+/// The specimen: the rock file, the block pattern and the specimen's size.
+void add_specimen_options(CLI::App* sub, LabTestCli& c) {
     auto& o = c.o;
     sub->add_option("--rock", c.rock,
                     "The rock from a file: one [[joint_property]] and at most one [[material]] as a model file has "
@@ -351,6 +354,11 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
     sub->add_option("--seed", o.seed, "Random seed of the block pattern")->check(cli::whole_at_least(0))->capture_default_str();
     sub->add_option("--lloyd", o.lloyd, "Lloyd relaxation iterations (0: cells of random points; more: more regular cells)")
         ->check(cli::non_negative())->capture_default_str();
+}
+
+/// The rock: its bonds, their softening and the blocks' material.
+void add_rock_options(CLI::App* sub, LabTestCli& c) {
+    auto& o = c.o;
     add_joint_flags(sub, o.joint, labtest_joint_keys, "", "The rock's bonds: ");
     sub->add_option("--tension-softening", c.tension_softening, "Tension softening b1,a1,a2 (SPEC §4)")
         ->delimiter(',')->expected(3)->capture_default_str();
@@ -360,22 +368,27 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
                   "The rock's blocks: ");
     sub->add_option("--mesh-size", o.mesh_size, "With --deformable-fraction: triangle size (m; default size / 2)")
         ->check(cli::non_negative());
+}
+
+/// How the platens load: the rate, the servo, the implicit preload, the platens.
+void add_loading_options(CLI::App* sub, LabTestCli& c) {
+    auto& o = c.o;
     sub->add_option("--strain-rate", o.strain_per_step,
                     "Platen velocity over specimen height, per step (with the servo: the unit of its rates)")
         ->check(cli::positive())->capture_default_str();
-    sub->add_option("--servo", o.servo,
+    sub->add_option("--servo", o.servo.on,
                     "Servo-controlled platens: slower while cracks form, faster after failure (docs/calibration.md)")
         ->capture_default_str();
-    sub->add_option("--servo-cracks", o.servo_cracks, "Servo: new cracks per record (20 steps) per 5,000 contacts it aims at")
+    sub->add_option("--servo-cracks", o.servo.cracks, "Servo: new cracks per record (20 steps) per 5,000 contacts it aims at")
         ->check(cli::positive())->capture_default_str();
-    sub->add_option("--servo-balance", o.servo_balance,
+    sub->add_option("--servo-balance", o.servo.balance,
                     "Servo, once cracking has started: largest difference between the top and bottom platen forces, as a fraction of the load (0: off)")
         ->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--servo-min", o.servo_min_factor, "Servo: slowest platen speed, times --strain-rate")
+    sub->add_option("--servo-min", o.servo.min_factor, "Servo: slowest platen speed, times --strain-rate")
         ->check(cli::positive())->capture_default_str();
-    sub->add_option("--servo-max", o.servo_max_factor, "Servo: fastest platen speed before failure, times --strain-rate")
+    sub->add_option("--servo-max", o.servo.max_factor, "Servo: fastest platen speed before failure, times --strain-rate")
         ->check(cli::positive())->capture_default_str();
-    sub->add_option("--servo-post-peak", o.servo_post_peak_factor, "Servo: platen speed after failure, times --strain-rate")
+    sub->add_option("--servo-post-peak", o.servo.post_peak_factor, "Servo: platen speed after failure, times --strain-rate")
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--preload", o.elastic_preload,
                     "The linear part by one implicit solve, up to just below the first joint's yield")
@@ -386,42 +399,61 @@ void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
                     "Rigid platen blocks pressing on the faces through contacts of this friction angle (degrees), "
                     "instead of prescribed face blocks (--platens); ucs and biaxial")
         ->check(cli::within(below(0, 90, degrees)));
-    sub->add_option("--stop-fraction", o.stop_fraction, "Stop after the peak once the stress is below this fraction of it")
+}
+
+/// When a test stops and how its peak is read.
+void add_stop_options(CLI::App* sub, LabTestOptions& o) {
+    sub->add_option("--stop-fraction", o.stop.fraction, "Stop after the peak once the stress is below this fraction of it")
         ->check(cli::in_range(0.0, 1.0))->capture_default_str();
-    sub->add_option("--failure-drop", o.failure_drop,
+    sub->add_option("--failure-drop", o.stop.failure_drop,
                     "A drop by this fraction from the peak marks failure; the run stops if the stress then climbs back above the peak")
         ->check(cli::in_range(0.0, 1.0))->capture_default_str();
     sub->add_option("--frame-every", o.frame_every,
                     "Steps between frames of the failure series in result.pvd (0: the final state only)")
         ->check(cli::non_negative())->capture_default_str();
-    sub->add_option("--max-strain", o.max_strain,
+    sub->add_option("--max-strain", o.stop.max_strain,
                     "Stop at this axial strain; a specimen not failed by then loads on up to --strain-cap")
         ->check(cli::positive())->capture_default_str();
-    sub->add_option("--strain-cap", o.strain_cap,
+    sub->add_option("--strain-cap", o.stop.strain_cap,
                     "Hard limit for a specimen still loading at --max-strain (at most --max-strain: stop there); "
                     "reached unfailed, the peak is a lower bound (still_loading)")
         ->check(cli::non_negative())->capture_default_str();
     sub->add_option_function<std::string>(
-           "--confined-peak", [&o](const std::string& v) { o.confined_peak_at_stall = v == "first-stall"; },
+           "--confined-peak", [&o](const std::string& v) { o.stop.peak_at_first_stall = v == "first-stall"; },
            "Confined tests: lab = the laboratory's peak, the largest stress before a lasting drop by --failure-drop "
            "(a specimen that only hardens loads on to --strain-cap); first-stall = the rule until 2026-11-27, the "
            "first stall of the stress after cracking (docs/calibration.md, The confined peak)")
         ->check(CLI::IsMember({"lab", "first-stall"}))->default_str("lab");
-    sub->add_option("--post-peak-strain", o.post_peak_strain,
+    sub->add_option("--post-peak-strain", o.stop.post_peak_strain,
                     "Confined tests: stop this much axial strain past the failure (the peak's drop; first-stall: past "
                     "the peak) once the specimen has failed (0: go on "
                     "to --max-strain or --stop-fraction; bbm envelope and calibrate use 2e-4)")
         ->check(cli::non_negative());
+}
+
+/// A persistent joint set across the specimen.
+void add_joint_set_options(CLI::App* sub, LabTestOptions& o) {
     sub->add_option_function<double>(
-           "--joint-set-angle", [&o](const double& a) { o.joint_set = true, o.joint_set_angle = a; },
+           "--joint-set-angle", [&o](const double& a) { o.joint_set.on = true, o.joint_set.angle = a; },
            "A persistent joint set across the specimen at this angle from horizontal (degrees; a single plane "
            "of weakness through the centre unless --joint-set-spacing), a Coulomb joint (--joint-set-friction, "
            "--joint-set-cohesion, --joint-set-tensile: a brittle weak bond when > 0)")
         ->check(cli::in_range(0.0, 180.0));
-    sub->add_option("--joint-set-spacing", o.joint_set_spacing, "Joint set: spacing along the normal (m; 0 = one joint)")
+    sub->add_option("--joint-set-spacing", o.joint_set.spacing, "Joint set: spacing along the normal (m; 0 = one joint)")
         ->check(cli::non_negative())->capture_default_str();
     static constexpr std::string_view joint_set_keys[] = {"friction", "residual_friction", "cohesion", "tensile"};
-    add_joint_flags(sub, o.joint_set_joint, joint_set_keys, "joint-set-", "Joint set: ");
+    add_joint_flags(sub, o.joint_set.joint, joint_set_keys, "joint-set-", "Joint set: ");
+}
+
+} // namespace
+
+void add_labtest_options(CLI::App* sub, LabTestCli& c, bool& quiet) {
+    add_specimen_options(sub, c);
+    add_rock_options(sub, c);
+    add_loading_options(sub, c);
+    add_stop_options(sub, c.o);
+    add_joint_set_options(sub, c.o);
+    auto& o = c.o;
     sub->add_option("--realizations", c.realizations, "Number of random realizations (seeds seed, seed+1, ...)")
         ->check(cli::positive())->capture_default_str();
     sub->add_option("--threads", c.threads,
@@ -636,9 +668,9 @@ void prepare_labtest(LabTestCli& c, LabTestOptions::Kind kind) {
         throw InputError("--platen-friction", 0, "",
                          std::string("applies to ucs and biaxial only: ") + labtest_name(kind) +
                              " needs platens that hold the specimen (use --platens rough or smooth)");
-    if (o.joint_set && kind == LabTestOptions::Kind::brazilian)
+    if (o.joint_set.on && kind == LabTestOptions::Kind::brazilian)
         throw InputError("--joint-set-angle", 0, "", "a joint set crosses rectangular specimens: not the brazilian disc");
-    if (o.joint_set && o.joint_set_spacing > 0 && o.joint_set_spacing < o.size)
+    if (o.joint_set.on && o.joint_set.spacing > 0 && o.joint_set.spacing < o.size)
         throw InputError("--joint-set-spacing", 0, "", "closer than a block size (--size)");
     check_specimen_size(c);
 }
@@ -667,10 +699,10 @@ void print_realization(Progress& lines, const LabTestOptions& ok, const LabTestR
     if (r.still_loading)
         std::fprintf(stderr, "  seed %llu: still loading at the strain cap %g, not failed: the peak is a "
                              "lower bound of the strength (jammed blocks, or raise --strain-cap)\n",
-                     static_cast<unsigned long long>(ok.seed), std::max(ok.max_strain, ok.strain_cap));
+                     static_cast<unsigned long long>(ok.seed), std::max(ok.stop.max_strain, ok.stop.strain_cap));
     else if (r.loaded_past_max_strain)
         std::fprintf(stderr, "  seed %llu: not failed at --max-strain %g: loaded on, failed at strain %.4g\n",
-                     static_cast<unsigned long long>(ok.seed), ok.max_strain, r.strain_at_peak);
+                     static_cast<unsigned long long>(ok.seed), ok.stop.max_strain, r.strain_at_peak);
     if (ok.confinement > 0.0 && r.hardened_past_yield())
         std::fprintf(stderr, "  seed %llu: yielded at %.2f MPa (the stress's first stall) and hardened to its "
                              "peak, %.0f%% higher: broken blocks interlocking (a residual friction below "

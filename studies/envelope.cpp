@@ -353,7 +353,7 @@ struct EnvelopeRunner {
             // most of their strength under confinement and would run to 1% strain).
             // Once failed, its peak is final (run_labtest): a longer tail only draws
             // more of the curve (1e-3 gave the same peaks, σci and σcd, 25% slower).
-            if (o.post_peak_strain <= 0.0) o.post_peak_strain = envelope_post_peak_strain;
+            if (o.stop.post_peak_strain <= 0.0) o.stop.post_peak_strain = envelope_post_peak_strain;
             o.threads = side_by_side == 1 ? available : 1;
             LabTestResult result;
             try {
@@ -443,7 +443,7 @@ void warn_about_envelope_runs(const std::vector<EnvelopeRun>& runs, const LabTes
     if (still_loading > 0)
         std::fprintf(stderr, "warning: %d test%s reached the strain cap %g still loading: %s peak is a lower bound "
                              "of the strength, and the fits with it (blocks jammed, or raise --strain-cap)\n",
-                     still_loading, still_loading == 1 ? "" : "s", std::max(c.o.max_strain, c.o.strain_cap),
+                     still_loading, still_loading == 1 ? "" : "s", std::max(c.o.stop.max_strain, c.o.stop.strain_cap),
                      still_loading == 1 ? "its" : "their");
     // Interlocking: a confined peak far above its first stall (the yield).
     int hardened = 0, confined = 0;
@@ -452,13 +452,26 @@ void warn_about_envelope_runs(const std::vector<EnvelopeRun>& runs, const LabTes
         ++confined;
         hardened += r.result.hardened_past_yield();
     }
-    if (hardened > 0 && !c.o.confined_peak_at_stall)
+    if (hardened > 0 && !c.o.stop.peak_at_first_stall)
         std::fprintf(stderr, "warning: %d of %d confined tests hardened past their first stall (the yield) by more "
                              "than 20%%: broken blocks interlocking, and the fits mix them with the specimens that "
                              "failed. A residual friction below the joints' lets broken joints slide "
                              "(--residual-friction); --confined-peak first-stall reads the yield "
                              "(docs/calibration.md, The confined peak)\n",
                      hardened, confined);
+}
+
+/// The confinements to test: as given, or 0.1 to 0.5 times the measured UCS
+/// (rounded to 0.1 MPa); sorted, each once.
+std::vector<double> confinements_to_test(const std::vector<double>& given, const std::vector<double>& ucs) {
+    double ucs_mean = 0.0;
+    for (double v : ucs) ucs_mean += v / double(ucs.size());
+    std::vector<double> confinements = given;
+    if (confinements.empty())
+        for (double f : {0.1, 0.2, 0.3, 0.4, 0.5}) confinements.push_back(std::round(f * ucs_mean / 1e5) * 1e5);
+    std::sort(confinements.begin(), confinements.end());
+    confinements.erase(std::unique(confinements.begin(), confinements.end()), confinements.end());
+    return confinements;
 }
 
 } // namespace
@@ -510,13 +523,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         (r.test == "ucs" ? ucs : strength_t)
             .push_back(r.test == "ucs" ? r.result.peak_stress
                                        : (brazilian ? r.result.tensile_strength : r.result.peak_stress));
-    double ucs_mean = 0.0;
-    for (double v : ucs) ucs_mean += v / double(ucs.size());
-    std::vector<double> confinements = e.confinements;
-    if (confinements.empty())
-        for (double f : {0.1, 0.2, 0.3, 0.4, 0.5}) confinements.push_back(std::round(f * ucs_mean / 1e5) * 1e5);
-    std::sort(confinements.begin(), confinements.end());
-    confinements.erase(std::unique(confinements.begin(), confinements.end()), confinements.end());
+    const std::vector<double> confinements = confinements_to_test(e.confinements, ucs);
     std::vector<Job> second;
     for (double s3 : confinements)
         for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});

@@ -31,14 +31,14 @@ bool uses_platen_blocks(const LabTestOptions& o) {
 }
 
 std::vector<meshing::SegmentSpec> joint_set_traces(const LabTestOptions& o) {
-    const double a = o.joint_set_angle * std::numbers::pi / 180.0;
+    const double a = o.joint_set.angle * std::numbers::pi / 180.0;
     const Vec2 t{std::cos(a), std::sin(a)}, n{-t.y, t.x}, centre{0.5 * o.width, 0.5 * o.height};
     const double reach = std::hypot(o.width, o.height);
-    const int lines = o.joint_set_spacing > 0 ? int(reach / o.joint_set_spacing) + 1 : 0;
+    const int lines = o.joint_set.spacing > 0 ? int(reach / o.joint_set.spacing) + 1 : 0;
     std::vector<meshing::SegmentSpec> traces;
     for (int k = -lines; k <= lines; ++k) {
         // The line centre + k s n + λ t clipped to the rectangle (Liang–Barsky).
-        const Vec2 p = centre + (k * o.joint_set_spacing) * n;
+        const Vec2 p = centre + (k * o.joint_set.spacing) * n;
         double lo = -reach, hi = reach;
         const double start[2] = {p.x, p.y}, dir[2] = {t.x, t.y}, box_lo[2] = {0.0, 0.0}, box_hi[2] = {o.width, o.height};
         for (int i = 0; i < 2; ++i) {
@@ -81,7 +81,7 @@ meshing::ModelGeometrySpec labtest_geometry(const LabTestOptions& o) {
         r.mesh.enabled = true;
         r.mesh.size = o.mesh_size > 0.0 ? o.mesh_size : 0.5 * o.size;
     }
-    if (o.joint_set && o.kind != LabTestOptions::Kind::brazilian) r.joints = joint_set_traces(o);
+    if (o.joint_set.on && o.kind != LabTestOptions::Kind::brazilian) r.joints = joint_set_traces(o);
     g.regions.push_back(r);
     if (uses_platen_blocks(o)) {
         // One block each, a block size thick, sharing the specimen's faces.
@@ -128,8 +128,8 @@ void add_labtest_materials(AnalysisSpec& an, const LabTestOptions& o) {
     }
     // The bond between specimen blocks (a later rule wins over the platen one).
     an.joint_assignments.push_back({o.joint.name, {}, {"specimen"}});
-    if (o.joint_set) {
-        JointPropertySpec set = o.joint_set_joint;
+    if (o.joint_set.on) {
+        JointPropertySpec set = o.joint_set.joint;
         set.name = "joint_set";
         if (!(set.kn > 0)) set.kn = o.joint.kn;
         if (!(set.ks > 0)) set.ks = o.joint.ks;

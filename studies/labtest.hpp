@@ -57,58 +57,29 @@ inline constexpr double envelope_post_peak_strain = 2e-4;
 /// its peak.
 inline constexpr double residual_window_strain = 2e-3, residual_run_strain = 5e-3;
 
-struct LabTestOptions {
-    enum class Kind { ucs, tension, biaxial, brazilian };
-    Kind kind = Kind::ucs;
-    meshing::PatternSpec::Kind pattern = meshing::PatternSpec::Kind::voronoi;
-    double size = 0.3, width = 8.0, height = 16.0; ///< m (brazilian: width = diameter)
-    /// What `size` measures (meshing/spec.hpp): by default the blocks' mean Feret
-    /// diameter, the paper's "average dimension".
-    meshing::PatternSpec::SizeMeasure size_measure = meshing::PatternSpec::SizeMeasure::feret;
-    /// Lloyd iterations: 0 = the Voronoi cells of random points, as the paper's
-    /// "randomly generated" blocks (relaxed cells are ~20% stronger: docs/calibration.md).
-    int lloyd = 0;
-    std::uint64_t seed = 1;
-    JointPropertySpec joint;            ///< the bond (law softening by default: paper values)
-    /// The blocks' material, as a [[material]] gives it (core/material_keys.hpp):
-    /// density; with 0 < deformable_fraction < 1 every block is meshed (triangles of
-    /// mesh_size, default size / 2) and takes the fraction f of the deformation:
-    /// blocks get young / f (young: the target modulus E of the rock mass), joints kn
-    /// / (1 − f) and ks / (1 − f); 0 = rigid blocks.
-    MaterialSpec material{.name = "rock", .density = 2700.0, .young = 20.0e9, .poisson = 0.2, .deformable_fraction = 0.0};
-    double confinement = 0.0;           ///< biaxial: lateral stress, Pa (positive = compression)
-    /// Platen velocity over height, per step: the loading rate without the servo,
-    /// the unit of its rates with it.
-    double strain_per_step = 5e-8;
-    /// Servo-controlled platens: at every record the platen speed is multiplied by
-    /// servo_cracks / (new cracks of the record), per 5,000 contacts, within
-    /// [0.5, 1.1] (×1.1 without new cracks) and kept within [min, max] ×
-    /// strain_per_step — slow while cracks redistribute load; once the specimen
-    /// has failed (failure_drop) it rises to post_peak × strain_per_step. The
-    /// elastic part needs no speed: the implicit preload below does it at once.
-    /// Once cracking has started the servo also holds the specimen in equilibrium:
-    /// the top and bottom platen forces may differ by at most servo_balance of the
-    /// load (rate × servo_balance / mismatch, within the same [0.5, 1.1]). A
-    /// network that fails in a cascade gives the crack count no warning, and
-    /// loaded faster than it can redistribute it carries more than its strength
-    /// (trigon: +12%); the force balance shows it.
-    /// Measured on the paper's specimen: docs/calibration.md, "Loading rate".
-    bool servo = true;
-    double servo_cracks = 2.0;
-    double servo_balance = 0.02;
-    double servo_min_factor = 0.05, servo_max_factor = 1.5, servo_post_peak_factor = 0.5;
-    /// The linear part by one implicit solve (run_labtest), up to this fraction of
-    /// the load at which the first joint yields; not with platen blocks (their
-    /// frictional contacts are not linear).
-    bool elastic_preload = true;
-    double preload_fraction = 0.9;
-    bool rough_platens = true;
-    /// ≥ 0: instead of prescribing the face blocks, rigid platen blocks (one block
-    /// size thick, as wide as the specimen) press on the faces through Coulomb
-    /// contacts of this friction angle (degrees; kn, ks of the bond). Compression
-    /// and biaxial tests only. < 0: the face blocks are the platens (rough_platens).
-    double platen_friction = -1.0;
-    double stop_fraction = 0.8;         ///< stop after the peak below this fraction of it
+/// Servo-controlled platens: at every record the platen speed is multiplied by
+/// `cracks` / (new cracks of the record), per 5,000 contacts, within [0.5, 1.1]
+/// (×1.1 without new cracks) and kept within [min_factor, max_factor] ×
+/// strain_per_step — slow while cracks redistribute load; once the specimen has
+/// failed (LabTestStops::failure_drop) it rises to post_peak_factor ×
+/// strain_per_step. The elastic part needs no speed: the implicit preload does it
+/// at once. Once cracking has started the servo also holds the specimen in
+/// equilibrium: the top and bottom platen forces may differ by at most `balance`
+/// of the load (rate × balance / mismatch, within the same [0.5, 1.1]). A network
+/// that fails in a cascade gives the crack count no warning, and loaded faster
+/// than it can redistribute it carries more than its strength (trigon: +12%); the
+/// force balance shows it. Measured on the paper's specimen: docs/calibration.md,
+/// "Loading rate".
+struct LabTestServo {
+    bool on = true;
+    double cracks = 2.0;
+    double balance = 0.02;
+    double min_factor = 0.05, max_factor = 1.5, post_peak_factor = 0.5;
+};
+
+/// When a lab test stops, and how its strength is read from the curve.
+struct LabTestStops {
+    double fraction = 0.8;              ///< stop after the peak below this fraction of it
     /// A drop by this fraction from the peak marks failure: the peak is then the
     /// strength, and the run stops if the stress climbs back above it (confined,
     /// the laboratory's peak: loading goes on, LabTestResult::reloads).
@@ -124,7 +95,7 @@ struct LabTestOptions {
     /// loading at 3% is jammed, not strong (LabTestResult::still_loading).
     double strain_cap = 0.03;
     /// Confined tests (biaxial): stop this much axial strain past the failure once
-    /// the specimen has failed (0: go on to max_strain or stop_fraction): past the
+    /// the specimen has failed (0: go on to max_strain or `fraction`): past the
     /// drop for the laboratory's peak (a climb back above it within the window is
     /// loading on), past the peak for the first-stall rule (whose failed peak is
     /// final). The envelope and calibration set envelope_post_peak_strain.
@@ -138,26 +109,69 @@ struct LabTestOptions {
     /// climb back above its peak stops the run — a strength the specimen may exceed
     /// by half when loaded on (Lac du Bonnet at σ3 = 71 MPa: 518 against 1,208 MPa;
     /// docs/calibration.md, "The confined peak").
-    bool confined_peak_at_stall = false;
+    bool peak_at_first_stall = false;
     long max_steps = 2000000;
-    int record_every = 20;              ///< steps between stress-strain samples
-    long frame_every = 4000;            ///< steps between frames of the failure series (0: none)
-    int threads = 1;                    ///< threads of the contact loop
-    double max_elements = 0;            ///< limit on blocks + triangles (0: half the machine's memory)
-    double mesh_size = 0.0;             ///< deformable blocks' triangles, m (0: size / 2)
-    /// A persistent joint set across a rectangular specimen (Jaeger's single
-    /// plane of weakness when one joint): traces at joint_set_angle degrees from
-    /// horizontal, joint_set_spacing apart along their normal, one through the
-    /// specimen's centre (spacing 0: that one alone), cut before the blocks, with
-    /// the property joint_set_joint (kn, ks: the bond's when 0).
-    bool joint_set = false;
-    double joint_set_angle = 60.0, joint_set_spacing = 0.0;
-    JointPropertySpec joint_set_joint = [] {
+};
+
+/// A persistent joint set across a rectangular specimen (Jaeger's single plane
+/// of weakness when one joint): traces at `angle` degrees from horizontal,
+/// `spacing` apart along their normal, one through the specimen's centre (spacing
+/// 0: that one alone), cut before the blocks, with the property `joint` (kn, ks:
+/// the bond's when 0).
+struct LabTestJointSet {
+    bool on = false;
+    double angle = 60.0, spacing = 0.0;
+    JointPropertySpec joint = [] {
         JointPropertySpec plane;
         plane.name = "joint_set";
         plane.law = JointPropertySpec::Law::coulomb;
         return plane;
     }();
+};
+
+/// A lab test: the specimen, the rock, how it is loaded and when it stops.
+struct LabTestOptions {
+    enum class Kind { ucs, tension, biaxial, brazilian };
+    Kind kind = Kind::ucs;
+    meshing::PatternSpec::Kind pattern = meshing::PatternSpec::Kind::voronoi;
+    double size = 0.3, width = 8.0, height = 16.0; ///< m (brazilian: width = diameter)
+    /// What `size` measures (meshing/spec.hpp): by default the blocks' mean Feret
+    /// diameter, the paper's "average dimension".
+    meshing::PatternSpec::SizeMeasure size_measure = meshing::PatternSpec::SizeMeasure::feret;
+    /// Lloyd iterations: 0 = the Voronoi cells of random points, as the paper's
+    /// "randomly generated" blocks (relaxed cells are ~20% stronger: docs/calibration.md).
+    int lloyd = 0;
+    std::uint64_t seed = 1;
+    double mesh_size = 0.0;             ///< deformable blocks' triangles, m (0: size / 2)
+    JointPropertySpec joint;            ///< the bond (law softening by default: paper values)
+    /// The blocks' material, as a [[material]] gives it (core/material_keys.hpp):
+    /// density; with 0 < deformable_fraction < 1 every block is meshed (triangles of
+    /// mesh_size, default size / 2) and takes the fraction f of the deformation:
+    /// blocks get young / f (young: the target modulus E of the rock mass), joints kn
+    /// / (1 − f) and ks / (1 − f); 0 = rigid blocks.
+    MaterialSpec material{.name = "rock", .density = 2700.0, .young = 20.0e9, .poisson = 0.2, .deformable_fraction = 0.0};
+    LabTestJointSet joint_set;
+    double confinement = 0.0;           ///< biaxial: lateral stress, Pa (positive = compression)
+    /// Platen velocity over height, per step: the loading rate without the servo,
+    /// the unit of its rates with it.
+    double strain_per_step = 5e-8;
+    LabTestServo servo;
+    /// The linear part by one implicit solve (run_labtest), up to this fraction of
+    /// the load at which the first joint yields; not with platen blocks (their
+    /// frictional contacts are not linear).
+    bool elastic_preload = true;
+    double preload_fraction = 0.9;
+    bool rough_platens = true;
+    /// ≥ 0: instead of prescribing the face blocks, rigid platen blocks (one block
+    /// size thick, as wide as the specimen) press on the faces through Coulomb
+    /// contacts of this friction angle (degrees; kn, ks of the bond). Compression
+    /// and biaxial tests only. < 0: the face blocks are the platens (rough_platens).
+    double platen_friction = -1.0;
+    LabTestStops stop;
+    int record_every = 20;              ///< steps between stress-strain samples
+    long frame_every = 4000;            ///< steps between frames of the failure series (0: none)
+    int threads = 1;                    ///< threads of the contact loop
+    double max_elements = 0;            ///< limit on blocks + triangles (0: half the machine's memory)
 
     /// The paper's Voronoi calibration run (SPEC §8).
     static LabTestOptions paper_ucs();

@@ -160,7 +160,7 @@ class JointSetGauge {
 public:
     JointSetGauge(const Solver& s, const LabTestOptions& o) {
         for (std::size_t k = 0; k < s.property_names().size(); ++k)
-            if (o.joint_set && s.property_names()[k] == "joint_set") property_ = int(k);
+            if (o.joint_set.on && s.property_names()[k] == "joint_set") property_ = int(k);
     }
     void record(const Solver& s, const StressStrainPoint& p, LabTestResult& r) const {
         if (property_ < 0 || r.joint_slip_stress > 0.0) return;
@@ -259,8 +259,8 @@ std::size_t elastic_preload(Solver& s, MovingPlaten& platen, const LabTestOption
 class Servo {
 public:
     Servo(const LabTestOptions& o, int contacts, int cracks_at_start)
-        : o_(o), rate_(o.servo ? o.strain_per_step * o.servo_min_factor : o.strain_per_step),
-          target_(o.servo_cracks * std::max(1.0, contacts / 5000.0)), cracks_at_start_(cracks_at_start),
+        : o_(o), rate_(o.servo.on ? o.strain_per_step * o.servo.min_factor : o.strain_per_step),
+          target_(o.servo.cracks * std::max(1.0, contacts / 5000.0)), cracks_at_start_(cracks_at_start),
           cracks_last_(cracks_at_start) {}
     double rate() const { return rate_; }
     /// The rate after record p. Never faster than ×1.1 a record: a change of rate
@@ -270,16 +270,16 @@ public:
         const double made = cracks_now - cracks_last_;
         cracks_last_ = cracks_now;
         if (failed) {
-            rate_ = std::min(1.1 * rate_, o_.strain_per_step * o_.servo_post_peak_factor);
+            rate_ = std::min(1.1 * rate_, o_.strain_per_step * o_.servo.post_peak_factor);
             return;
         }
         double f = made <= 0 ? 1.1 : std::clamp(target_ / made, 0.5, 1.1);
-        if (o_.servo_balance > 0 && cracks_now > cracks_at_start_) {
+        if (o_.servo.balance > 0 && cracks_now > cracks_at_start_) {
             const double top = s.boundary_force("top").y, bottom = s.boundary_force("bottom").y;
             const double mismatch = std::abs(top + bottom) / std::max(std::abs(top), 1e-300);
-            if (mismatch > 0) f = std::min(f, std::clamp(o_.servo_balance / mismatch, 0.5, 1.1));
+            if (mismatch > 0) f = std::min(f, std::clamp(o_.servo.balance / mismatch, 0.5, 1.1));
         }
-        rate_ = std::clamp(rate_ * f, o_.strain_per_step * o_.servo_min_factor, o_.strain_per_step * o_.servo_max_factor);
+        rate_ = std::clamp(rate_ * f, o_.strain_per_step * o_.servo.min_factor, o_.strain_per_step * o_.servo.max_factor);
     }
 
 private:
@@ -294,7 +294,7 @@ private:
 class StopRules {
 public:
     StopRules(const LabTestOptions& o, int cracks_at_start)
-        : o_(o), cracks_at_start_(cracks_at_start), lab_peak_(o.confinement > 0.0 && !o.confined_peak_at_stall) {}
+        : o_(o), cracks_at_start_(cracks_at_start), lab_peak_(o.confinement > 0.0 && !o.stop.peak_at_first_stall) {}
     /// True when the run stops after this record.
     bool stop_after(const Solver& s, const StressStrainPoint& p, LabTestResult& r) {
         if (locked(s, p, r)) return true;
@@ -355,7 +355,7 @@ private:
     /// the axial load: the start-up transient of the platens is no failure.
     void watch_failure(const StressStrainPoint& p, LabTestResult& r) {
         cracking_ = p.cracks_tensile + p.cracks_shear > cracks_at_start_;
-        const bool dropped = peak_ > 0 && p.axial_stress < (1.0 - o_.failure_drop) * peak_;
+        const bool dropped = peak_ > 0 && p.axial_stress < (1.0 - o_.stop.failure_drop) * peak_;
         while (stall_from_ + 1 < r.curve.size() && r.curve[stall_from_ + 1].axial_strain <= p.axial_strain - 2e-4)
             ++stall_from_;
         bool stalled = false;
@@ -370,15 +370,15 @@ private:
     /// Past the peak once the stress is clearly down from it (after cracking: not
     /// in the start-up transient of the platens).
     bool past_peak(const StressStrainPoint& p, LabTestResult& r) const {
-        if (!(cracking_ && peak_ > 0 && p.step > peak_step_ && p.axial_stress < o_.stop_fraction * peak_)) return false;
+        if (!(cracking_ && peak_ > 0 && p.step > peak_step_ && p.axial_stress < o_.stop.fraction * peak_)) return false;
         r.peak_passed = true;
         return true;
     }
     /// Confined: post_peak_strain past the peak (the laboratory's peak: past the
     /// drop, which gives a burst of cracks the room to be climbed back above).
     bool past_post_peak_strain(const StressStrainPoint& p, LabTestResult& r) const {
-        if (!(failed_ && o_.confinement > 0.0 && o_.post_peak_strain > 0.0 &&
-              p.axial_strain >= (lab_peak_ ? strain_at_failure_ : strain_at_peak_) + o_.post_peak_strain))
+        if (!(failed_ && o_.confinement > 0.0 && o_.stop.post_peak_strain > 0.0 &&
+              p.axial_strain >= (lab_peak_ ? strain_at_failure_ : strain_at_peak_) + o_.stop.post_peak_strain))
             return false;
         r.peak_passed = true;
         return true;
@@ -387,8 +387,8 @@ private:
     /// cap. Failed after loading on: stop max_strain past the peak at the latest
     /// (the locking rule gets the room it had before max_strain).
     bool at_strain_limit(const StressStrainPoint& p, LabTestResult& r) const {
-        if (!(p.axial_strain >= o_.max_strain)) return false;
-        const double cap = std::max(o_.max_strain, o_.strain_cap);
+        if (!(p.axial_strain >= o_.stop.max_strain)) return false;
+        const double cap = std::max(o_.stop.max_strain, o_.stop.strain_cap);
         if (!failed_ && p.axial_strain < cap) {
             r.loaded_past_max_strain = true;
             return false;
@@ -397,7 +397,7 @@ private:
             r.still_loading = still_at_peak(p);
             return true;
         }
-        return !r.loaded_past_max_strain || p.axial_strain >= cap || p.axial_strain >= strain_at_peak_ + o_.max_strain;
+        return !r.loaded_past_max_strain || p.axial_strain >= cap || p.axial_strain >= strain_at_peak_ + o_.stop.max_strain;
     }
 
     const LabTestOptions& o_;
@@ -444,7 +444,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     StopRules rules(o, cracks_at_start);
     platen.set_speed(servo.rate() * h);
     double ratio_max = 0.0;
-    while (s.steps() - start < o.max_steps) {
+    while (s.steps() - start < o.stop.max_steps) {
         s.step();
         strain += servo.rate();
         ratio_max = std::max(ratio_max, s.unbalanced_ratio());
@@ -454,7 +454,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         p.unbalanced_ratio = ratio_max;
         r.curve.push_back(p);
         joint_set.record(s, p, r);
-        if (o.servo) {
+        if (o.servo.on) {
             servo.adapt(s, p, rules.failed());
             platen.set_speed(servo.rate() * h);
         }
@@ -464,7 +464,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         if (rules.stop_after(s, p, r)) break;
     }
     // Out of steps while loading on: the peak is a lower bound too.
-    if (s.steps() - start >= o.max_steps && r.loaded_past_max_strain && !rules.failed() && !r.curve.empty())
+    if (s.steps() - start >= o.stop.max_steps && r.loaded_past_max_strain && !rules.failed() && !r.curve.empty())
         r.still_loading = rules.still_at_peak(r.curve.back());
     r.steps = s.steps();
     r.peak_stress = rules.peak();

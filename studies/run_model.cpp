@@ -543,6 +543,44 @@ void print_run_report(const Solver& solver, const nlohmann::json& summary, const
                  opt.out.string().c_str());
 }
 
+/// The model a run steps: its file read, its blocks generated and its solver
+/// built, each failure reported as bad input at the model file's line.
+struct BuiltModel {
+    io::ModelFile model;
+    meshing::BlockAssembly blocks;
+    meshing::GenerationStats gen;
+    std::unique_ptr<Solver> solver;
+};
+
+BuiltModel build_model_to_run(const std::string& model_path, const RunOptions& opt) {
+    BuiltModel b;
+    b.model = io::read_model(model_path);
+    b.model.analysis.solver.threads = opt.threads;
+    if (opt.max_elements > 0) b.model.geometry.max_elements = opt.max_elements;
+    if (b.model.analysis.stages.empty())
+        throw InputError(model_path, 0, "stage", "the model has no [[stage]] to run (bbm mesh only generates blocks)");
+    try {
+        b.blocks = meshing::generate_blocks(b.model.geometry, &b.gen);
+    } catch (const GeometryError& e) {
+        throw io::to_input_error(b.model.source, e);
+    }
+    try {
+        b.solver = std::make_unique<Solver>(b.blocks, b.model.analysis);
+    } catch (const InputError& e) {
+        throw InputError(model_path, b.model.source.line_of(e.key()), e.key(), e.message());
+    }
+    return b;
+}
+
+/// Says why the run stopped before its end and how to continue it.
+void report_stop(int stop_signal, long step, const fs::path& out) {
+    std::fprintf(stderr, "\n%s at step %ld: wrote %s; continue with: bbm run --resume --out %s\n",
+                 stop_signal < 0 ? "stopped (--stop-at-step)"
+                 : stop_signal == SIGINT ? "interrupted (SIGINT)"
+                 : stop_signal == SIGTERM ? "interrupted (SIGTERM)" : "interrupted (SIGUSR1)",
+                 step, (out / "checkpoint.bin").string().c_str(), out.string().c_str());
+}
+
 } // namespace
 
 int run_model(const RunOptions& opt) {
@@ -562,24 +600,11 @@ int run_model(const RunOptions& opt) {
     const auto to_run = model_to_run(opt, checkpoint, header);
     if (!to_run) return 0;
     const std::string& model_path = *to_run;
-    io::ModelFile model = io::read_model(model_path);
-    model.analysis.solver.threads = opt.threads;
-    if (opt.max_elements > 0) model.geometry.max_elements = opt.max_elements;
-    if (model.analysis.stages.empty())
-        throw InputError(model_path, 0, "stage", "the model has no [[stage]] to run (bbm mesh only generates blocks)");
-    meshing::BlockAssembly blocks;
-    meshing::GenerationStats gen;
-    try {
-        blocks = meshing::generate_blocks(model.geometry, &gen);
-    } catch (const GeometryError& e) {
-        throw io::to_input_error(model.source, e);
-    }
-    std::unique_ptr<Solver> solver;
-    try {
-        solver = std::make_unique<Solver>(blocks, model.analysis);
-    } catch (const InputError& e) {
-        throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
-    }
+    BuiltModel built = build_model_to_run(model_path, opt);
+    io::ModelFile& model = built.model;
+    const meshing::BlockAssembly& blocks = built.blocks;
+    const meshing::GenerationStats& gen = built.gen;
+    std::unique_ptr<Solver>& solver = built.solver;
     if (opt.check_only) return 0;
     solver->profile().enabled = opt.profile;
     int rigid = 0;
@@ -623,12 +648,7 @@ int run_model(const RunOptions& opt) {
     const int stop_signal = interrupted.load();
     if (stop_signal != 0) {
         output.write_checkpoint(*solver);
-        if (!opt.quiet)
-            std::fprintf(stderr, "\n%s at step %ld: wrote %s; continue with: bbm run --resume --out %s\n",
-                         stop_signal < 0 ? "stopped (--stop-at-step)"
-                         : stop_signal == SIGINT ? "interrupted (SIGINT)"
-                         : stop_signal == SIGTERM ? "interrupted (SIGTERM)" : "interrupted (SIGUSR1)",
-                         solver->steps(), (opt.out / "checkpoint.bin").string().c_str(), opt.out.string().c_str());
+        if (!opt.quiet) report_stop(stop_signal, solver->steps(), opt.out);
     }
     // The stages finished (before a resume too) and, if the run stopped inside one, that stage so far.
     std::vector<StageReport> reports = output.reports();

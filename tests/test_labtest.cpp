@@ -151,7 +151,7 @@ struct PostPeak {
 };
 PostPeak post_peak_run(LabTestOptions o) {
     o.threads = 2;
-    o.stop_fraction = 0.5; // the checks follow the softening to half the peak
+    o.stop.fraction = 0.5; // the checks follow the softening to half the peak
     PostPeak p{run_labtest(o)};
     REQUIRE(!p.r.curve.empty());
     p.end_fraction = p.r.curve.back().axial_stress / p.r.peak_stress;
@@ -197,8 +197,8 @@ TEST_CASE("a test not failed at its strain limit loads on to its strength and at
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0, o.seed = 1;
     o.threads = 2;
-    o.max_strain = 5e-4;
-    o.strain_cap = 0.0;
+    o.stop.max_strain = 5e-4;
+    o.stop.strain_cap = 0.0;
     const auto capped = run_labtest(o);
     REQUIRE(!capped.curve.empty());
     CHECK(capped.still_loading);
@@ -208,9 +208,9 @@ TEST_CASE("a test not failed at its strain limit loads on to its strength and at
     CHECK(capped.peak_stress == doctest::Approx(capped.curve.back().axial_stress).epsilon(0.02));
     CHECK(capped.peak_stress < 0.8 * 22e6); // below the specimen's strength, about 22 MPa
 
-    o.strain_cap = LabTestOptions{}.strain_cap;
+    o.stop.strain_cap = LabTestOptions{}.stop.strain_cap;
     const auto on = run_labtest(o);
-    o.max_strain = LabTestOptions{}.max_strain;
+    o.stop.max_strain = LabTestOptions{}.stop.max_strain;
     const auto full = run_labtest(o);
     CHECK_FALSE(full.loaded_past_max_strain);
     CHECK(on.loaded_past_max_strain);
@@ -237,8 +237,8 @@ TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, 
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0;
     o.material.deformable_fraction = 0.95;
-    o.max_strain = 2e-4;
-    o.strain_cap = 0.0; // the preload and a few steps are what this compares
+    o.stop.max_strain = 2e-4;
+    o.stop.strain_cap = 0.0; // the preload and a few steps are what this compares
     o.threads = 1;
     std::vector<LabTestResult> serial, parallel(3);
     for (int k = 0; k < 3; ++k) {
@@ -286,12 +286,12 @@ TEST_CASE("a single plane of weakness slides where Jaeger's closed form says (bi
         o.width = 4.0, o.height = 8.0;
         o.confinement = 5e6;
         o.rough_platens = false;
-        o.joint_set = true;
-        o.joint_set_angle = beta;
-        o.joint_set_joint.kn = o.joint.kn, o.joint_set_joint.ks = o.joint.ks;
-        o.joint_set_joint.friction = 30.0;
-        o.max_strain = 2e-3; // the slip is read before; the pieces then jam
-        o.strain_cap = 0.0;
+        o.joint_set.on = true;
+        o.joint_set.angle = beta;
+        o.joint_set.joint.kn = o.joint.kn, o.joint_set.joint.ks = o.joint.ks;
+        o.joint_set.joint.friction = 30.0;
+        o.stop.max_strain = 2e-3; // the slip is read before; the pieces then jam
+        o.stop.strain_cap = 0.0;
         o.threads = 2;
         const auto r = run_labtest(o);
         const double b = beta * std::numbers::pi / 180.0, mu = std::tan(std::numbers::pi / 6.0);
@@ -316,7 +316,7 @@ TEST_CASE("a biaxial test whose confinement leaves a block the implicit preload 
     o.joint.kn = 2000.3e9, o.joint.ks = 683.5e9;
     o.joint.tensile = 17.9e6, o.joint.cohesion = 123.9e6, o.joint.friction = 35.0;
     o.confinement = 71e6;
-    o.max_steps = 3000;
+    o.stop.max_steps = 3000;
     o.threads = 1;
     for (std::uint64_t seed : {1, 2}) {
         o.seed = seed;

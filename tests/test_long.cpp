@@ -68,7 +68,7 @@ TEST_CASE("uniaxial compression, paper trigon specimen: the default loading give
     LabTestResult fast, slow;
     std::thread other([&] { fast = run_labtest(o); });
     auto q = o;
-    q.servo = false;
+    q.servo.on = false;
     q.strain_per_step = 4e-9;
     slow = run_labtest(q);
     other.join();
@@ -158,7 +158,7 @@ TEST_CASE("residual strength, Lac du Bonnet's in-situ set: broken joints at 10 d
     o.joint.tensile = 15.1313e6, o.joint.cohesion = 41.843e6;
     o.joint.friction = 5, o.joint.residual_friction = 10;
     o.confinement = 10e6;
-    o.stop_fraction = 0.0, o.max_strain = 0.02, o.strain_cap = 0.02;
+    o.stop.fraction = 0.0, o.stop.max_strain = 0.02, o.stop.strain_cap = 0.02;
     o.threads = 2, o.frame_every = 0;
     const auto r = run_labtest(o);
     REQUIRE(!r.curve.empty());
@@ -200,7 +200,7 @@ TEST_CASE("confined friction, Lac du Bonnet: sigma_ci unconfined and the laborat
     plain.kind = LabTestOptions::Kind::biaxial;
     plain.joint.confined_friction = -1;
     plain.confinement = 35.5e6, plain.seed = 1001, plain.threads = 2, plain.frame_every = 0;
-    plain.post_peak_strain = envelope_post_peak_strain;
+    plain.stop.post_peak_strain = envelope_post_peak_strain;
     const auto r = run_labtest(plain);
     MESSAGE("without the confined friction: sigma1 " << r.peak_stress / 1e6 << " MPa");
     CHECK(r.peak_stress < 0.6 * 557.2e6);
@@ -246,7 +246,7 @@ std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
             auto o = base;
             o.seed = std::uint64_t(k + 1);
             o.threads = 2;
-            o.stop_fraction = 0.5;
+            o.stop.fraction = 0.5;
             r[k] = run_labtest(o);
         }
         return r;
@@ -257,7 +257,7 @@ std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
             auto o = base;
             o.seed = std::uint64_t(k + 1);
             o.threads = 1;
-            o.stop_fraction = 0.5; // the checks follow the softening to half the peak
+            o.stop.fraction = 0.5; // the checks follow the softening to half the peak
             r[k] = run_labtest(o);
         });
     for (auto& t : pool) t.join();
