@@ -1,4 +1,6 @@
-// bbm: the command-line program, a thin front end on the library (studies/).
+// bbm: the command-line program, a thin front end on the library (studies/):
+// bbm_cli_main is main() of the program (apps/main.cpp) and of the fuzzer of
+// --config files (tests/fuzz/fuzz_config.cpp), compiled once for both.
 // Subcommands:
 //   bbm mesh MODEL.toml --out DIR   generate the block model, write VTK and a summary
 //   bbm run MODEL.toml --out DIR    generate it and run the model file's stages
@@ -288,7 +290,7 @@ int run_cli(int argc, char** argv) {
 
 } // namespace
 
-int main(int argc, char** argv) {
+int bbm_cli_main(int argc, char** argv) {
     // First thing: a scheduler's SIGUSR1 or SIGTERM while bbm starts must ask for
     // a checkpoint, not kill it (again after MPI, which may install its own).
     studies::catch_stop_signals();

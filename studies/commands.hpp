@@ -1,6 +1,6 @@
 // bbm studies: the commands a user runs — `mesh`, the lab tests (`ucs`, `tension`,
 // `biaxial`, `brazilian`) and `calibrate` — as library calls with their options,
-// their output files and their summaries, so that the program (apps/main.cpp) and
+// their output files and their summaries, so that the program (apps/cli.cpp) and
 // the Python module (python/) are thin front ends that run the same code.
 //
 // The lab tests' options are CLI11 options (add_labtest_options): the program puts

@@ -67,8 +67,8 @@ TEST_CASE("the contact pass's shares: every work item to one thread, in order, a
 // tests on 3 (an odd split of every batch), in the long suite all of them on 1 and
 // 3 (test_determinism_long.cpp). Running 1, 2 and 3 threads here was 321 s of the
 // default suite.
-TEST_CASE("every shipped example ends in the recorded state on 2 threads") {
-    CHECK(test::check_examples_on({2}) >= 20);
+TEST_CASE("every shipped example but those of the same code paths ends in the recorded state on 2 threads") {
+    CHECK(test::check_examples_on({2}, false) >= 28);
 }
 
 TEST_CASE("the trigon tunnel, past its first 900 cracks, ends in the recorded state on 2 threads") {

@@ -2,8 +2,8 @@
 // or calibration read from a TOML file.
 //
 // The first byte picks the command, the rest is the file. The program must end
-// with status 0 (valid) or 2 (a mistake it names); it is main() of apps/main.cpp,
-// compiled under another name (tests/fuzz/CMakeLists.txt), so every check the
+// with status 0 (valid) or 2 (a mistake it names); it is the program's command line
+// (apps/cli.cpp: bbm_cli_main, the same object as bbm's), so every check the
 // command line has is the one fuzzed. --check stops before any work.
 #include <cstddef>
 #include <cstdint>
