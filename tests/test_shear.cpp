@@ -69,7 +69,7 @@ TEST_CASE("direct shear: a weak brittle bond peaks at c + sigma_n tan(phi) and f
     CHECK(r.residual_shear_stress == doctest::Approx(2e6 * tan_deg(25.0)).epsilon(1e-3));
 }
 
-TEST_CASE("direct shear: constant normal stiffness holds sigma_n0 + K dv, and a dilating joint grows stronger") {
+TEST_CASE("direct shear: constant normal stiffness holds sigma_n0 + K dv, and a dilating joint grows stronger" * validation) {
     // A joint of persistence 0.5: its rock bridge breaks and the plane dilates.
     auto o = shear_specimen(meshing::PatternSpec::Kind::voronoi, 0.2);
     o.height = 1.25;

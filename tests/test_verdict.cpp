@@ -7,6 +7,7 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
+#include "tests/validation.hpp"
 
 #include <doctest/doctest.h>
 
@@ -184,7 +185,7 @@ max_steps = 100000
     CHECK(s.time() < std::sqrt(2.0 * 4.0 / 9.81));
 }
 
-TEST_CASE("verdict: a stage can wait for equilibrium where the ratio comes while the rock still cracks") {
+TEST_CASE("verdict: a stage can wait for equilibrium where the ratio comes while the rock still cracks" * validation) {
     // The paper's Voronoi tunnel with a loose ratio (1e-3): the model's ratio is
     // reached 620 steps into the failure stage while a crack still forms, and a
     // stage ending there leaves a rock that is failing. until = "equilibrium"
