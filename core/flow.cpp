@@ -56,6 +56,16 @@ void domain_sums(const Network& n, const FluidSpec& f, const State& s, std::vect
     }
 }
 
+/// min over free domains of V / (K_w Σ c): the explicit stage's stable step.
+double stable_step_of(const Network& n, const FluidSpec& f, const State& s, const std::vector<double>& conductance_sum,
+                      const std::vector<double>& volume) {
+    double dt = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n.domains(); ++i)
+        if (!s.held[i] && conductance_sum[i] > 0.0)
+            dt = std::min(dt, volume[i] / (f.bulk_modulus * conductance_sum[i]));
+    return dt;
+}
+
 /// The driving pressure difference of pipe k: (p_i − p_j) − ρ_w g·(x_i − x_j).
 double drive(const Network& n, const FluidSpec& f, const State& s, int k) {
     const int i = n.pipe_from[k], j = n.pipe_to[k];
@@ -103,10 +113,7 @@ std::vector<double> pipe_flows(const Network& n, const FluidSpec& f, const State
 double stable_timestep(const Network& n, const FluidSpec& f, const State& s) {
     std::vector<double> csum, volume;
     domain_sums(n, f, s, csum, volume);
-    double dt = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < n.domains(); ++i)
-        if (!s.held[i] && csum[i] > 0.0) dt = std::min(dt, volume[i] / (f.bulk_modulus * csum[i]));
-    return dt;
+    return stable_step_of(n, f, s, csum, volume);
 }
 
 int advance(const Network& n, const FluidSpec& f, State& s, double dt, double safety) {
@@ -121,13 +128,9 @@ int advance(const Network& n, const FluidSpec& f, State& s, double dt, double sa
         if (const double ck = conductance(n, f, s, k); ck > 0.0) open.push_back(k), c.push_back(ck);
     std::vector<int> wet;
     std::vector<double> rate; // K_w / V of each wet domain
-    double limit = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < n.domains(); ++i) {
-        if (s.held[i] || !(volume[i] > 0.0)) continue;
-        wet.push_back(i), rate.push_back(f.bulk_modulus / volume[i]);
-        if (csum[i] > 0.0) limit = std::min(limit, volume[i] / (f.bulk_modulus * csum[i]));
-    }
-    const double largest = safety * limit;
+    for (int i = 0; i < n.domains(); ++i)
+        if (!s.held[i] && volume[i] > 0.0) wet.push_back(i), rate.push_back(f.bulk_modulus / volume[i]);
+    const double largest = safety * stable_step_of(n, f, s, csum, volume);
     const int substeps = std::isfinite(largest) ? std::max(1, int(std::ceil(dt / largest))) : 1;
     const double h = dt / substeps;
     std::vector<double> net(n.domains(), 0.0);
@@ -203,11 +206,11 @@ SteadyReport solve_steady(const Network& n, const FluidSpec& f, State& s) {
 }
 
 double outflow_at_held(const Network& n, const FluidSpec& f, const State& s, const std::vector<std::uint8_t>& which) {
+    const std::vector<double> q = pipe_flows(n, f, s);
     double out = 0.0;
     for (int k = 0; k < n.pipes(); ++k) {
-        const double q = conductance(n, f, s, k) * drive(n, f, s, k);
-        if (which[n.pipe_to[k]]) out += q;
-        if (which[n.pipe_from[k]]) out -= q;
+        if (which[n.pipe_to[k]]) out += q[k];
+        if (which[n.pipe_from[k]]) out -= q[k];
     }
     return out;
 }

@@ -15,20 +15,36 @@ using namespace bbm;
 
 namespace {
 
-/// A W × H region of Voronoi blocks of size d with one straight fracture along
-/// y = H / 2 from side to side (a real joint: its joints are tagged so).
-meshing::BlockAssembly fractured_region(double width, double height, double size, std::uint64_t seed = 1) {
+/// A region of Voronoi blocks of size d: a rectangle, with a circular hole of
+/// radius r about `hole` when r > 0, and the real joints `joints`.
+meshing::BlockAssembly voronoi_region(Vec2 lo, Vec2 hi, double size, std::uint64_t seed,
+                                      std::vector<meshing::SegmentSpec> joints = {}, Vec2 hole = {},
+                                      double radius = 0.0) {
     meshing::ModelGeometrySpec g;
+    g.max_segment = 0.1;
     meshing::RegionSpec r;
     r.name = "rock";
-    r.outline.min = {0.0, 0.0};
-    r.outline.max = {width, height};
+    r.outline.min = lo;
+    r.outline.max = hi;
+    if (radius > 0.0) {
+        meshing::OutlineSpec h;
+        h.kind = meshing::OutlineSpec::Kind::circle;
+        h.center = hole;
+        h.radius = radius;
+        r.holes.push_back(h);
+    }
     r.pattern.kind = meshing::PatternSpec::Kind::voronoi;
     r.pattern.size = size;
     r.pattern.seed = seed;
-    r.joints.push_back({{0.0, 0.5 * height}, {width, 0.5 * height}});
+    r.joints = std::move(joints);
     g.regions.push_back(r);
     return meshing::generate_blocks(g);
+}
+
+/// A W × H region of Voronoi blocks of size d with one straight fracture along
+/// y = H / 2 from side to side (a real joint: its joints are tagged so).
+meshing::BlockAssembly fractured_region(double width, double height, double size, std::uint64_t seed = 1) {
+    return voronoi_region({0.0, 0.0}, {width, height}, size, seed, {{{0.0, 0.5 * height}, {width, 0.5 * height}}});
 }
 
 /// Aperture a on the fracture's pipes, 0 (closed) on every other joint.
@@ -144,35 +160,11 @@ TEST_CASE("flow: a pressure step diffuses along one fracture as p0 erfc(x / (2 s
 
 namespace {
 
-/// A region of Voronoi blocks of size d (a rectangle, with a circular hole of
-/// radius r about `hole` when r > 0) with every joint open to the same aperture.
-meshing::BlockAssembly jointed_region(Vec2 lo, Vec2 hi, double size, std::uint64_t seed, Vec2 hole = {},
-                                      double radius = 0.0) {
-    meshing::ModelGeometrySpec g;
-    g.max_segment = 0.1;
-    meshing::RegionSpec r;
-    r.name = "rock";
-    r.outline.min = lo;
-    r.outline.max = hi;
-    if (radius > 0.0) {
-        meshing::OutlineSpec h;
-        h.kind = meshing::OutlineSpec::Kind::circle;
-        h.center = hole;
-        h.radius = radius;
-        r.holes.push_back(h);
-    }
-    r.pattern.kind = meshing::PatternSpec::Kind::voronoi;
-    r.pattern.size = size;
-    r.pattern.seed = seed;
-    g.regions.push_back(r);
-    return meshing::generate_blocks(g);
-}
-
 /// The network's equivalent conductivity κ (Darcy: u = −κ ∇p, m²/(Pa·s) per unit
 /// depth) across an L × L sample: pressure P held on one side, 0 on the other,
 /// the two sides between sealed; the mean of the x and y directions.
 double equivalent_conductivity(double side, double size, double aperture, std::uint64_t seed) {
-    const auto a = jointed_region({0.0, 0.0}, {side, side}, size, seed);
+    const auto a = voronoi_region({0.0, 0.0}, {side, side}, size, seed);
     const auto n = flow::Network::of_joints(a);
     const flow::FluidSpec f;
     double sum = 0.0;
@@ -201,7 +193,7 @@ TEST_CASE("flow: steady inflow into a circular tunnel below the water table, aga
     const double half_width = 20.0, bottom = -20.0;
     for (std::uint64_t seed : {11, 12, 13}) { // the sample and the tunnel on other seeds
         const double kappa = equivalent_conductivity(8.0, size, aperture, seed);
-        const auto a = jointed_region({-half_width, bottom}, {half_width, 0.0}, size, seed + 100, {0.0, -depth}, r);
+        const auto a = voronoi_region({-half_width, bottom}, {half_width, 0.0}, size, seed + 100, {}, {0.0, -depth}, r);
         const auto n = flow::Network::of_joints(a);
         const flow::FluidSpec f;
         flow::State s(n, aperture);
