@@ -21,6 +21,7 @@ void Contacts::add(int a, int vertex, int b, int edge, int end, double l, int pr
     property.push_back(prop);
     history.push_back(h);
     normal.push_back({});
+    if (flow_on) flow_link.push_back({-1, -1, -1}), fluid_pressure.push_back(0.0);
 }
 
 void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
@@ -36,8 +37,10 @@ void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
         property[out] = property[i];
         history[out] = history[i];
         normal[out] = normal[i];
+        if (flow_on) flow_link[out] = flow_link[i], fluid_pressure[out] = fluid_pressure[i];
         ++out;
     }
+    if (flow_on) flow_link.resize(out), fluid_pressure.resize(out);
     for (auto* v : {&vertex_block, &vertex_id, &edge_block, &edge_id, &edge_end, &property}) v->resize(out);
     length.resize(out);
     history.resize(out);
@@ -72,6 +75,7 @@ bool Contacts::sort_by_blocks() {
         rotate_cycle(vertex_block), rotate_cycle(vertex_id), rotate_cycle(edge_block), rotate_cycle(edge_id);
         rotate_cycle(edge_end), rotate_cycle(length), rotate_cycle(property), rotate_cycle(history);
         rotate_cycle(normal);
+        if (flow_on) rotate_cycle(flow_link), rotate_cycle(fluid_pressure);
         for (int k = start; fill_[k] >= 0;) {
             const int next = fill_[k];
             fill_[k] = -1 - next;
@@ -212,6 +216,7 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
     const int* __restrict e0 = c.edge_id.data();
     const int* __restrict e1 = c.edge_end.data();
     const double* __restrict len = c.length.data();
+    const double* __restrict wet = c.wet() ? c.fluid_pressure.data() : nullptr;
     JointHistory* __restrict hist = c.history.data();
     ContactForce* __restrict out = c.force.data();
     const Vec2* __restrict vertex = b.vertex;
@@ -250,7 +255,8 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
         if constexpr (Mixed)
             if (face && face[i] >= 0) du_s = face_du_s[face[i]];
         law.update(h, du_n, du_s);
-        const Vec2 f = len[i] * (h.sn * n - h.tau * t);
+        const double sn = wet ? h.sn + wet[i] : h.sn; // effective stress + the fluid's
+        const Vec2 f = len[i] * (sn * n - h.tau * t);
         double moment_b = -cross(rb, f);
         if constexpr (Mixed)
             if (b.deformable[B]) moment_b = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);

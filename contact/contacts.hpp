@@ -35,6 +35,7 @@
 #include "contact/joint_law.hpp"
 #include "base/vec2.hpp"
 
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -102,6 +103,15 @@ struct Contacts {
     /// Normal n as of the last step (written by update_normals; the step itself
     /// does not store it); the tangent is t = (−n.y, n.x).
     std::vector<Vec2> normal;
+    /// Water in the joints (core/joint_flow.hpp); both empty in a dry model. Per
+    /// contact: {domain at its vertex, pipe, second pipe} of the flow network (−1:
+    /// none; a contact made by detection has none), moved with its contact; and the
+    /// fluid pressure on it (Pa over its length, the flow stage's, before each
+    /// contact pass): the law's stress is the effective one, the force adds this.
+    std::vector<std::array<int, 3>> flow_link;
+    std::vector<double> fluid_pressure;
+    bool flow_on = false; ///< the two arrays above are kept, one entry per contact
+    bool wet() const { return flow_on; }
 
     // Derived index, rebuilt by rebuild_index() whenever contacts are added or removed.
     /// Contacts by property set and kind: batch 2p holds the rigid–rigid contacts
@@ -229,7 +239,8 @@ void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_ra
 inline Vec2 contact_force(const Contacts& c, int i) {
     const JointHistory& h = c.history[i];
     const Vec2 n = c.normal[i];
-    return c.length[i] * (h.sn * n - h.tau * tangent_of(n));
+    const double sn = c.wet() ? h.sn + c.fluid_pressure[i] : h.sn;
+    return c.length[i] * (sn * n - h.tau * tangent_of(n));
 }
 
 /// Stage 2 of a step, first pass: per contact (work items, each law dispatched

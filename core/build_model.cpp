@@ -258,23 +258,32 @@ void Solver::build_contacts(const meshing::BlockAssembly& a, const AnalysisSpec&
     // Joint records -> point contacts, one at each end with half the joint length.
     double mean_edge = 0.0;
     std::map<std::pair<int, int>, int> existing; // (vertex id, edge id) -> contact
+    if (an.flow.on) {
+        flow_ = std::make_unique<JointFlow>(a, an.flow, settings_.gravity);
+        c_.flow_on = true;
+    }
     for (const auto& j : a.joints) {
         int prop = table.assigned(a, j, an, region_names_);
         prop = table.strength_class(prop, std::size_t(&j - a.joints.data()));
         prop = table.split(prop, std::min(materials.fraction(a, j.block_a), materials.fraction(a, j.block_b)));
         mean_edge += j.length();
-        add_joint_contacts(a, j, prop, existing);
+        const auto ends = add_joint_contacts(a, j, prop, existing);
+        if (flow_) {
+            const int joint = int(&j - a.joints.data());
+            flow_->link(c_, ends[0], joint, true), flow_->link(c_, ends[1], joint, false);
+        }
     }
     if (!a.joints.empty()) mean_edge /= double(a.joints.size());
     c_.sort_by_blocks();
+    if (flow_) flow_->write_contact_pressures(c_);
     corner_radius_ = settings_.corner_radius > 0.0 ? settings_.corner_radius : 0.05 * mean_edge;
     new_contact_property_ = table.new_contact_set(settings_.new_contact_property);
     face_shear_.assign(laws_.size(), 0);
     for (std::size_t k = 0; k < table.specs().size(); ++k) face_shear_[k] = table.specs()[k].face_shear;
 }
 
-void Solver::add_joint_contacts(const meshing::BlockAssembly& a, const meshing::JointRecord& j, int prop,
-                                std::map<std::pair<int, int>, int>& existing) {
+std::array<int, 2> Solver::add_joint_contacts(const meshing::BlockAssembly& a, const meshing::JointRecord& j, int prop,
+                                              std::map<std::pair<int, int>, int>& existing) {
     const double half = 0.5 * j.length();
     auto vertex_of = [&](int block, Vec2 p) {
         for (std::uint32_t v = a.first[block]; v < a.first[block + 1]; ++v)
@@ -290,7 +299,7 @@ void Solver::add_joint_contacts(const meshing::BlockAssembly& a, const meshing::
         BBM_ASSERT(vertex >= 0, "a joint ends at a vertex of one of its blocks");
         if (auto it = existing.find({vertex, edge}); it != existing.end()) {
             c_.length[it->second] += half; // collinear edges: one contact, summed share
-            return;
+            return it->second;
         }
         JointHistory h;
         h.bonded = contact::starts_bonded(laws_[prop]);
@@ -298,9 +307,10 @@ void Solver::add_joint_contacts(const meshing::BlockAssembly& a, const meshing::
         const int edge_block = a_is_vertex ? j.block_b : j.block_a;
         c_.add(a_is_vertex ? j.block_a : j.block_b, vertex, edge_block, edge,
                contact::next_vertex(a.first.data(), edge_block, edge), half, prop, h);
+        return c_.size() - 1;
     };
-    add_end(j.p0, true);
-    add_end(j.p1, false);
+    const int first = add_end(j.p0, true);
+    return {first, add_end(j.p1, false)};
 }
 
 void Solver::prepare_detection(const meshing::BlockAssembly& a) {

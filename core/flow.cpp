@@ -75,15 +75,18 @@ double drive(const Network& n, const FluidSpec& f, const State& s, int k) {
 
 } // namespace
 
-Network Network::of_joints(const meshing::BlockAssembly& a, double tolerance) {
+Network Network::of_joints(const meshing::BlockAssembly& a, double tolerance,
+                           const std::vector<std::uint8_t>* joint_in) {
     Network n;
     if (!(tolerance > 0.0)) {
         Box2 all;
         for (const Vec2& p : a.points) all.add(p);
         tolerance = 1e-9 * std::max({all.width(), all.height(), 1e-300});
     }
+    n.merge_tolerance = tolerance;
     DomainIndex index(n, tolerance);
     for (int j = 0; j < int(a.joints.size()); ++j) {
+        if (joint_in && !(*joint_in)[j]) continue;
         const auto& joint = a.joints[j];
         const double length = joint.length();
         if (!(length > tolerance)) continue;
@@ -97,7 +100,18 @@ Network Network::of_joints(const meshing::BlockAssembly& a, double tolerance) {
     return n;
 }
 
-double hydraulic_aperture(const FluidSpec& f, double a) { return std::clamp(a, f.residual_aperture, f.max_aperture); }
+int Network::domain_at(Vec2 p) const {
+    // Linear: used while building links and boundaries, not per step.
+    int best = -1;
+    double best_d = merge_tolerance;
+    for (int d = 0; d < domains(); ++d)
+        if (const double dist = norm(domain_position[d] - p); dist <= best_d) best = d, best_d = dist;
+    return best;
+}
+
+double hydraulic_aperture(const FluidSpec& f, double a) {
+    return a == 0.0 ? 0.0 : std::clamp(a, f.residual_aperture, f.max_aperture);
+}
 
 double conductance(const Network& n, const FluidSpec& f, const State& s, int pipe) {
     const double a = hydraulic_aperture(f, s.aperture[pipe]);
@@ -118,22 +132,23 @@ double stable_timestep(const Network& n, const FluidSpec& f, const State& s) {
 
 int advance(const Network& n, const FluidSpec& f, State& s, double dt, double safety) {
     if (!(dt > 0.0)) return 0;
-    std::vector<double> csum, volume;
+    auto& w = s.scratch;
+    std::vector<double>&csum = w.conductance_sum, &volume = w.volume, &c = w.c, &rate = w.rate;
     domain_sums(n, f, s, csum, volume);
     // Only the pipes that conduct and the free domains they reach change over the
     // step: in a rock whose intact joints are closed, a small part of the network.
-    std::vector<int> open;
-    std::vector<double> c;
+    std::vector<int>&open = w.open, &wet = w.wet;
+    open.clear(), c.clear(), wet.clear(), rate.clear();
     for (int k = 0; k < n.pipes(); ++k)
         if (const double ck = conductance(n, f, s, k); ck > 0.0) open.push_back(k), c.push_back(ck);
-    std::vector<int> wet;
-    std::vector<double> rate; // K_w / V of each wet domain
+    // K_w / V of each wet domain
     for (int i = 0; i < n.domains(); ++i)
         if (!s.held[i] && volume[i] > 0.0) wet.push_back(i), rate.push_back(f.bulk_modulus / volume[i]);
     const double largest = safety * stable_step_of(n, f, s, csum, volume);
     const int substeps = std::isfinite(largest) ? std::max(1, int(std::ceil(dt / largest))) : 1;
     const double h = dt / substeps;
-    std::vector<double> net(n.domains(), 0.0);
+    std::vector<double>& net = w.net;
+    net.assign(n.domains(), 0.0);
     for (int step = 0; step < substeps; ++step) {
         for (int i : wet) net[i] = s.source[i];
         for (std::size_t m = 0; m < open.size(); ++m) {

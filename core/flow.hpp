@@ -58,8 +58,13 @@ struct Network {
     int pipes() const { return int(pipe_from.size()); }
 
     /// The joints of `a` as pipes; joint ends closer than `tolerance` (m; 0: 1e-9
-    /// of the assembly's extent) are one domain. A joint shorter than that is no pipe.
-    static Network of_joints(const meshing::BlockAssembly& a, double tolerance = 0.0);
+    /// of the assembly's extent) are one domain. A joint shorter than that is no pipe,
+    /// nor one with `joint_in[j] == 0` (when given).
+    static Network of_joints(const meshing::BlockAssembly& a, double tolerance = 0.0,
+                             const std::vector<std::uint8_t>* joint_in = nullptr);
+    /// The domain within the merge tolerance of `p`, or −1.
+    int domain_at(Vec2 p) const;
+    double merge_tolerance = 0.0;
 };
 
 /// The flow state: a pressure per domain, an aperture per pipe, and what holds
@@ -70,6 +75,11 @@ struct State {
     std::vector<std::uint8_t> held; ///< per domain: 1 = pressure prescribed
     std::vector<double> source;    ///< per domain: injected rate Q, m²/s per unit depth
     double time = 0.0;             ///< s
+    /// advance()'s work arrays, kept between calls (no allocation per step).
+    struct Scratch {
+        std::vector<double> conductance_sum, volume, c, rate, net;
+        std::vector<int> open, wet;
+    } scratch;
 
     explicit State(const Network& n, double initial_aperture = 0.0)
         : pressure(n.domains(), 0.0), aperture(n.pipes(), initial_aperture), held(n.domains(), 0),
@@ -77,9 +87,11 @@ struct State {
     void hold(int domain, double p) { held[domain] = 1, pressure[domain] = p; }
 };
 
-/// a³ / (12 μ L) of pipe k, its aperture bounded to [a_res, a_max].
+/// a³ / (12 μ L) of pipe k, its aperture bounded to [a_res, a_max]; an aperture of
+/// exactly 0 seals the pipe (an intact bond without an aperture of its own, a
+/// joint of excavated rock): it neither conducts nor stores.
 double conductance(const Network& n, const FluidSpec& f, const State& s, int pipe);
-/// a clamped to [a_res, a_max].
+/// a clamped to [a_res, a_max], or 0 if a is 0 (sealed).
 double hydraulic_aperture(const FluidSpec& f, double a);
 
 /// Flow along each pipe, from pipe_from to pipe_to, m²/s per unit depth.

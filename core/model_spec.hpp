@@ -11,6 +11,7 @@
 #include "base/vec2.hpp"
 #include "core/bolts.hpp"
 #include "core/dowels.hpp"
+#include "core/joint_flow.hpp"
 #include "core/liners.hpp"
 #include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
@@ -158,6 +159,7 @@ struct AnalysisSpec {
     std::vector<BoltSetSpec> bolts; ///< support sets, installed by install stages
     std::vector<LinerSpec> liners;
     std::vector<DowelSetSpec> dowels;
+    FlowSpec flow; ///< [flow], [[flow_boundary]], [[flow_source]]: water in the joints
     ReportSpec report;
 };
 

@@ -274,7 +274,8 @@ void Solver::initialize_stress(const StressFieldSpec& field) {
         const Vec2 sn_vec = traction(s, n);
         JointHistory& h = c_.history[i];
         const auto& law = laws_[c_.property[i]];
-        h.sn = -dot(n, sn_vec);
+        // The in-situ stress is total; a law carries the effective part (σn − p).
+        h.sn = -dot(n, sn_vec) - (c_.wet() ? c_.fluid_pressure[i] : 0.0);
         h.tau = dot(t, sn_vec);
         h.un = -h.sn / contact::normal_stiffness(law);
         h.us = h.tau / contact::shear_stiffness(law);
@@ -337,6 +338,7 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
                         pressure_block_moment_, pressure_node_force_);
     }
     c_.remove_if_flagged(drop);
+    if (flow_) flow_->excavated(b_.removed);
     rebuild_contact_index();
     detector_.invalidate();
     for (int i = 0; i < b_.count(); ++i)
@@ -411,6 +413,12 @@ void Solver::support_stage() {
                 supports_[k]->force_pass(rock, tie_reaction_.data() + first, tie_moment_.data() + first);
             }
     }
+}
+
+void Solver::flow_stage() {
+    if (!flow_) return;
+#pragma omp single
+    flow_->stage(c_, dt_, steps_);
 }
 
 void Solver::contact_and_zone_stage() {
@@ -700,6 +708,8 @@ void Solver::step() {
         profile_.lap(StepProfile::vertices);
         detect_if_due();            // 1. contact detection, when due
         profile_.lap(StepProfile::detection);
+        flow_stage();               //    water in the joints (core/joint_flow.hpp)
+        profile_.lap(StepProfile::flow);
         face_slip_stage();          // 2. (rigid faces on deformable blocks)
         profile_.lap(StepProfile::face_slip);
         support_stage();            // 4. (bolts and liners: forces and reactions)

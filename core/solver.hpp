@@ -68,9 +68,10 @@ struct SparseTriplets;
 /// first thread between stage boundaries, so a stage's time includes its wait at
 /// the barrier that ends it (the slowest thread's share). Off: one branch a stage.
 struct StepProfile {
-    enum Stage { vertices, detection, face_slip, supports, contacts_and_zones, gather, integrate, bookkeeping, count };
-    static constexpr std::array<const char*, count> names{
-        "vertices", "detection", "face slip", "supports", "contacts and zones", "gather", "integrate", "bookkeeping"};
+    enum Stage { vertices, detection, flow, face_slip, supports, contacts_and_zones, gather, integrate, bookkeeping, count };
+    static constexpr std::array<const char*, count> names{"vertices",           "detection", "flow",
+                                                          "face slip",          "supports",  "contacts and zones",
+                                                          "gather",             "integrate", "bookkeeping"};
     bool enabled = false;
     long steps = 0;
     std::array<double, count> seconds{};
@@ -115,6 +116,8 @@ public:
     const BoltState& bolts() const { return support<BoltSupport>().state(); }
     BoltState& bolts() { return support<BoltSupport>().state(); } ///< a study may load a node (BoltState::applied)
     const LinerState& liners() const { return support<LinerSupport>().state(); }
+    /// Water in the joints (core/joint_flow.hpp); null in a dry model.
+    const JointFlow* flow() const { return flow_.get(); }
     /// Recomputes time step and (quasi-static) masses from the current contacts.
     void update_timestep();
     /// Implicit elastic stage (SPEC §5): assembles the linear stiffness of blocks
@@ -258,8 +261,9 @@ private:
     void build_contacts(const meshing::BlockAssembly& a, const AnalysisSpec& an);
     /// A joint's two point contacts (one per end, half its length each; collinear
     /// edges share one).
-    void add_joint_contacts(const meshing::BlockAssembly& a, const meshing::JointRecord& j, int property,
-                            std::map<std::pair<int, int>, int>& existing);
+    /// The contacts at the joint's two ends (new, or an existing one's share grown).
+    std::array<int, 2> add_joint_contacts(const meshing::BlockAssembly& a, const meshing::JointRecord& j, int property,
+                                          std::map<std::pair<int, int>, int>& existing);
     void prepare_detection(const meshing::BlockAssembly& a); ///< tolerance, reach, junctions
     void prepare_team();                                     ///< the step's per-thread scratch
     // The elastic stage's pieces (core/implicit.cpp).
@@ -289,6 +293,7 @@ private:
     /// The force stages below in order (the implicit stage's evaluations).
     void compute_forces();
     // The force stages of a step (core/solver.cpp), in order.
+    void flow_stage();             ///< water in the joints: apertures, pressures, contact pressures
     void face_slip_stage();        ///< mean slip of rigid faces on deformable blocks
     void support_stage();          ///< the supports' force passes, one thread, no barrier
     void contact_and_zone_stage(); ///< the contact and zone passes, then a barrier
@@ -326,6 +331,7 @@ private:
     StageMonitor monitor_;
     /// The support types (core/support.hpp), and the first tie of each (of supports_.size() + 1).
     std::vector<std::unique_ptr<Support>> supports_;
+    std::unique_ptr<JointFlow> flow_;
     std::vector<int> support_tie_first_;
     /// What each support tie puts on its rock this step (the force, and its moment
     /// about a rigid host's centroid): written by the support stage, gathered by the rock.

@@ -165,6 +165,10 @@ void Solver::for_each_field(Self& s, Visit&& v) {
     v({"contacts.edge_end", G::contacts, E}, c.edge_end), v({"contacts.length", G::contacts, E}, c.length);
     v({"contacts.property", G::contacts, E}, c.property), v({"contacts.history", G::contacts, E}, c.history);
     v({"contacts.normal", G::contacts, R}, c.normal), v({"contacts.force", G::contacts, R}, c.force);
+    // Water in the joints (core/joint_flow.hpp): empty in a dry model.
+    v({"contacts.flow_link", G::contacts, E}, c.flow_link);
+    v({"contacts.fluid_pressure", G::contacts, R}, c.fluid_pressure);
+    if (s.flow_) s.flow_->visit_fields(v, E, R);
     v({"contacts.block_first", G::blocks, R}, c.block_first), v({"contacts.block_entry", G::contacts, R}, c.block_entry);
     v({"contacts.node_first", G::nodes, R}, c.node_first), v({"contacts.node_entry", G::contacts, R}, c.node_entry);
     v({"contacts.fill", G::contacts, R}, c.fill_), v({"contacts.partial_sum", G::contacts, R}, c.partial_sum);
@@ -356,6 +360,7 @@ void Solver::load_state(std::istream& i) {
     if (hash != state_hash()) throw std::runtime_error("checkpoint is corrupt (state hash differs)");
     const auto loaded = field_hashes();
     c_.normal.resize(c_.size());
+    if (flow_) flow_->write_contact_pressures(c_);
     for (auto& support : supports_) support->after_load();
     index_support_ties();
     normals_stale_ = true;

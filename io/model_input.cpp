@@ -582,19 +582,6 @@ JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Pa
     return a;
 }
 
-Box2 read_box(const Ctx& c, const toml::node& node, const Path& p) {
-    const toml::table& t = to_table(c, node, p, "a box { min = [x, y], max = [x, y] }");
-    static constexpr std::array<std::string_view, 2> keys{"min", "max"};
-    check_keys(c, t, p, keys);
-    Box2 b;
-    b.lo = required_point(c, t, p, "min");
-    b.hi = required_point(c, t, p, "max");
-    if (!(b.hi.x > b.lo.x && b.hi.y > b.lo.y))
-        c.fail(*t.get("max"), p.key("max"),
-               "must exceed min = " + fmt(b.lo) + " in both x and y, got " + fmt(b.hi));
-    return b;
-}
-
 BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& names,
                            const Names& regions) {
     static constexpr std::array<std::string_view, 8> velocity_keys{"name", "type", "regions", "box",
@@ -724,6 +711,13 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
                            "): bolt sets, dowel sets and liners share their names (install stages name any)");
             }
     for (const Names* kind : support_kinds) supports.names.insert(supports.names.end(), kind->names.begin(), kind->names.end());
+    read_flow(c, doc, an.flow, regions);
+    if (an.flow.on && an.flow.mode == FlowSpec::Mode::transient && an.solver.mode != SolverSpec::Mode::dynamic) {
+        const Path mp = Path{}.key("flow").key("mode");
+        c.fail(mf.source.line_of(mp.full), mp,
+               "transient flow needs [solver] mode = \"dynamic\": a quasi-static run's time is not real time "
+               "(use mode = \"steady\": drained)");
+    }
     Names stages{"stage", "stages", "stage", {}, {}};
     read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
         an.stages.push_back(read_stage(c, t, p, i, stages, regions, supports));
@@ -861,9 +855,10 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     c.file = name;
     c.source = &mf.source;
     const Path root{};
-    static constexpr std::array<std::string_view, 13> top_keys{
-        "model",    "region", "material", "joint_property", "joint_assignment",
-        "boundary", "solver", "history",  "stage",          "report", "bolt", "liner", "dowel"};
+    static constexpr std::array<std::string_view, 16> top_keys{
+        "model",   "region", "material", "joint_property", "joint_assignment", "boundary",
+        "solver",  "history", "stage",   "report",         "bolt",             "liner",
+        "dowel",   "flow",   "flow_boundary", "flow_source"};
     check_keys(c, doc, root, top_keys);
 
     if (const toml::node* n = find(c, doc, root, "model")) {

@@ -475,6 +475,20 @@ template <class F> void read_tables(Ctx& c, const toml::table& doc, std::string_
     c.owner.clear();
 }
 
+/// A box { min = [x, y], max = [x, y] } with max above min in x and y.
+inline Box2 read_box(const Ctx& c, const toml::node& node, const Path& p) {
+    const toml::table& t = to_table(c, node, p, "a box { min = [x, y], max = [x, y] }");
+    static constexpr std::array<std::string_view, 2> keys{"min", "max"};
+    check_keys(c, t, p, keys);
+    Box2 b;
+    b.lo = required_point(c, t, p, "min");
+    b.hi = required_point(c, t, p, "max");
+    if (!(b.hi.x > b.lo.x && b.hi.y > b.lo.y))
+        c.fail(*t.get("max"), p.key("max"),
+               "must exceed min = " + fmt(b.lo) + " in both x and y, got " + fmt(b.hi));
+    return b;
+}
+
 // --- stress fields (boundaries and initialize stages) -----------------------------
 
 
@@ -509,5 +523,7 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
                                  const meshing::OutlineSpec& outline);
 /// [[liner]] tables (io/read_liners.cpp).
 void read_liners(Ctx& c, const toml::table& doc, std::vector<LinerSpec>& liners, Names& names);
+/// [flow], [[flow_boundary]] and [[flow_source]] (io/read_flow.cpp).
+void read_flow(Ctx& c, const toml::table& doc, FlowSpec& flow, const Names& regions);
 
 } // namespace bbm::io::reader

@@ -1,0 +1,138 @@
+// bbm core: water in the joints, coupled to the blocks (docs/theory.md §16.4).
+//
+// The network of core/flow.hpp over the joints of the "flow regions" (by default
+// every region with a block pattern; the elastic far field is dry), tied to the
+// solver's contacts and stepped as one stage of the step:
+//
+//   aperture   each point contact of a pipe's joint gives a = a0 + un, bounded to
+//              [a_res, a_max] (un: its normal opening, SPEC §4), or the bond's own
+//              aperture while it is intact (0: sealed); a pipe takes the mean of
+//              its contacts'. A pipe with a removed block is closed.
+//   pressure   steady (drained: one sparse solve every `steady_every` steps, and
+//              after an excavation) or transient (explicit sub-steps under the
+//              flow's stable step, dynamic mode only).
+//   coupling   the joint laws act on the effective stress σn' = σn − p: a
+//              contact's law force is the skeleton's, and the fluid adds p over the
+//              contact's share of its pipes' lengths along the normal (pushing the
+//              blocks apart). p is the pressure of the domain at the contact's
+//              vertex — a joint's two end contacts take its two ends' pressures.
+//   boundaries the far-field interface held at the undisturbed pressure (or
+//              sealed), an opening's wall drained to atmospheric when excavated,
+//              [[flow_boundary]] boxes held at a pressure or a head, rates at points.
+//
+// Arrays: per contact, Contacts::flow_link {domain, pipe, pipe} (empty in a dry
+// model, moved with its contact) and Contacts::fluid_pressure (written by the
+// stage before the contact pass); per domain the pressure, held and drained flags
+// (saved and hashed: visit_fields).
+#pragma once
+
+#include "contact/contacts.hpp"
+#include "core/flow.hpp"
+#include "core/state_fields.hpp"
+#include "meshing/blocks.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bbm {
+
+/// [[flow_boundary]]: the domains in a box held at a pressure or a hydraulic head.
+struct FlowBoundarySpec {
+    std::string name;
+    Box2 box;
+    std::optional<double> pressure; ///< Pa
+    std::optional<double> head;     ///< m: p = ρ_w |g| (head − y)
+};
+
+/// [[flow_source]]: a rate injected (negative: extracted) at the domain nearest a point.
+struct FlowSourceSpec {
+    Vec2 at{};
+    double rate = 0.0; ///< m²/s per unit depth
+};
+
+/// [flow]: the fluid, the joints' apertures, the initial pressure and the boundaries.
+struct FlowSpec {
+    bool on = false;
+    flow::FluidSpec fluid;        ///< gravity: the solver's unless `gravity_given`
+    bool gravity_given = false;
+    double aperture = 1.0e-4;     ///< a0: hydraulic aperture of a broken or unbonded joint at zero normal stress, m
+    double bond_aperture = 0.0;   ///< an intact bond's; 0 = sealed
+    std::vector<std::string> regions; ///< empty = every region with a block pattern
+    std::optional<double> water_table; ///< y of the free surface: hydrostatic below it
+    double pressure = 0.0;             ///< uniform initial pressure when no water table, Pa
+    enum class Mode { steady, transient };
+    Mode mode = Mode::steady;
+    int steady_every = 100;            ///< steps between steady solves
+    bool far_field_held = true;        ///< the interface with dry regions held at the initial pressure
+    bool drain_openings = true;        ///< an excavated opening's wall at atmospheric pressure
+    std::vector<FlowBoundarySpec> boundaries;
+    std::vector<FlowSourceSpec> sources;
+};
+
+class JointFlow {
+public:
+    /// The network of the flow regions' joints, initial pressures and held domains.
+    /// Throws InputError (key "flow") for a water table or head without gravity, a
+    /// flow region that does not exist, or a network with no joint.
+    JointFlow(const meshing::BlockAssembly& a, const FlowSpec& spec, Vec2 solver_gravity);
+
+    /// Ties contact `contact` (at end p0 or p1 of joint `joint`) to its domain and
+    /// pipe; call for both ends of every joint as its contacts are made.
+    void link(contact::Contacts& c, int contact, int joint, bool at_p0) const;
+
+    /// The stage: apertures from the contacts, pressures (steady or transient over
+    /// `dt`), then each contact's fluid pressure. Serial.
+    void stage(contact::Contacts& c, double dt, long step);
+    /// Only the contacts' fluid pressures from the current domain pressures.
+    void write_contact_pressures(contact::Contacts& c) const;
+    /// After an excavation: pipes of removed blocks close; their walls' domains
+    /// (ends of a pipe with one removed block) are drained (held at 0) if asked.
+    void excavated(const std::vector<std::uint8_t>& removed);
+
+    /// Net flow into the drained walls of openings, m²/s per unit depth (positive: out of the rock).
+    double inflow() const;
+    /// Per contact: its pipes' mean hydraulic aperture (m; 0 where it has none).
+    std::vector<double> contact_apertures(const contact::Contacts& c) const;
+    /// Fluid pressure of the domain at a point's nearest domain, Pa.
+    double pressure_near(Vec2 p) const;
+
+    const flow::Network& network() const { return net_; }
+    const flow::State& state() const { return state_; }
+    const flow::FluidSpec& fluid() const { return fluid_; }
+    const FlowSpec& spec() const { return spec_; }
+    const std::vector<std::uint8_t>& drained() const { return drained_; }
+    int steady_solves() const { return solves_; }
+
+    /// Its arrays in the solver's state list (core/state.cpp): visit(info, array).
+    template <class Visit>
+    void visit_fields(Visit&& v, unsigned evolving, unsigned rebuilt) {
+        v({"flow.pressure", MemoryGroup::other, evolving}, state_.pressure);
+        v({"flow.held", MemoryGroup::other, evolving}, state_.held);
+        v({"flow.drained", MemoryGroup::other, evolving}, drained_);
+        v({"flow.pipe_open", MemoryGroup::other, evolving}, pipe_open_);
+        v({"flow.time", MemoryGroup::other, evolving}, state_.time);
+        v({"flow.pending_solve", MemoryGroup::other, evolving}, pending_solve_);
+        v({"flow.aperture", MemoryGroup::other, rebuilt}, state_.aperture);
+        v({"flow.source", MemoryGroup::other, rebuilt}, state_.source);
+    }
+
+private:
+    void update_apertures(const contact::Contacts& c);
+    double initial_pressure(Vec2 x) const;
+
+    FlowSpec spec_;
+    flow::FluidSpec fluid_;
+    flow::Network net_;
+    flow::State state_;
+    std::vector<int> joint_pipe_;         ///< per joint: its pipe, −1 if none
+    std::vector<int> pipe_block_a_, pipe_block_b_;
+    std::vector<std::uint8_t> pipe_open_; ///< 0: a block of it removed
+    std::vector<std::uint8_t> drained_;   ///< per domain: on an excavated opening's wall
+    std::vector<double> aperture_sum_;
+    std::vector<int> aperture_count_;
+    std::uint8_t pending_solve_ = 1;      ///< a steady solve due at the next stage
+    int solves_ = 0;
+};
+
+} // namespace bbm
