@@ -101,7 +101,8 @@ struct HistorySpec {
     enum class Quantity {
         unbalanced_ratio, displacement_x, displacement_y, velocity_x, velocity_y, rotation,
         boundary_force_x, boundary_force_y, cracks_tensile, cracks_shear, kinetic_energy,
-        strain_energy, dissipated_energy, work
+        strain_energy, dissipated_energy, work,
+        inflow ///< into the drained openings, m²/s per unit depth ([flow])
     };
     std::string name;
     Quantity quantity = Quantity::unbalanced_ratio;

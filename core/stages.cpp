@@ -153,6 +153,7 @@ std::vector<double> HistoryRecorder::sample(const Solver& s) const {
         case Q::strain_energy: v = s.strain_energy(); break;
         case Q::dissipated_energy: v = s.dissipated_energy(); break;
         case Q::work: v = s.external_work(); break;
+        case Q::inflow: v = s.flow() ? s.flow()->inflow() : 0.0; break;
         }
         out.push_back(v);
     }

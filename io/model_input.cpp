@@ -712,6 +712,11 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
             }
     for (const Names* kind : support_kinds) supports.names.insert(supports.names.end(), kind->names.begin(), kind->names.end());
     read_flow(c, doc, an.flow, regions);
+    for (std::size_t i = 0; i < an.histories.size(); ++i)
+        if (an.histories[i].quantity == HistorySpec::Quantity::inflow && !an.flow.on) {
+            const Path hp = Path{}.key("history").at(i).key("quantity");
+            c.fail(mf.source.line_of(hp.full), hp, "an inflow history needs a [flow] table (water in the joints)");
+        }
     if (an.flow.on && an.flow.mode == FlowSpec::Mode::transient && an.solver.mode != SolverSpec::Mode::dynamic) {
         const Path mp = Path{}.key("flow").key("mode");
         c.fail(mf.source.line_of(mp.full), mp,

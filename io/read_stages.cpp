@@ -8,13 +8,14 @@ namespace bbm::io::reader {
 namespace {
 
 // In the order of the enums of core/model_spec.hpp.
-constexpr std::array<std::string_view, 14> quantities{"unbalanced_ratio",  "displacement_x",
+constexpr std::array<std::string_view, 15> quantities{"unbalanced_ratio",  "displacement_x",
                                                       "displacement_y",    "velocity_x",
                                                       "velocity_y",        "rotation",
                                                       "boundary_force_x",  "boundary_force_y",
                                                       "cracks_tensile",    "cracks_shear",
                                                       "kinetic_energy",    "strain_energy",
-                                                      "dissipated_energy", "work"};
+                                                      "dissipated_energy", "work",
+                                                      "inflow"};
 constexpr std::array<std::string_view, 6> stage_types{"initialize", "solve", "excavate", "cycle",
                                                       "elastic",    "install"};
 

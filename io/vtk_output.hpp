@@ -70,6 +70,10 @@ void write_state_blocks_vtu(const Solver& s, const std::filesystem::path& file);
 /// us, damage, state (0 intact, 1 softening, 2 broken-tension, 3 broken-shear,
 /// 4 sliding), property, length).
 void write_state_contacts_vtu(const Solver& s, const std::filesystem::path& file);
+/// Water in the joints (a model with [flow]): the network's domains as points
+/// (point data pressure, head, held, drained) and its pipes as line cells (cell
+/// data aperture, flow_rate from pipe_from to pipe_to in m²/s per m, joint).
+void write_flow_vtu(const Solver& s, const std::filesystem::path& file);
 /// An installed support type (core/support.hpp) as line cells with the arrays
 /// its lines() names: bolts (core/bolts.hpp), liners (core/liners.hpp), dowels
 /// (core/dowels.hpp) document theirs.

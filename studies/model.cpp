@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -208,6 +209,19 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         // last good state, not the end of the model's stages.
         {"complete", complete},
         {"stages", stages}};
+    if (const JointFlow* flow = solver.flow()) {
+        const auto& st = flow->state();
+        int conducting = 0;
+        for (int k = 0; k < flow->network().pipes(); ++k)
+            conducting += flow::conductance(flow->network(), flow->fluid(), st, k) > 0.0;
+        summary["flow"] = {{"mode", flow->spec().mode == FlowSpec::Mode::steady ? "steady" : "transient"},
+                           {"domains", flow->network().domains()},
+                           {"pipes", flow->network().pipes()},
+                           {"conducting_pipes", conducting},
+                           {"inflow", flow->inflow()},
+                           {"max_pressure", *std::max_element(st.pressure.begin(), st.pressure.end())},
+                           {"steady_solves", flow->steady_solves()}};
+    }
     // The run's verdict: that of its last judged (solve or cycle) stage.
     for (auto r = reports.rbegin(); r != reports.rend(); ++r)
         if (r->verdict.kind != Verdict::Kind::none) {

@@ -256,6 +256,11 @@ public:
         std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
         write_state_contacts_vtu(s, out_ / name);
         series_.push_back({s.time(), name});
+        if (s.flow()) {
+            std::snprintf(name, sizeof name, "vtk/flow_%08ld.vtu", s.steps());
+            write_flow_vtu(s, out_ / name);
+            series_.push_back({s.time(), name});
+        }
         for (const auto& support : s.supports()) {
             if (support->tie_count() == 0) continue;
             std::snprintf(name, sizeof name, "vtk/%s_%08ld.vtu", support->name(), s.steps());

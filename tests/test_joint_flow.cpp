@@ -8,6 +8,7 @@
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
 #include "restart.hpp"
+#include "io/model_input.hpp"
 
 #include <doctest/doctest.h>
 
@@ -258,4 +259,41 @@ TEST_CASE("a pressurised crack in elastic blocks opens as Sneddon's: w = 4 (1 - 
     MESSAGE("Sneddon: worst relative error of the opening over |x| <= 0.8 c: ", worst, " at ", checked, " nodes");
     CHECK(checked > 20);
     CHECK(worst < 0.05);
+}
+
+TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far field, inflow; exact on restart "
+          "and on 2 threads") {
+    auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/tunnel_below_water_table.toml");
+    test::RestartModel m{meshing::generate_blocks(file.geometry), file.analysis};
+    for (auto& stage : m.analysis.stages) {
+        if (stage.kind == StageSpec::Kind::excavate) stage.relax_steps = stage.steps = 600;
+        if (stage.kind == StageSpec::Kind::solve) stage.max_steps = 900;
+    }
+    {
+        Solver s(m.blocks, m.analysis);
+        const JointFlow& flow = *s.flow();
+        const auto& net = flow.network();
+        const double rho_g = 1000.0 * 9.81;
+        // Held at the interface with the far field: hydrostatic from the table at y = 100 m.
+        int held = 0;
+        for (int d = 0; d < net.domains(); ++d)
+            if (flow.state().held[d]) {
+                ++held;
+                CHECK(flow.state().pressure[d] == doctest::Approx(rho_g * (100.0 - net.domain_position[d].y)));
+            }
+        CHECK(held > 100);
+        StageObserver quiet;
+        run_stages(s, m.analysis.stages, quiet);
+        // After excavation the wall is drained and water flows into the tunnel.
+        int drained = 0;
+        for (int d = 0; d < net.domains(); ++d)
+            if (flow.drained()[d]) {
+                ++drained;
+                CHECK(flow.state().pressure[d] == 0.0);
+            }
+        CHECK(drained > 20);
+        CHECK(flow.inflow() > 0.0);
+        MESSAGE("inflow " << flow.inflow() << " m2/s per m of the half model, " << drained << " drained domains");
+    }
+    test::check_exact_restart(m, {300, 1000}, {2});
 }
