@@ -1537,3 +1537,25 @@ TEST_CASE("fracture traces from a DXF drawing: lines, polylines with arcs, layer
               "the POLYLINE has no SEQEND");
     std::remove(path.c_str());
 }
+
+TEST_CASE("the water tables ([flow], [[flow_boundary]], [[flow_source]]) refuse bad input with file, line and key") {
+    const std::string base = std::string(one_region);
+    check_error(base + "[flow]\naperture = -1e-4\n", "aperture = -1e-4", "flow.aperture", "must be > 0 m");
+    check_error(base + "[flow]\nviscosity = 0.0\n", "viscosity = 0.0", "flow.viscosity", "must be > 0 Pa·s");
+    check_error(base + "[flow]\nbond_aperture = -1e-6\n", "bond_aperture", "flow.bond_aperture", "must be >= 0 m");
+    check_error(base + "[flow]\nmax_aperture = 1e-3\nresidual_aperture = 2e-3\n", "[flow]", "flow.max_aperture",
+                "must exceed residual_aperture");
+    check_error(base + "[flow]\nwater_table = 10.0\npressure = 1e5\n", "[flow]", "flow.pressure",
+                "not both");
+    check_error(base + "[flow]\nregions = [\"b\"]\n", "regions", "flow.regions[0]", "region");
+    check_error(base + "[flow]\nmode = \"transient\"\n", "mode", "flow.mode", "dynamic");
+    check_error(base + "[flow]\nmode = \"unsteady\"\n", "mode", "flow.mode", "did you mean");
+    check_error(base + "[flow]\nfar_field = \"open\"\n", "far_field", "flow.far_field", "held");
+    check_error(base + "[flow]\n\n[[flow_boundary]]\nname = \"top\"\nbox = { min = [0, 0], max = [1, 1] }\n",
+                "[[flow_boundary]]", "flow_boundary[0]", "'pressure' or the 'head'");
+    check_error(base + "[[flow_boundary]]\nname = \"top\"\nbox = { min = [0, 0], max = [1, 1] }\npressure = 1e5\n",
+                "[[flow_boundary]]", "flow_boundary[0]", "needs a [flow] table");
+    check_error(base + "[flow]\n\n[[flow_source]]\nat = [0, 0]\n", "[[flow_source]]", "flow_source[0].rate", "rate");
+    check_error(base + "[[history]]\nname = \"q\"\nquantity = \"inflow\"\n", "quantity = \"inflow\"",
+                "history[0].quantity", "needs a [flow] table");
+}
