@@ -160,8 +160,41 @@ int main(int argc, char** argv) {
             answers.push_back({{"job", job.name}, {"seconds", t.seconds}, {"target_seconds", job.target_seconds},
                                {"steps", t.steps}});
         }
-        fs::remove_all(tmp);
         result["time_to_answer"] = answers;
+
+        // 3. Water in the joints: the flow stage's cost per step against the
+        // mechanical stages' (the step profile of the wet tunnel, 2 threads).
+        {
+            studies::RunOptions o;
+            o.model = (root / "examples/water/tunnel_below_water_table.toml").string();
+            o.out = tmp / "water", o.threads = 2, o.quiet = true, o.profile = true;
+            const auto t0 = clock_type::now();
+            studies::run_model(o);
+            const double wall = seconds_since(t0);
+            std::ifstream in(o.out / "summary.json");
+            const auto summary = nlohmann::json::parse(in);
+            const auto& prof = summary["profile"];
+            const double steps = prof["steps"].get<double>(), flow = prof["seconds"]["flow"].get<double>();
+            const double total = prof["total_seconds"].get<double>();
+            const int solves = summary["flow"]["steady_solves"].get<int>();
+            std::printf("\nwater in the joints (examples/water/tunnel_below_water_table.toml, 2 threads)\n"
+                        "  %.0f steps, %d steady solves of %d domains: flow %.1f us per step (%.1f ms per solve), "
+                        "the mechanical stages %.1f us per step (flow %.1f%% of the step); %.2f s end to end\n",
+                        steps, solves, summary["flow"]["domains"].get<int>(), 1e6 * flow / steps,
+                        solves ? 1e3 * flow / solves : 0.0, 1e6 * (total - flow) / steps, 100.0 * flow / total, wall);
+            result["flow_stage"] = {{"model", "examples/water/tunnel_below_water_table.toml"},
+                                    {"threads", 2},
+                                    {"steps", steps},
+                                    {"steady_solves", solves},
+                                    {"domains", summary["flow"]["domains"]},
+                                    {"pipes", summary["flow"]["pipes"]},
+                                    {"flow_us_per_step", 1e6 * flow / steps},
+                                    {"flow_ms_per_steady_solve", solves ? 1e3 * flow / solves : 0.0},
+                                    {"mechanical_us_per_step", 1e6 * (total - flow) / steps},
+                                    {"flow_share_of_step", flow / total},
+                                    {"wall_seconds", wall}};
+        }
+        fs::remove_all(tmp);
     }
     // 1. Scaling.
     std::vector<int> sizes{2500, 10000, 40000, 160000};

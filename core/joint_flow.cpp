@@ -148,14 +148,20 @@ void JointFlow::write_contact_pressures(contact::Contacts& c) const {
 }
 
 void JointFlow::stage(contact::Contacts& c, double dt, long step) {
-    update_apertures(c);
     if (spec_.mode == FlowSpec::Mode::transient) {
+        update_apertures(c);
         flow::advance(net_, fluid_, state_, dt);
-    } else if (pending_solve_ || (spec_.steady_every > 0 && step % spec_.steady_every == 0)) {
-        flow::solve_steady(net_, fluid_, state_);
-        pending_solve_ = 0;
-        ++solves_;
+        write_contact_pressures(c);
+        return;
     }
+    // Steady: nothing changes between solves. The contacts' pressures move with
+    // their contacts when detection removes or renumbers them, and a contact it
+    // makes has no pipe (0).
+    if (!pending_solve_ && !(step % spec_.steady_every == 0)) return;
+    update_apertures(c);
+    flow::solve_steady(net_, fluid_, state_);
+    pending_solve_ = 0;
+    ++solves_;
     write_contact_pressures(c);
 }
 
