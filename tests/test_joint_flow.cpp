@@ -297,3 +297,84 @@ TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far
     }
     test::check_exact_restart(m, {300, 1000}, {2});
 }
+
+TEST_CASE("transient flow as a stage of a dynamic run: a pressure step diffuses along a fracture as erfc") {
+    // The library's erfc check (tests/test_flow.cpp) through the solver: a 10 m
+    // fracture through 0.2 m Voronoi blocks, every block held still, the intact
+    // bonds sealed, the fracture's unbonded joints open at a0 = 20 μm; water at p0
+    // held at its left end from t = 0, the flow sub-stepped inside each dynamic step.
+    const double a0 = 2e-5, p0 = 1e6;
+    const Built m = build(R"(
+[solver]
+mode = "dynamic"
+
+[[region]]
+name = "rock"
+outline = { type = "rectangle", min = [0.0, 0.0], max = [10.0, 1.0] }
+pattern = { type = "voronoi", size = 0.2, seed = 2 }
+joints = [ { from = [0.0, 0.5], to = [10.0, 0.5] } ]
+
+[[joint_property]]
+name = "bond"
+law = "elastic"
+kn = 1e11
+ks = 1e11
+
+[[joint_property]]
+name = "fracture"
+law = "coulomb"
+kn = 1e11
+ks = 1e11
+friction = 30.0
+
+[[joint_assignment]]
+property = "bond"
+
+[[joint_assignment]]
+property = "fracture"
+tags = ["real_joint"]
+
+[[boundary]]
+name = "held"
+type = "velocity"
+regions = ["rock"]
+vx = 0.0
+vy = 0.0
+omega = 0.0
+
+[flow]
+mode = "transient"
+aperture = 2e-5
+
+[[flow_boundary]]
+name = "inlet"
+box = { min = [-0.01, 0.49], max = [0.01, 0.51] }
+pressure = 1e6
+)");
+    Solver s(m.blocks, m.file.analysis);
+    const JointFlow& flow = *s.flow();
+    const flow::FluidSpec& f = flow.fluid();
+    const double diffusivity = f.bulk_modulus * a0 * a0 / (12.0 * f.viscosity);
+    const double target = 1.5 * 1.5 / diffusivity; // √(D t) = 1.5 m
+    const long steps = long(std::ceil(target / s.timestep()));
+    for (long k = 0; k < steps; ++k) s.step();
+    const double t = flow.state().time, spread = std::sqrt(diffusivity * t);
+    CHECK(t == doctest::Approx(steps * s.timestep()));
+    const auto& net = flow.network();
+    double worst = 0.0;
+    int compared = 0;
+    for (int i = 0; i < net.domains(); ++i) {
+        const Vec2 x = net.domain_position[i];
+        if (std::abs(x.y - 0.5) > 1e-9 || x.x < 1e-9) continue;
+        worst = std::max(worst, std::abs(flow.state().pressure[i] - p0 * std::erfc(x.x / (2.0 * spread))));
+        ++compared;
+    }
+    MESSAGE("transient stage: " << steps << " dynamic steps of " << s.timestep() << " s, sqrt(D t) = " << spread
+                                << " m; largest difference from erfc " << worst / p0 * 100.0 << "% of p0 at "
+                                << compared << " domains");
+    CHECK(compared > 30);
+    CHECK(worst < 1e-3 * p0); // 0.026% measured
+    // The water pushes on the fracture's faces, the blocks held: no contact has
+    // moved, and the apertures are a0 still.
+    for (double a : flow.contact_apertures(s.contacts())) CHECK((a == 0.0 || a == doctest::Approx(a0)));
+}
