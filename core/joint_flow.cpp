@@ -165,13 +165,13 @@ void JointFlow::stage(contact::Contacts& c, double dt, long step) {
     write_contact_pressures(c);
 }
 
-void JointFlow::excavated(const std::vector<std::uint8_t>& removed) {
+void JointFlow::excavated(const std::vector<std::uint8_t>& removed, double wall_pressure) {
     for (int k = 0; k < net_.pipes(); ++k) {
         const bool ra = removed[pipe_block_a_[k]], rb = removed[pipe_block_b_[k]];
         if (!ra && !rb) continue;
         pipe_open_[k] = 0;
         if (ra != rb && spec_.drain_openings)
-            for (int d : {net_.pipe_from[k], net_.pipe_to[k]}) drained_[d] = 1, state_.hold(d, 0.0);
+            for (int d : {net_.pipe_from[k], net_.pipe_to[k]}) drained_[d] = 1, state_.hold(d, wall_pressure);
     }
     pending_solve_ = 1;
 }

@@ -87,8 +87,10 @@ public:
     /// Only the contacts' fluid pressures from the current domain pressures.
     void write_contact_pressures(contact::Contacts& c) const;
     /// After an excavation: pipes of removed blocks close; their walls' domains
-    /// (ends of a pipe with one removed block) are drained (held at 0) if asked.
-    void excavated(const std::vector<std::uint8_t>& removed);
+    /// (ends of a pipe with one removed block) are held at the opening's water
+    /// pressure, `wall_pressure` (0: drained to atmospheric; a pressurised borehole:
+    /// the excavate stage's `pressure`), if `drain_openings`.
+    void excavated(const std::vector<std::uint8_t>& removed, double wall_pressure = 0.0);
 
     /// Net flow into the drained walls of openings, m²/s per unit depth (positive: out of the rock).
     double inflow() const;

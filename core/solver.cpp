@@ -338,7 +338,7 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
                         pressure_block_moment_, pressure_node_force_);
     }
     c_.remove_if_flagged(drop);
-    if (flow_) flow_->excavated(b_.removed);
+    if (flow_) flow_->excavated(b_.removed, pressure); // the opening's water pushes on its wall and enters it
     rebuild_contact_index();
     detector_.invalidate();
     for (int i = 0; i < b_.count(); ++i)
