@@ -103,6 +103,11 @@ int run_cli(int argc, char** argv) {
     run->add_flag("--profile", run_options.profile,
                   "Time each stage of the step (detection, contacts and zones, gather, integration...): a table on "
                   "stderr at the end, and \"profile\" in summary.json");
+    run->add_option_function<std::string>(
+           "--shade", [&run_options](const std::string& v) { run_options.shade_pressure = v == "pressure"; },
+           "What failure.png's blocks are shaded by: displacement (the default) or pressure (the water in their "
+           "joints, a model with [flow])")
+        ->check(CLI::IsMember({"displacement", "pressure"}));
 
     std::vector<std::string> compare_models;
     std::string compare_out = "out/compare";

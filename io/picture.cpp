@@ -217,39 +217,65 @@ Box2 failure_frame(const Solver& s, const FailurePlotOptions& o) {
     return box;
 }
 
-/// The displacement a picture shades by: of rigid blocks (centroid) and of zones
-/// (mean of their nodes). The scale ends at the 99.5th percentile: one fragment
-/// fallen far must not wash out the displacement field of the rest.
-struct DisplacementShade {
-    const Solver& s;
+/// What a failure picture's blocks and zones are shaded by: their displacement
+/// (light grey to ochre; rigid blocks' centroids, zones' mean of their nodes; the
+/// scale ends at the 99.5th percentile: one fragment fallen far must not wash out
+/// the rest) or, in a wet model on request, the water's pressure in their joints
+/// (light grey to blue, to the largest; the dry far field grey).
+struct Shade {
+    bool water = false;
+    std::vector<double> block, zone; ///< per block (rigid), per zone
     double top = 0.0, largest = 0.0;
-    explicit DisplacementShade(const Solver& solver) : s(solver) {
+    Shade(const Solver& s, bool by_pressure) : water(by_pressure && s.flow()) {
         const auto& b = s.blocks();
         const auto& z = s.zones();
-        std::vector<double> us;
-        for (int i = 0; i < b.count(); ++i)
-            if (!b.removed[i] && !b.deformable[i]) us.push_back(norm(b.centroid[i] - b.centroid0[i]));
-        for (int k = 0; k < z.size(); ++k)
-            if (!b.removed[z.block[k]]) us.push_back(zone(k));
-        std::sort(us.begin(), us.end());
-        largest = us.empty() ? 0.0 : us.back();
-        top = us.empty() ? 0.0 : us[std::size_t(0.995 * double(us.size() - 1))];
-    }
-    double zone(int k) const {
         const auto& nodes = s.nodes();
-        Vec2 u{};
-        for (int nd : s.zones().node[k]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0;
-        return norm(u);
+        block.assign(b.count(), 0.0), zone.assign(z.size(), 0.0);
+        if (water) {
+            // A block's pressure: the length-weighted mean of its contacts' water pressure.
+            const auto& c = s.contacts();
+            std::vector<double> length(b.count(), 0.0);
+            for (int i = 0; i < c.size(); ++i)
+                for (int blk : {c.vertex_block[i], c.edge_block[i]})
+                    block[blk] += c.fluid_pressure[i] * c.length[i], length[blk] += c.length[i];
+            for (int i = 0; i < b.count(); ++i) block[i] = length[i] > 0 ? block[i] / length[i] : 0.0;
+        } else {
+            for (int i = 0; i < b.count(); ++i) block[i] = norm(b.centroid[i] - b.centroid0[i]);
+            for (int k = 0; k < z.size(); ++k) {
+                Vec2 u{};
+                for (int nd : z.node[k]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0;
+                zone[k] = norm(u);
+            }
+        }
+        std::vector<double> v;
+        for (int i = 0; i < b.count(); ++i)
+            if (!b.removed[i] && !b.deformable[i]) v.push_back(block[i]);
+        for (int k = 0; k < z.size(); ++k)
+            if (!b.removed[z.block[k]]) v.push_back(zone[k]);
+        std::sort(v.begin(), v.end());
+        largest = v.empty() ? 0.0 : v.back();
+        top = v.empty() ? 0.0 : water ? largest : v[std::size_t(0.995 * double(v.size() - 1))];
     }
-    /// Light grey for still material to ochre for the most displaced.
     void set(cairo_t* cr, double u) const {
+        if (water) {
+            const double f = top > 0 ? std::min(1.0, u / top) : 0.0;
+            cairo_set_source_rgb(cr, 0.92 - 0.75 * f, 0.92 - 0.5 * f, 0.92 - 0.05 * f);
+            return;
+        }
         const double f = top > 0 ? std::sqrt(std::min(1.0, u / top)) : 0.0;
         cairo_set_source_rgb(cr, 0.92 - 0.05 * f, 0.92 - 0.25 * f, 0.92 - 0.6 * f);
     }
+    /// The legend's words for the shading.
+    std::string words() const {
+        char buf[120];
+        if (water) std::snprintf(buf, sizeof buf, "shading: water pressure 0 to %.3g MPa", 1e-6 * top);
+        else std::snprintf(buf, sizeof buf, "shading: displacement 0 to %.3g mm (max %.3g mm)", 1e3 * top, 1e3 * largest);
+        return buf;
+    }
 };
 
-/// Zones and blocks shaded by their displacement; deformable blocks outlined.
-void draw_material(cairo_t* cr, const Solver& s, const DisplacementShade& shade, double px) {
+/// Zones and blocks shaded; deformable blocks outlined.
+void draw_material(cairo_t* cr, const Solver& s, const Shade& shade, double px) {
     const auto& b = s.blocks();
     const auto& nodes = s.nodes();
     const auto& z = s.zones();
@@ -258,7 +284,7 @@ void draw_material(cairo_t* cr, const Solver& s, const DisplacementShade& shade,
         const auto& t = z.node[k];
         const Vec2 corners[3] = {nodes.position[t[0]], nodes.position[t[1]], nodes.position[t[2]]};
         polygon_path(cr, corners);
-        shade.set(cr, shade.zone(k));
+        shade.set(cr, shade.zone[k]);
         cairo_fill_preserve(cr);
         cairo_set_source_rgba(cr, 0.7, 0.7, 0.7, 0.5);
         cairo_set_line_width(cr, 0.25 * px);
@@ -273,7 +299,7 @@ void draw_material(cairo_t* cr, const Solver& s, const DisplacementShade& shade,
             cairo_stroke(cr);
             continue;
         }
-        shade.set(cr, norm(b.centroid[i] - b.centroid0[i]));
+        shade.set(cr, shade.block[i]);
         cairo_fill_preserve(cr);
         cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 0.7);
         cairo_set_line_width(cr, 0.4 * px);
@@ -366,7 +392,7 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     const View view(box, o.width_px, legend);
     Canvas canvas(file, view.w, view.h);
     cairo_t* cr = canvas.cr;
-    const DisplacementShade shade(s);
+    const Shade shade(s, o.shade_pressure);
     view.apply(cr, box, legend);
     const double px = 1.0 / view.scale;
     draw_material(cr, s, shade, px);
@@ -386,8 +412,8 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    std::snprintf(buf, sizeof buf, "shear cracks (%d)   shading: displacement 0 to %.3g mm (max %.3g mm)%s%s%s%s",
-                  s.cracks(contact::JointState::broken_shear), 1e3 * shade.top, 1e3 * shade.largest,
+    std::snprintf(buf, sizeof buf, "shear cracks (%d)   %s%s%s%s%s", s.cracks(contact::JointState::broken_shear),
+                  shade.words().c_str(),
                   o.outline.empty() ? "" : "   dashed: failed zone", support_legend.c_str(), o.title.empty() ? "" : "   ",
                   o.title.c_str());
     text(cr, 292, y0, buf);

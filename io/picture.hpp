@@ -37,9 +37,12 @@ struct FailurePlotOptions {
     std::string title;
     /// A closed outline drawn dashed over the cracks (the failed zone about an opening); empty: none.
     std::vector<Vec2> outline;
+    /// Shade the blocks by the water's pressure in their joints (a model with
+    /// [flow]), not by their displacement.
+    bool shade_pressure = false;
 };
 
-/// Blocks shaded by displacement magnitude, with broken contacts drawn along their
+/// Blocks shaded by displacement magnitude (or the water's pressure), with broken contacts drawn along their
 /// joints: tensile cracks red, shear cracks blue; a legend.
 void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o = {});
 

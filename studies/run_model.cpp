@@ -663,7 +663,8 @@ int run_model(const RunOptions& opt) {
     nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, stop_signal != 0,
                                          health.empty() && stop_signal == 0);
     if (opt.profile) summary["profile"] = report_profile(solver->profile(), solver->contacts().size());
-    const FailurePlotOptions fo = failure_plot_options(model, blocks, *solver, model_path);
+    FailurePlotOptions fo = failure_plot_options(model, blocks, *solver, model_path);
+    fo.shade_pressure = opt.shade_pressure;
     if (!health.empty()) summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
     else draw_pictures(*solver, output, opt, fo);
     write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");

@@ -41,6 +41,7 @@ struct RunOptions {
     double max_elements = 0;        ///< overrides [model] max_elements when > 0
     bool check_only = false;        ///< read, generate and set up the model, then stop (--check)
     bool profile = false;           ///< time each stage of the step (--profile): a table, and summary.json "profile"
+    bool shade_pressure = false;    ///< failure.png shaded by the water's pressure (--shade pressure)
 };
 
 /// Exit status: 0 done (with resume: also when the run had already finished), 130
