@@ -295,6 +295,16 @@ PYBIND11_MODULE(_bbm, mod) {
         .def_property_readonly("shear_displacement", [](const ContactArrays& a) {
             return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].us; });
         }, "M shear displacements us, m")
+        .def_property_readonly("fluid_pressure", [](const ContactArrays& a) {
+            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.wet() ? c.fluid_pressure[i] : 0.0; });
+        }, "M water pressures on the contacts, Pa ([flow]; 0 in a dry model): the law's normal_stress is the effective one")
+        .def_property_readonly("aperture", [](const ContactArrays& a) {
+            const Solver& s = solver_of(a);
+            const auto values = s.flow() ? s.flow()->contact_apertures(s.contacts()) : std::vector<double>(s.contacts().size(), 0.0);
+            auto out = fresh<double>(py::ssize_t(values.size()), 0);
+            std::copy(values.begin(), values.end(), out.mutable_data());
+            return out;
+        }, "M hydraulic apertures of the contacts' joints, m ([flow]; 0: none or sealed)")
         .def_property_readonly("property", [](const ContactArrays& a) {
             return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { *o = c.property[i]; });
         }, "M property sets (indices into Model.property_names; contacts formed in the run get solver.new_contact_property)")
@@ -498,6 +508,31 @@ PYBIND11_MODULE(_bbm, mod) {
                                "Installed bolts: positions, axial forces, grout forces, states")
         .def_property_readonly("liners", [](py::object self) { return arrays_of<LinerArrays>(self); },
                                "Installed liners: positions, thrusts, moments, interface stresses")
+        .def_property_readonly("flow", [](const Model& m) -> py::object {
+            const JointFlow* f = m.solver().flow();
+            if (!f) return py::none();
+            const auto& net = f->network();
+            const auto& st = f->state();
+            auto domains = fresh<double>(net.domains(), 2), pressure = fresh<double>(net.domains(), 0);
+            auto aperture = fresh<double>(net.pipes(), 0), rate = fresh<double>(net.pipes(), 0);
+            auto pipes = fresh<std::int32_t>(net.pipes(), 2);
+            const auto q = flow::pipe_flows(net, f->fluid(), st);
+            for (int d = 0; d < net.domains(); ++d) {
+                domains.mutable_data()[2 * d] = net.domain_position[d].x, domains.mutable_data()[2 * d + 1] = net.domain_position[d].y;
+                pressure.mutable_data()[d] = st.pressure[d];
+            }
+            for (int k = 0; k < net.pipes(); ++k) {
+                aperture.mutable_data()[k] = flow::hydraulic_aperture(f->fluid(), st.aperture[k]);
+                rate.mutable_data()[k] = q[k];
+                pipes.mutable_data()[2 * k] = net.pipe_from[k], pipes.mutable_data()[2 * k + 1] = net.pipe_to[k];
+            }
+            py::dict d;
+            d["domain_position"] = domains, d["pressure"] = pressure, d["pipes"] = pipes, d["aperture"] = aperture;
+            d["flow_rate"] = rate, d["inflow"] = f->inflow();
+            return d;
+        }, "Water in the joints ([flow]; None when dry), copied: domain_position (D×2, m), pressure (D, Pa), pipes "
+           "(P×2 domains), aperture (P, m), flow_rate (P, m²/s per m, from the first domain to the second), inflow "
+           "(into the drained openings, m²/s per m)")
         .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
         .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
         .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })

@@ -392,3 +392,17 @@ def test_unstable_model_raises_numerical_error(tmp_path):
     with pytest.raises(bbm.NumericalError, match="step"):
         m.run()
     assert not m.summary()["complete"]
+
+
+def test_water_in_the_joints_arrays():
+    m = bbm.Model(str(SOURCE / "examples/water/tunnel_below_water_table.toml"), threads=2)
+    f = m.flow
+    assert f is not None
+    # Before any stage: hydrostatic from the water table at y = 100 m, every domain.
+    y = f["domain_position"][:, 1]
+    assert np.allclose(f["pressure"], 1000.0 * 9.81 * (100.0 - y), rtol=1e-9)
+    assert f["pipes"].shape == (len(f["aperture"]), 2)
+    c = m.contacts
+    assert c.fluid_pressure.shape == (c.count,) and c.aperture.shape == (c.count,)
+    assert c.fluid_pressure.max() > 0.9e6
+    assert bbm.Model(str(INSITU)).flow is None
