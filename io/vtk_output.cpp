@@ -554,40 +554,26 @@ void write_flow_vtu(const Solver& s, const fs::path& file) {
     const auto& net = flow.network();
     const auto& st = flow.state();
     const auto nd = static_cast<vtkIdType>(net.domains()), np = static_cast<vtkIdType>(net.pipes());
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(nd);
+    auto grid = line_grid(net.domain_position, np, [&](vtkIdType k) {
+        return std::pair<vtkIdType, vtkIdType>{net.pipe_from[k], net.pipe_to[k]};
+    });
     auto pressure = double_array("pressure", nd), head = double_array("head", nd);
     auto held = int_array("held", nd), drained = int_array("drained", nd);
     const double rho_g = flow.fluid().density * norm(flow.fluid().gravity);
     for (vtkIdType d = 0; d < nd; ++d) {
-        const Vec2 x = net.domain_position[d];
-        points->SetPoint(d, x.x, x.y, 0.0);
         pressure->SetValue(d, st.pressure[d]);
-        head->SetValue(d, rho_g > 0 ? x.y + st.pressure[d] / rho_g : 0.0);
+        head->SetValue(d, rho_g > 0 ? net.domain_position[d].y + st.pressure[d] / rho_g : 0.0);
         held->SetValue(d, st.held[d]), drained->SetValue(d, flow.drained()[d]);
     }
-    vtkNew<vtkIdTypeArray> offsets, connectivity;
-    offsets->SetNumberOfValues(np + 1);
-    connectivity->SetNumberOfValues(2 * np);
     auto aperture = double_array("aperture", np), rate = double_array("flow_rate", np);
     auto joint = int_array("joint", np);
     const std::vector<double> q = flow::pipe_flows(net, flow.fluid(), st);
     for (vtkIdType k = 0; k < np; ++k) {
-        offsets->SetValue(k, 2 * k);
-        connectivity->SetValue(2 * k, net.pipe_from[k]);
-        connectivity->SetValue(2 * k + 1, net.pipe_to[k]);
         aperture->SetValue(k, flow::hydraulic_aperture(flow.fluid(), st.aperture[k]));
         rate->SetValue(k, q[k]);
         joint->SetValue(k, net.pipe_joint[k]);
     }
-    offsets->SetValue(np, 2 * np);
-    vtkNew<vtkCellArray> cells;
-    cells->SetData(offsets, connectivity);
-    vtkNew<vtkUnstructuredGrid> grid;
-    grid->SetPoints(points);
-    grid->SetCells(VTK_LINE, cells);
-    add_cell_arrays(grid, aperture, rate, joint);
+    add_cell_arrays(grid.GetPointer(), aperture, rate, joint);
     for (auto* a : {static_cast<vtkDataArray*>(pressure), static_cast<vtkDataArray*>(head),
                     static_cast<vtkDataArray*>(held), static_cast<vtkDataArray*>(drained)})
         grid->GetPointData()->AddArray(a);

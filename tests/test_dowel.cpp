@@ -6,6 +6,8 @@
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
 
+#include "model_text.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -59,15 +61,8 @@ bond_stiffness = 2e9
 )" + dowel;
 }
 
-struct Built {
-    io::ModelFile file;
-    meshing::BlockAssembly blocks;
-};
-Built build(const std::string& text) {
-    Built b{io::parse_model(text, "dowel.toml"), {}};
-    b.blocks = meshing::generate_blocks(b.file.geometry);
-    return b;
-}
+using Built = test::BuiltModel;
+Built build(const std::string& text) { return test::build_model(text, "dowel.toml"); }
 
 const Built& sheared_model() {
     static const Built m = build(two_blocks("kn = 1e11\nks = 1e11\nfriction = 0.0\n",

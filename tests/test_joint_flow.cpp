@@ -10,6 +10,8 @@
 #include "restart.hpp"
 #include "io/model_input.hpp"
 
+#include "model_text.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -21,15 +23,8 @@ using namespace bbm;
 
 namespace {
 
-struct Built {
-    io::ModelFile file;
-    meshing::BlockAssembly blocks;
-};
-Built build(const std::string& text) {
-    Built b{io::parse_model(text, "flow.toml"), {}};
-    b.blocks = meshing::generate_blocks(b.file.geometry);
-    return b;
-}
+using Built = test::BuiltModel;
+Built build(const std::string& text) { return test::build_model(text, "flow.toml"); }
 
 // Two rigid blocks on a joint along y = 0 (friction 30°), the upper one pressed
 // by `sigma` and pushed sideways; the joint's water held at `p`.

@@ -9,6 +9,8 @@
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
 
+#include "model_text.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -19,16 +21,8 @@ using namespace bbm;
 
 namespace {
 
-struct Built {
-    io::ModelFile file;
-    meshing::BlockAssembly blocks;
-};
-
-Built build(const std::string& text) {
-    Built b{io::parse_model(text, "support.toml"), {}};
-    b.blocks = meshing::generate_blocks(b.file.geometry);
-    return b;
-}
+using Built = test::BuiltModel;
+Built build(const std::string& text) { return test::build_model(text, "support.toml"); }
 
 // A grouted bolt along y = 0 from x = 0 (head, on the rock's face) to x = L, in
 // rock that does not move (one fixed block); grout stiffness k per metre, steel EA.
