@@ -47,7 +47,7 @@ std::atomic<int> interrupted{0};
 // A run checkpoint starts with this tag and the format version. Format 1 (no
 // version, model hash or stage reports; its solver state lacked the renumbering
 // count) is refused with a reason; so is format 2 (no verdicts in its stage
-// reports, and a solver state without the stage monitor). Format 3: docs/theory.md §10.1.
+// reports, and a solver state without the stage monitor). Format 3: docs/theory.md §10.1 (the formats before it: docs/notes/2026-11-28-theory-record.md §10.1).
 constexpr std::string_view checkpoint_tag = "bbm-run-checkpoint-";
 constexpr std::uint32_t checkpoint_format = 3;
 

@@ -8,7 +8,7 @@
 // version of each file. `--resume DIR` rebuilds the model from the file named in
 // the checkpoint (refusing it if the file changed since) and continues; the result
 // is identical (same state hash) to an uninterrupted run, on any thread count.
-// What a checkpoint holds: docs/theory.md §10.1.
+// What a checkpoint holds: docs/theory.md §10.1 (the full list: docs/notes/2026-11-28-theory-record.md §10.1).
 #pragma once
 
 #include <filesystem>

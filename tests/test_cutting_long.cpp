@@ -2,7 +2,7 @@
 //   * the four networks of 10,000 fractures in 40 m x 40 m of 0.5 m Voronoi blocks
 //     that bbm once refused (three: "blocks cover 1599.99 m² of 1600") or crashed
 //     on (one: SIGSEGV inside CGAL's Boolean operations), and the documented one
-//     (docs/theory.md §15) that left 163 trace tips unsplit;
+//     (docs/notes/2026-11-25-dfn-cutting-guards.md) that left 163 trace tips unsplit;
 //   * 20 random networks in 40 m x 40 m with up to 10,000 fractures.
 // Each must be cut with no error into blocks that tile the region, every trace a
 // fracture joint once, no tip inside a block (tests/cutting_checks.hpp).
@@ -71,7 +71,7 @@ TEST_CASE("10,000 fractures in 40 m x 40 m, the networks once refused or crashed
     dense("10/80 degrees, seeds 31, 32 (SIGSEGV in CGAL)", two_sets(10.0, 80.0, 31, 32));
     dense("60/150 degrees, seeds 41, 42 (refused: 1599.99 m²)", two_sets(60.0, 150.0, 41, 42));
     dense("0/95 degrees, seeds 51, 52 (refused: 1600.00 m²)", two_sets(0.0, 95.0, 51, 52));
-    dense("20/110 degrees, seeds 4, 5 (docs/theory.md §15: 163 tips unsplit)", two_sets(20.0, 110.0, 4, 5));
+    dense("20/110 degrees, seeds 4, 5 (docs/notes/2026-11-25-dfn-cutting-guards.md: 163 tips unsplit)", two_sets(20.0, 110.0, 4, 5));
 }
 
 TEST_CASE("20 random networks in 40 m x 40 m with up to 10,000 fractures are cut exactly") {
