@@ -194,11 +194,5 @@ std::vector<double> JointFlow::contact_apertures(const contact::Contacts& c) con
     return a;
 }
 
-double JointFlow::pressure_near(Vec2 p) const {
-    int best = 0;
-    for (int d = 1; d < net_.domains(); ++d)
-        if (norm(net_.domain_position[d] - p) < norm(net_.domain_position[best] - p)) best = d;
-    return state_.pressure[best];
-}
 
 } // namespace bbm

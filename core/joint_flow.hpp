@@ -96,8 +96,6 @@ public:
     double inflow() const;
     /// Per contact: its pipes' mean hydraulic aperture (m; 0 where it has none).
     std::vector<double> contact_apertures(const contact::Contacts& c) const;
-    /// Fluid pressure of the domain at a point's nearest domain, Pa.
-    double pressure_near(Vec2 p) const;
 
     const flow::Network& network() const { return net_; }
     const flow::State& state() const { return state_; }

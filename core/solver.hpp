@@ -308,6 +308,12 @@ private:
     /// The one list of the state (core/state.cpp): visit(FieldInfo, field&) per field.
     template <class Self, class Visit>
     static void for_each_field(Self& self, Visit&& visit);
+    template <class Self, class Visit>
+    static void for_each_body_field(Self& self, Visit& visit);
+    template <class Self, class Visit>
+    static void for_each_contact_field(Self& self, Visit& visit);
+    template <class Self, class Visit>
+    static void for_each_run_field(Self& self, Visit& visit);
     std::uint64_t compute_model_fingerprint() const; ///< core/state.cpp
     /// Per hashed field, its name and the hash of its bytes (load_state's check).
     std::vector<std::pair<std::string, std::uint64_t>> field_hashes() const;

@@ -124,14 +124,14 @@ struct ElementTraits<MonitorSample> : PackedRecordTraits<MonitorSample> {};
 /// scalar it holds, with what it is indexed by and what it is used for. Saved
 /// fields are written in this order (the checkpoint format: change the order or
 /// the saved set and raise `format` above).
+/// The list's first part: blocks, FE nodes and zones.
 template <class Self, class Visit>
-void Solver::for_each_field(Self& s, Visit&& v) {
+void Solver::for_each_body_field(Self& s, Visit& v) {
     using G = MemoryGroup;
     constexpr unsigned E = field_use::evolving, M = field_use::model, R = field_use::rebuilt;
     auto& b = s.b_;
     auto& n = s.n_;
     auto& z = s.z_;
-    auto& c = s.c_;
     // Blocks: kinematics and (scaled) masses, then what the model file fixes.
     v({"blocks.centroid", G::blocks, E}, b.centroid), v({"blocks.velocity", G::blocks, E}, b.velocity);
     v({"blocks.theta", G::blocks, E}, b.theta), v({"blocks.omega", G::blocks, E}, b.omega);
@@ -159,6 +159,14 @@ void Solver::for_each_field(Self& s, Visit&& v) {
     v({"zones.density", G::zones, R}, z.density), v({"zones.node_first", G::nodes, R}, z.node_first);
     v({"zones.node_entry", G::zones, R}, z.node_entry), v({"zones.nodal_force", G::zones, R}, z.nodal_force);
     v({"zones.partial_sum", G::zones, R}, z.partial_sum);
+}
+
+/// Its second: contacts (with their water links) and the water in the joints.
+template <class Self, class Visit>
+void Solver::for_each_contact_field(Self& s, Visit& v) {
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, R = field_use::rebuilt;
+    auto& c = s.c_;
     // Contacts in their order, with their histories; then their index and scratch.
     v({"contacts.vertex_block", G::contacts, E}, c.vertex_block), v({"contacts.vertex_id", G::contacts, E}, c.vertex_id);
     v({"contacts.edge_block", G::contacts, E}, c.edge_block), v({"contacts.edge_id", G::contacts, E}, c.edge_id);
@@ -177,6 +185,15 @@ void Solver::for_each_field(Self& s, Visit&& v) {
     v({"contacts.face_group", G::contacts, R}, c.face_group), v({"contacts.face_first", G::contacts, R}, c.face_first);
     v({"contacts.face_entry", G::contacts, R}, c.face_entry), v({"contacts.face_du_s", G::contacts, R}, c.face_du_s);
     v({"contacts.face_scratch", G::contacts, R}, c.face_scratch);
+}
+
+/// Its third: the run's loads, time and counters, detection, supports and the step's scratch.
+template <class Self, class Visit>
+void Solver::for_each_run_field(Self& s, Visit& v) {
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, M = field_use::model, R = field_use::rebuilt;
+    auto& b = s.b_;
+    auto& n = s.n_;
     // Excavation: support forces being relaxed, and a constant support pressure.
     v({"relax.block_force", G::blocks, E}, s.relax_block_force_);
     v({"relax.block_moment", G::blocks, E}, s.relax_block_moment_);
@@ -226,6 +243,13 @@ void Solver::for_each_field(Self& s, Visit&& v) {
     v({"step.pass_time", G::other, R}, s.pass_time_), v({"step.balance_scratch", G::other, R}, s.balance_scratch_);
     // What the stage did so far, for its verdict (not physics: not in the state hash).
     v({"monitor.samples", G::other, field_use::saved}, s.monitor_.samples_);
+}
+
+template <class Self, class Visit>
+void Solver::for_each_field(Self& s, Visit&& v) {
+    for_each_body_field(s, v);
+    for_each_contact_field(s, v);
+    for_each_run_field(s, v);
 }
 
 std::uint64_t Solver::compute_model_fingerprint() const {
