@@ -166,14 +166,29 @@ void JointFlow::stage(contact::Contacts& c, double dt, long step) {
 }
 
 void JointFlow::excavated(const std::vector<std::uint8_t>& removed, double wall_pressure) {
+    // This excavation's number: one past the latest opening's (saturating: a
+    // pressurise stage acts on the latest opening only).
+    const std::uint8_t latest = drained_.empty() ? 0 : *std::max_element(drained_.begin(), drained_.end());
+    const std::uint8_t number = latest == 255 ? latest : std::uint8_t(latest + 1);
     for (int k = 0; k < net_.pipes(); ++k) {
         const bool ra = removed[pipe_block_a_[k]], rb = removed[pipe_block_b_[k]];
         if (!ra && !rb) continue;
         pipe_open_[k] = 0;
         if (ra != rb && spec_.drain_openings)
-            for (int d : {net_.pipe_from[k], net_.pipe_to[k]}) drained_[d] = 1, state_.hold(d, wall_pressure);
+            for (int d : {net_.pipe_from[k], net_.pipe_to[k]}) {
+                if (!drained_[d]) drained_[d] = number;
+                state_.hold(d, wall_pressure);
+            }
     }
     pending_solve_ = 1;
+}
+
+void JointFlow::set_opening_pressure(double wall_pressure, bool solve_now) {
+    const std::uint8_t latest = drained_.empty() ? 0 : *std::max_element(drained_.begin(), drained_.end());
+    if (latest == 0) return; // no opening has a wall in the flow regions
+    for (int d = 0; d < net_.domains(); ++d)
+        if (drained_[d] == latest) state_.hold(d, wall_pressure);
+    if (solve_now) pending_solve_ = 1;
 }
 
 double JointFlow::inflow() const {

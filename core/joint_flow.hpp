@@ -91,6 +91,10 @@ public:
     /// pressure, `wall_pressure` (0: drained to atmospheric; a pressurised borehole:
     /// the excavate stage's `pressure`), if `drain_openings`.
     void excavated(const std::vector<std::uint8_t>& removed, double wall_pressure = 0.0);
+    /// The latest opening's water pressure changed (a `pressurise` stage): its
+    /// wall's domains are held at `wall_pressure`; `solve_now` asks for a steady
+    /// solve at the next stage (a jump), else the usual cadence follows a ramp.
+    void set_opening_pressure(double wall_pressure, bool solve_now);
 
     /// Net flow into the drained walls of openings, m²/s per unit depth (positive: out of the rock).
     double inflow() const;
@@ -128,7 +132,9 @@ private:
     std::vector<int> joint_pipe_;         ///< per joint: its pipe, −1 if none
     std::vector<int> pipe_block_a_, pipe_block_b_;
     std::vector<std::uint8_t> pipe_open_; ///< 0: a block of it removed
-    std::vector<std::uint8_t> drained_;   ///< per domain: on an excavated opening's wall
+    /// per domain: 0, or the number (from 1) of the excavation whose opening's
+    /// wall it is on (a later one keeps the earlier's number)
+    std::vector<std::uint8_t> drained_;
     std::vector<double> aperture_sum_;
     std::vector<int> aperture_count_;
     std::uint8_t pending_solve_ = 1;      ///< a steady solve due at the next stage

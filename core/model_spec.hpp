@@ -114,7 +114,10 @@ struct StageSpec {
     /// elastic: elastic equilibrium in one implicit sparse solve (SPEC §5), no keys.
     /// install: puts the named support sets ([[bolt]]) in place, tied to the rock
     /// as it is at that moment (after a partial relaxation: convergence–confinement).
-    enum class Kind { initialize, solve, excavate, cycle, elastic, install };
+    /// pressurise: the latest opening's pressure (excavated with one) ramped to
+    /// `pressure` over `steps` steps (0: at once): a borehole's pressurisation
+    /// cycles, as a hydraulic fracturing test runs them.
+    enum class Kind { initialize, solve, excavate, cycle, elastic, install, pressurise };
     std::string name;
     Kind kind = Kind::solve;
     StressFieldSpec stress;            ///< initialize
@@ -131,11 +134,11 @@ struct StageSpec {
     enum class Until { ratio, rest, equilibrium };
     Until until = Until::ratio;
     long quiet_steps = 2000;
-    long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps)
+    long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps); pressurise: ramp
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
     double keep = 0.0;                 ///< excavate: fraction of the support kept for good (a support pressure)
-    double pressure = 0.0;             ///< excavate: Pa on the new boundary, normal to it, for good
+    double pressure = 0.0;             ///< excavate: Pa on the new boundary, normal to it, for good; pressurise: target
     std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
 };
 

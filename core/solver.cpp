@@ -337,6 +337,7 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
             add_to_kept(i, x, sign * pressure * c_.length[i] * c_.normal[i], pressure_block_force_,
                         pressure_block_moment_, pressure_node_force_);
     }
+    pressure_scale_.clear(); // the new opening's pressure is the excavation's
     c_.remove_if_flagged(drop);
     if (flow_) flow_->excavated(b_.removed, pressure); // the opening's water pushes on its wall and enters it
     rebuild_contact_index();
@@ -451,6 +452,8 @@ void Solver::gather_stage() {
                          : relax_block_force_.empty() && relax_node_force_.empty() ? 0.0
                                                                                     : relax_keep_;
     const bool pressure = !pressure_block_force_.empty();
+    // 1 as excavated (x 1.0 is exact: the same bits as without a scale).
+    const double pressure_scale = pressure_scale_.empty() ? 1.0 : pressure_scale_[0];
     const int nn = n_.count();
     // Blocks in contiguous runs of equal work (a block's contacts), no barrier.
     const auto [first_block, last_block] =
@@ -462,7 +465,7 @@ void Solver::gather_stage() {
         f += b_.applied[i] + b_.real_mass[i] * g;
         m += b_.applied_moment[i];
         if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
-        if (pressure) f += pressure_block_force_[i], m += pressure_block_moment_[i];
+        if (pressure) f += pressure_scale * pressure_block_force_[i], m += pressure_scale * pressure_block_moment_[i];
         if (ties)
             for (int t = tie_block_first_[i]; t < tie_block_first_[i + 1]; ++t) {
                 const int tie = tie_block_tie_[t];
@@ -475,7 +478,7 @@ void Solver::gather_stage() {
     for (int k = 0; k < nn; ++k) {
         Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
         if (relax > 0.0) f += relax * relax_node_force_[k];
-        if (pressure) f += pressure_node_force_[k];
+        if (pressure) f += pressure_scale * pressure_node_force_[k];
         if (ties)
             for (int t = tie_node_first_[k]; t < tie_node_first_[k + 1]; ++t) {
                 const auto [tie, weight] = tie_node_tie_[t];
@@ -693,6 +696,14 @@ void Solver::balance_contact_pass() {
         }
     }
     std::fill(pass_time_.begin(), pass_time_.end(), PassTime{});
+}
+
+void Solver::set_opening_pressure(double pressure, double excavation_pressure, bool solve_now) {
+    if (!(excavation_pressure > 0.0) || pressure_block_force_.empty())
+        throw InputError("", 0, "stage.pressure", "a pressurise stage changes the pressure of an opening excavated with one: "
+                                           "give the excavate stage before it a pressure > 0");
+    pressure_scale_.assign(1, pressure / excavation_pressure);
+    if (flow_) flow_->set_opening_pressure(pressure, solve_now);
 }
 
 void Solver::step() {

@@ -98,6 +98,12 @@ public:
     /// good (a support pressure in Pa); a later excavate replaces both.
     void excavate(const std::vector<std::string>& regions, long relax_steps, double keep = 0.0,
                   double pressure = 0.0);
+    /// The latest opening's pressure is now `pressure` (Pa): the push on its wall
+    /// scaled from the excavation's `excavation_pressure`, which must be > 0 (it
+    /// gave the push its direction and extent), and, with water in the joints,
+    /// the wall's junctions held at it (`solve_now`: a steady solve at the next
+    /// step). What a `pressurise` stage does, step by step along its ramp.
+    void set_opening_pressure(double pressure, double excavation_pressure, bool solve_now);
     void step();
     /// Installs the named support sets, of any registered type (core/support.hpp:
     /// [[bolt]] sets, [[liner]]s, …): what an `install` stage does. Each node is
@@ -394,6 +400,9 @@ private:
     /// and per node (empty when none).
     std::vector<Vec2> pressure_block_force_, pressure_node_force_;
     std::vector<double> pressure_block_moment_;
+    /// The opening's pressure over the excavation's: one value once a pressurise
+    /// stage has changed it, else empty (1: as excavated; hashed only when set).
+    std::vector<double> pressure_scale_;
     double first_dt_ = 0.0;
     double dt_ = 1.0, time_ = 0.0, ratio_ = 0.0, work_ = 0.0, corner_radius_ = 0.0;
     // Detection: tolerance, property of new contacts, motion since the last pass.

@@ -14,9 +14,26 @@ const char* to_string(StageSpec::Kind k) {
     case StageSpec::Kind::cycle: return "cycle";
     case StageSpec::Kind::elastic: return "elastic";
     case StageSpec::Kind::install: return "install";
+    case StageSpec::Kind::pressurise: return "pressurise";
     }
     return "?";
 }
+
+namespace {
+
+/// The latest opening's pressure before stage `index`, and its excavation's: from
+/// the stages themselves (a pressurise stage ends at its target), so a resumed
+/// ramp is where the uninterrupted one was.
+std::pair<double, double> opening_pressures_before(const std::vector<StageSpec>& stages, int index) {
+    double now = 0.0, excavated = 0.0;
+    for (int k = 0; k < index; ++k) {
+        if (stages[k].kind == StageSpec::Kind::excavate) now = excavated = stages[k].pressure;
+        if (stages[k].kind == StageSpec::Kind::pressurise) now = stages[k].pressure;
+    }
+    return {now, excavated};
+}
+
+} // namespace
 
 std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs,
                                     StageCursor start) {
@@ -48,8 +65,15 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             if (k >= 10 && s.unbalanced_ratio() <= st.ratio) return true;
             return st.until == U::rest && sampled && s.monitor().at_rest(st.ratio, st.quiet_steps);
         };
+        // A pressurise stage's ramp: the pressure at its step k (1 ... steps).
+        const auto [pressure_before, excavation_pressure] = st.kind == StageSpec::Kind::pressurise
+                                                                ? opening_pressures_before(stages, index)
+                                                                : std::pair{0.0, 0.0};
         auto run = [&](long max_steps, bool solve) {
             for (long k = cursor.step + 1; k <= max_steps; ++k) {
+                if (st.kind == StageSpec::Kind::pressurise)
+                    s.set_opening_pressure(pressure_before + (st.pressure - pressure_before) * double(k) / double(max_steps),
+                                           excavation_pressure, true);
                 s.step();
                 ++r.steps;
                 cursor.step = k;
@@ -70,6 +94,9 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             case StageSpec::Kind::excavate: s.excavate(st.regions, st.relax_steps, st.keep, st.pressure); break;
             case StageSpec::Kind::elastic: r.method = s.solve_elastic().method; break;
             case StageSpec::Kind::install: s.install_supports(st.supports); break;
+            case StageSpec::Kind::pressurise:
+                if (st.steps == 0) s.set_opening_pressure(st.pressure, excavation_pressure, true);
+                break;
             case StageSpec::Kind::solve:
             case StageSpec::Kind::cycle: break;
             }
@@ -82,6 +109,7 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             break;
         case StageSpec::Kind::excavate: run(st.steps, false); break;
         case StageSpec::Kind::cycle: run(st.steps, false); break;
+        case StageSpec::Kind::pressurise: run(st.steps, false); break;
         case StageSpec::Kind::initialize:
         case StageSpec::Kind::install:
         case StageSpec::Kind::elastic: break;

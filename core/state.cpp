@@ -37,9 +37,10 @@ namespace {
 // stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners; 5 a
 // constant support pressure (excavate's `pressure`); 6 the same fields with a
 // hash of the bolts' and liners' kinematics; 7 the state hash over every saved
-// field (the state-field list); 8 the dowels' fields (core/dowels.hpp).
+// field (the state-field list); 8 the dowels' fields (core/dowels.hpp); 9 the
+// opening's pressure scale (a pressurise stage).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '8';
+constexpr std::uint64_t format = '9';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -203,6 +204,7 @@ void Solver::for_each_run_field(Self& s, Visit& v) {
     v({"pressure.block_force", G::blocks, E}, s.pressure_block_force_);
     v({"pressure.block_moment", G::blocks, E}, s.pressure_block_moment_);
     v({"pressure.node_force", G::nodes, E}, s.pressure_node_force_);
+    v({"pressure.scale", G::other, E}, s.pressure_scale_);
     // Time and counters.
     v({"solver.timestep", G::other, E}, s.dt_), v({"solver.time", G::other, E}, s.time_);
     v({"solver.ratio", G::other, E}, s.ratio_), v({"solver.work", G::other, E}, s.work_);

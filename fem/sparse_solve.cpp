@@ -22,6 +22,7 @@ std::vector<double> solve_sparse(const SparseTriplets& k, const std::vector<doub
     // the BLAS installed (reference, OpenBLAS with its per-CPU kernels) changes the
     // last bits of the answer, which a failing model turns into other cracks.
     Eigen::CholmodSimplicialLLT<Matrix, Eigen::Lower> chol;
+    chol.cholmod().print = 0; // a matrix that is not positive definite falls back to LU below, quietly
     chol.compute(m);
     if (chol.info() == Eigen::Success) {
         x = chol.solve(rhs);

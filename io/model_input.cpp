@@ -724,8 +724,17 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
                "(use mode = \"steady\": drained)");
     }
     Names stages{"stage", "stages", "stage", {}, {}};
+    double opening_pressure = -1.0; // the latest excavate stage's pressure (-1: none yet)
     read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
         an.stages.push_back(read_stage(c, t, p, i, stages, regions, supports));
+        const StageSpec& st = an.stages.back();
+        if (st.kind == StageSpec::Kind::excavate) opening_pressure = st.pressure;
+        if (st.kind == StageSpec::Kind::pressurise && !(opening_pressure > 0.0))
+            c.fail(*find(c, t, p, "type"), p.key("type"),
+                   opening_pressure < 0.0
+                       ? "a pressurise stage needs an excavate stage before it: it changes the pressure in the opening"
+                       : "a pressurise stage changes the pressure of an opening excavated with one: give the excavate "
+                         "stage before it a pressure > 0 (it sets where the water pushes)");
     });
     if (const toml::node* n = find(c, doc, Path{}, "report")) {
         const Path p = Path{}.key("report");

@@ -16,8 +16,8 @@ constexpr std::array<std::string_view, 15> quantities{"unbalanced_ratio",  "disp
                                                       "kinetic_energy",    "strain_energy",
                                                       "dissipated_energy", "work",
                                                       "inflow"};
-constexpr std::array<std::string_view, 6> stage_types{"initialize", "solve", "excavate", "cycle",
-                                                      "elastic",    "install"};
+constexpr std::array<std::string_view, 7> stage_types{"initialize", "solve",   "excavate",  "cycle",
+                                                      "elastic",    "install", "pressurise"};
 
 } // namespace
 
@@ -71,6 +71,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
                                                                    "steps", "keep", "pressure"};
     static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
     static constexpr std::array<std::string_view, 2> elastic_keys{"name", "type"};
+    static constexpr std::array<std::string_view, 4> pressurise_keys{"name", "type", "pressure", "steps"};
     check_keys(c, t, p, all_keys);
     StageSpec s;
     using Kind = StageSpec::Kind;
@@ -91,6 +92,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
                       : s.kind == Kind::excavate ? Keys(excavate_keys)
                       : s.kind == Kind::cycle    ? Keys(cycle_keys)
                       : s.kind == Kind::install  ? Keys(install_keys)
+                      : s.kind == Kind::pressurise ? Keys(pressurise_keys)
                                                  : Keys(elastic_keys);
     check_keys(c, t, p, keys, all_keys,
                article(stage_types[static_cast<std::size_t>(s.kind)]) + " stage");
@@ -127,6 +129,10 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         break;
     case Kind::install:
         s.supports = name_list(c, t, p, "supports", supports, "");
+        break;
+    case Kind::pressurise:
+        s.pressure = required_number(c, t, p, "pressure", at_least(0, " Pa"));
+        s.steps = integer(c, t, p, "steps", 0, long_max).value_or(0);
         break;
     }
     return s;

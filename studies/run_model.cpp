@@ -137,8 +137,9 @@ public:
         if (stage_name_ != st.name) stage_name_ = st.name, stage_t0_ = now, stage_k0_ = k;
         const double el = std::chrono::duration<double>(now - stage_t0_).count();
         const double rate = el > 0 ? (k - stage_k0_) / el : 0.0;
-        const long total = st.kind == StageSpec::Kind::cycle ? st.steps
-                         : st.kind == StageSpec::Kind::excavate ? st.steps : st.max_steps;
+        using K = StageSpec::Kind;
+        const long total = st.kind == K::cycle || st.kind == K::excavate || st.kind == K::pressurise ? st.steps
+                                                                                                       : st.max_steps;
         progress_.line("  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s",
                      st.name.c_str(), k, total, s.unbalanced_ratio(), s.cracks(contact::JointState::broken_tension),
                         s.cracks(contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);

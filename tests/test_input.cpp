@@ -1559,3 +1559,35 @@ TEST_CASE("the water tables ([flow], [[flow_boundary]], [[flow_source]]) refuse 
     check_error(base + "[[history]]\nname = \"q\"\nquantity = \"inflow\"\n", "quantity = \"inflow\"",
                 "history[0].quantity", "needs a [flow] table");
 }
+
+TEST_CASE("a pressurise stage needs an opening excavated with a pressure before it, and says so with file, line and key") {
+    const std::string base = std::string(one_region);
+    check_error(base + "[[stage]]\ntype = \"pressurise\"\npressure = 1e6\n", "type = \"pressurise\"", "stage[0].type",
+                "needs an excavate stage before it");
+    check_error(base + "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\n\n[[stage]]\ntype = \"pressurise\"\n"
+                       "pressure = 1e6\n",
+                "type = \"pressurise\"", "stage[1].type", "give the excavate stage before it a pressure > 0");
+    check_error(base + "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\npressure = 1e6\n\n[[stage]]\n"
+                       "type = \"pressurise\"\npressure = -1\n",
+                "pressure = -1", "stage[1].pressure", "must be >= 0");
+    {
+        const std::string text = base + "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\npressure = 1e6\n\n"
+                                        "[[stage]]\ntype = \"pressurise\"\n";
+        const auto e = error_of(text);
+        REQUIRE(e.has_value());
+        CHECK(e->line() == line_of(text, "type = \"pressurise\"") - 1); // its [[stage]] header
+        CHECK(e->key() == "stage[1].pressure");
+        CHECK(std::string(e->what()).find("missing required key 'pressure'") != std::string::npos);
+    }
+    check_error(base + "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\npressure = 1e6\n\n[[stage]]\n"
+                       "type = \"pressurise\"\npressure = 1e6\nratio = 1e-5\n",
+                "ratio", "stage[1].ratio", "does not apply to a pressurise stage");
+    // Read: ramps from the excavation's pressure.
+    const auto mf = parse_model(base + "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\npressure = 1e6\n\n"
+                                       "[[stage]]\ntype = \"pressurise\"\npressure = 0\nsteps = 300\n",
+                                "p.toml");
+    REQUIRE(mf.analysis.stages.size() == 2);
+    CHECK(mf.analysis.stages[1].kind == bbm::StageSpec::Kind::pressurise);
+    CHECK(mf.analysis.stages[1].pressure == 0.0);
+    CHECK(mf.analysis.stages[1].steps == 300);
+}

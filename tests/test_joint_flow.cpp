@@ -373,3 +373,40 @@ pressure = 1e6
     // moved, and the apertures are a0 still.
     for (double a : flow.contact_apertures(s.contacts())) CHECK((a == 0.0 || a == doctest::Approx(a0)));
 }
+
+TEST_CASE("a borehole's pressurise stages: breakdown, shut-in and re-opening ramps; the wall's water follows the "
+          "ramp, exact on restart inside a ramp and on 2 threads") {
+    // The hydraulic fracturing example on 0.25 m blocks, its stages shortened.
+    auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/hydraulic_fracturing.toml");
+    file.geometry.regions[0].pattern.size = 0.25;
+    file.geometry.regions[1].pattern.size = 0.25;
+    file.geometry.max_segment = 0.1;
+    test::RestartModel m{meshing::generate_blocks(file.geometry), file.analysis};
+    for (auto& stage : m.analysis.stages) {
+        if (stage.kind == StageSpec::Kind::excavate) stage.relax_steps = stage.steps = 100;
+        if (stage.kind == StageSpec::Kind::solve) stage.max_steps = 100;
+        if (stage.kind == StageSpec::Kind::pressurise) stage.steps = 100;
+    }
+    {
+        // Each step of the re-opening ramp holds the wall at the ramp's pressure.
+        struct WallPressure : StageObserver {
+            int checked = 0;
+            void step_done(const Solver& s, const StageSpec& st, long k) override {
+                if (st.kind != StageSpec::Kind::pressurise || k % 10 != 0) return;
+                const double from = st.pressure == 0.0 ? 6.5e6 : 0.0;
+                const double p = from + (st.pressure - from) * double(k) / double(st.steps);
+                const JointFlow& flow = *s.flow();
+                for (int d = 0; d < flow.network().domains(); ++d)
+                    if (flow.drained()[d]) {
+                        CHECK(flow.state().pressure[d] == doctest::Approx(p));
+                        ++checked;
+                    }
+            }
+        } wall;
+        Solver s(m.blocks, m.analysis);
+        run_stages(s, m.analysis.stages, wall);
+        CHECK(wall.checked > 100);
+    }
+    // Stops inside the excavation's relaxation, the shut-in ramp and the re-opening ramp.
+    test::check_exact_restart(m, {50, 250, 450}, {2});
+}
