@@ -66,9 +66,10 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             return st.until == U::rest && sampled && s.monitor().at_rest(st.ratio, st.quiet_steps);
         };
         // A pressurise stage's ramp: the pressure at its step k (1 ... steps).
-        const auto [pressure_before, excavation_pressure] = st.kind == StageSpec::Kind::pressurise
-                                                                ? opening_pressures_before(stages, index)
-                                                                : std::pair{0.0, 0.0};
+        // (Plain variables, not a structured binding: lambdas capture them in C++20's clang 14.)
+        const std::pair<double, double> before =
+            st.kind == StageSpec::Kind::pressurise ? opening_pressures_before(stages, index) : std::pair{0.0, 0.0};
+        const double pressure_before = before.first, excavation_pressure = before.second;
         auto run = [&](long max_steps, bool solve) {
             for (long k = cursor.step + 1; k <= max_steps; ++k) {
                 if (st.kind == StageSpec::Kind::pressurise)
