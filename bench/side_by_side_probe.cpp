@@ -4,7 +4,7 @@
 // from the one run alone (-1: none). `bbm ucs` runs deformable realizations one at
 // a time because a 4 x 8 m f = 0.95 specimen side by side once differed in 2 of
 // about 40 runs; this is the tool to look for that fault again
-// (docs/calibration.md, Measures).
+// (docs/notes/2026-11-28-calibration-history.md, What the programs do, Output).
 //
 //   side_by_side_probe [width (m)] [max strain] [trials] [seed] [seed] ...
 #include "studies/labtest.hpp"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The paper's Voronoi tunnel under the modelling choices where bbm may differ from
-UDEC (issue 12, item 3; docs/calibration.md "The paper's Voronoi tunnel, choice by
-choice").
+UDEC (issue 12, item 3; docs/notes/2026-11-28-calibration-history.md "The paper's
+Voronoi tunnel, choice by choice").
 
 Each variant edits `examples/tunnel_voronoi.toml` (the paper's joints as given) in
 one respect, or a few for the combined rows, and runs it over `--seeds` block

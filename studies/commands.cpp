@@ -770,7 +770,8 @@ int run_labtest_command(LabTestCli& c, LabTestOptions::Kind kind, bool quiet, bo
     // Deformable specimens: realizations one at a time, each with the threads in its
     // contact loop. Side by side in one process a 4 x 8 m f = 0.95 specimen gave,
     // rarely (2 runs of about 40), another answer than alone — a thread-safety
-    // fault around meshing not found yet (docs/calibration.md, After the peak).
+    // fault around meshing not found yet (docs/notes/2026-11-28-calibration-history.md,
+    // What the programs do).
     const bool one_at_a_time = o.material.deformable_fraction > 0.0;
     const int threads = one_at_a_time ? 1 : std::max(1, std::min(n, available));
     const int threads_for_loop = available;

@@ -68,8 +68,9 @@ inline constexpr double residual_window_strain = 2e-3, residual_run_strain = 5e-
 /// of the load (rate × balance / mismatch, within the same [0.5, 1.1]). A network
 /// that fails in a cascade gives the crack count no warning, and loaded faster
 /// than it can redistribute it carries more than its strength (trigon: +12%); the
-/// force balance shows it. Measured on the paper's specimen: docs/calibration.md,
-/// "Loading rate".
+/// force balance shows it. Measured on the paper's specimen:
+/// docs/notes/2026-11-28-calibration-history.md, "Loading rate" and "Measured
+/// against the paper".
 struct LabTestServo {
     bool on = true;
     double cracks = 2.0;

@@ -34,7 +34,8 @@ struct CompareEnvelopeOptions {
     bool enabled = false;
     /// Specimens smaller than the paper's 8 × 16 m by default: a deformable
     /// envelope at 8 × 16 m takes an hour or more on 2 cores; the ranking of the
-    /// models is the same at 4 × 8 m (docs/calibration.md measured both).
+    /// models is the same at 4 × 8 m (docs/notes/2026-11-28-calibration-history.md,
+    /// "The strength envelope", measured both).
     double width = 4.0, height = 8.0;
     int realizations = 1;
     std::vector<double> confinements; ///< Pa; empty: 0.1–0.5 × each rock's UCS

@@ -55,7 +55,8 @@ TEST_CASE("calibrate to a steep envelope (Hoek-Brown mi 25): the joints' frictio
     const int chosen = c["calibrated_iteration"];
     CHECK(its[chosen - 1]["misfit"].get<double>() <= std::min(its[0]["misfit"].get<double>(), its[1]["misfit"].get<double>()));
     // joint_property.toml holds the set exactly (JSON numbers round-trip): a set
-    // rounded to 6 digits is another rock for a brittle specimen (docs/calibration.md).
+    // rounded to 6 digits is another rock for a brittle specimen
+    // (docs/notes/2026-11-28-calibration-history.md, "Lac du Bonnet granite").
     const std::string toml = c["joint_property_toml"];
     for (const char* key : {"kn", "ks", "tensile", "cohesion", "friction"}) {
         const auto at = toml.find(std::string("\n") + key + " = ");

@@ -26,7 +26,7 @@ import subprocess
 
 RADIUS = 1.75          # m, the Mine-by tunnel
 SIGMA1, SIGMA3 = 60e6, 11e6
-UCS_PEAK_MODEL = 229.7e6  # the peak-calibrated bonds' UCS (docs/calibration.md, Lac du Bonnet, iteration 2)
+UCS_PEAK_MODEL = 229.7e6  # the peak-calibrated bonds' UCS (docs/notes/2026-11-28-calibration-history.md, Lac du Bonnet, iteration 2)
 NOTCH_DEG = (104.0, 284.0)  # across the largest stress: roof and floor
 SIDEWALL_DEG = (14.0, 194.0)  # along it: the side walls, where the hoop stress is least (tension)
 
