@@ -642,6 +642,44 @@ void check_deformable_materials(const Ctx& c, const ModelFile& mf) {
     }
 }
 
+/// The [[stage]] tables, in order; a pressurise stage must follow an excavate
+/// stage with a pressure (the opening whose pressure it changes).
+void read_stages(Ctx& c, const toml::table& doc, std::vector<StageSpec>& out, const Names& regions,
+                 const Names& supports) {
+    Names stages{"stage", "stages", "stage", {}, {}};
+    double opening_pressure = -1.0; // the latest excavate stage's pressure (-1: none yet)
+    read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
+        out.push_back(read_stage(c, t, p, i, stages, regions, supports));
+        const StageSpec& st = out.back();
+        if (st.kind == StageSpec::Kind::excavate) opening_pressure = st.pressure;
+        if (st.kind == StageSpec::Kind::pressurise && !(opening_pressure > 0.0))
+            c.fail(*find(c, t, p, "type"), p.key("type"),
+                   opening_pressure < 0.0
+                       ? "a pressurise stage needs an excavate stage before it: it changes the pressure in the opening"
+                       : "a pressurise stage changes the pressure of an opening excavated with one: give the excavate "
+                         "stage before it a pressure > 0 (it sets where the water pushes)");
+    });
+}
+
+/// The optional [report] table: the opening to measure and the window to draw.
+void read_report(Ctx& c, const toml::table& doc, ReportSpec& r) {
+    if (const toml::node* n = find(c, doc, Path{}, "report")) {
+        const Path p = Path{}.key("report");
+        const toml::table& t = to_table(c, *n, p, "a [report] table");
+        static constexpr std::array<std::string_view, 4> keys{"center", "springline", "crown", "window"};
+        check_keys(c, t, p, keys);
+        if (find(c, t, p, "center") || find(c, t, p, "springline") || find(c, t, p, "crown")) {
+            r.opening = true;
+            r.center = required_point(c, t, p, "center");
+            r.springline = required_point(c, t, p, "springline");
+            r.crown = required_point(c, t, p, "crown");
+            if (!(norm(r.springline - r.center) > 0) || !(norm(r.crown - r.center) > 0))
+                c.fail(t, p, "springline and crown must differ from center (they are points on the opening's wall)");
+        }
+        if (const toml::node* w = find(c, t, p, "window")) r.window = read_box(c, *w, p.key("window"));
+    }
+}
+
 /// The analysis tables, after the regions (whose names they refer to) are read.
 /// `region_material` is the `material` key of each region, if given.
 void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
@@ -723,35 +761,8 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
                "transient flow needs [solver] mode = \"dynamic\": a quasi-static run's time is not real time "
                "(use mode = \"steady\": drained)");
     }
-    Names stages{"stage", "stages", "stage", {}, {}};
-    double opening_pressure = -1.0; // the latest excavate stage's pressure (-1: none yet)
-    read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
-        an.stages.push_back(read_stage(c, t, p, i, stages, regions, supports));
-        const StageSpec& st = an.stages.back();
-        if (st.kind == StageSpec::Kind::excavate) opening_pressure = st.pressure;
-        if (st.kind == StageSpec::Kind::pressurise && !(opening_pressure > 0.0))
-            c.fail(*find(c, t, p, "type"), p.key("type"),
-                   opening_pressure < 0.0
-                       ? "a pressurise stage needs an excavate stage before it: it changes the pressure in the opening"
-                       : "a pressurise stage changes the pressure of an opening excavated with one: give the excavate "
-                         "stage before it a pressure > 0 (it sets where the water pushes)");
-    });
-    if (const toml::node* n = find(c, doc, Path{}, "report")) {
-        const Path p = Path{}.key("report");
-        const toml::table& t = to_table(c, *n, p, "a [report] table");
-        static constexpr std::array<std::string_view, 4> keys{"center", "springline", "crown", "window"};
-        check_keys(c, t, p, keys);
-        auto& r = an.report;
-        if (find(c, t, p, "center") || find(c, t, p, "springline") || find(c, t, p, "crown")) {
-            r.opening = true;
-            r.center = required_point(c, t, p, "center");
-            r.springline = required_point(c, t, p, "springline");
-            r.crown = required_point(c, t, p, "crown");
-            if (!(norm(r.springline - r.center) > 0) || !(norm(r.crown - r.center) > 0))
-                c.fail(t, p, "springline and crown must differ from center (they are points on the opening's wall)");
-        }
-        if (const toml::node* w = find(c, t, p, "window")) r.window = read_box(c, *w, p.key("window"));
-    }
+    read_stages(c, doc, an.stages, regions, supports);
+    read_report(c, doc, an.report);
 }
 
 } // namespace
