@@ -110,11 +110,16 @@ struct SteadyReport {
     int free_domains = 0;     ///< solved for
     int isolated_domains = 0; ///< in a part without a held pressure: left as they were
     double relative_residual = 0.0;
+    /// pipes whose ends were merged at one head: 10^10 times the others at an
+    /// end, in a network whose conductances span more than 10 decades (flow.cpp)
+    int merged_pipes = 0;
 };
 
 /// The steady state: pressures with Σ_j q_ij = Q_i in every free domain connected
 /// (by conducting pipes) to a held one. Throws InputError if a part of the network
-/// with an injection has no held pressure (no steady state exists).
+/// with an injection has no held pressure (no steady state exists). A pipe 10^10
+/// times stronger than the others at one of its ends has its ends merged at one
+/// head (beyond double precision otherwise); a solve that fails throws NumericalError.
 SteadyReport solve_steady(const Network& n, const FluidSpec& f, State& s);
 
 /// The net flow out of the network at each held domain, summed: what a drained

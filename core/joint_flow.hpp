@@ -33,6 +33,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace bbm {
@@ -106,6 +107,8 @@ public:
     const flow::FluidSpec& fluid() const { return fluid_; }
     const FlowSpec& spec() const { return spec_; }
     const std::vector<std::uint8_t>& drained() const { return drained_; }
+    /// The two blocks of pipe k's joint (the solver's block numbers).
+    std::pair<int, int> pipe_blocks(int k) const { return {pipe_block_a_[k], pipe_block_b_[k]}; }
     int steady_solves() const { return solves_; }
 
     /// Its arrays in the solver's state list (core/state.cpp): visit(info, array).

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <utility>
 #include <omp.h>
 
 namespace bbm {
@@ -419,7 +420,15 @@ void Solver::support_stage() {
 void Solver::flow_stage() {
     if (!flow_) return;
 #pragma omp single
-    flow_->stage(c_, dt_, steps_);
+    {
+        // An exception may not leave the parallel region (it would end the
+        // program): kept, and thrown again by step() once the region is over.
+        try {
+            flow_->stage(c_, dt_, steps_);
+        } catch (...) {
+            stage_error_ = std::current_exception();
+        }
+    }
 }
 
 void Solver::contact_and_zone_stage() {
@@ -740,6 +749,7 @@ void Solver::step() {
         }
         profile_.lap(StepProfile::bookkeeping);
     }
+    if (stage_error_) std::rethrow_exception(std::exchange(stage_error_, nullptr));
 }
 
 void StepProfile::start() {

@@ -51,6 +51,7 @@
 
 #include <array>
 #include <cstdint>
+#include <exception>
 #include <iosfwd>
 #include <map>
 #include <memory>
@@ -344,6 +345,7 @@ private:
     /// The support types (core/support.hpp), and the first tie of each (of supports_.size() + 1).
     std::vector<std::unique_ptr<Support>> supports_;
     std::unique_ptr<JointFlow> flow_;
+    std::exception_ptr stage_error_; ///< thrown inside the step's parallel region, thrown again after it
     std::vector<int> support_tie_first_;
     /// What each support tie puts on its rock this step (the force, and its moment
     /// about a rigid host's centroid): written by the support stage, gathered by the rock.

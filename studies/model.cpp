@@ -147,6 +147,23 @@ nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
     }
     opening["hoop_stress_springline"] = spring;
     opening["hoop_stress_crown"] = crown;
+    if (solver.flow()) {
+        // The damaged zone as a path for water along the tunnel, rings of a tenth of the radius.
+        const auto k = measure_axial_permeability(solver, rep.center, rep.springline, rep.crown, 0.1 * std::min(a_s, a_c));
+        opening["axial_permeability"] = {{"intact_m2", k.intact},
+                                         {"ring_m", k.ring},
+                                         {"crown_m2", k.crown},
+                                         {"springline_m2", k.springline},
+                                         {"all_round_m2", k.all_round},
+                                         {"edz_joints", k.edz_joints},
+                                         {"edz_area_m2", k.edz_area},
+                                         {"edz_depth_m", k.edz_depth},
+                                         {"edz_transmissivity_m4", k.edz_transmissivity},
+                                         {"edz_permeability_m2", k.edz_permeability},
+                                         {"core_area_m2", k.core_area},
+                                         {"core_joints", k.core_joints},
+                                         {"parted_joints", k.parted_joints}};
+    }
     return opening;
 }
 

@@ -1,5 +1,7 @@
 #include "studies/opening.hpp"
 
+#include "core/joint_flow.hpp"
+
 #include <algorithm>
 #include <functional>
 #include <chrono>
@@ -305,6 +307,125 @@ double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>&
         add((n.position[t[0]] + n.position[t[1]] + n.position[t[2]]) / 3.0, z.stress[k], g.area);
     }
     return weight > 0 ? sum / weight : NAN;
+}
+
+} // namespace bbm
+
+namespace bbm {
+
+AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown,
+                                             double ring) {
+    AxialPermeability k;
+    k.ring = ring;
+    const JointFlow* flow = s.flow();
+    if (!flow || !(ring > 0)) return k;
+    const auto& net = flow->network();
+    const auto& st = flow->state();
+    const auto& b = s.blocks();
+    const double radius = std::min(norm(springline - center), norm(crown - center));
+    // The rings reach the nearest held junction that is not the wall's (the
+    // interface with the dry far field, a boundary): whole rings of wet rock.
+    double reach = INFINITY, farthest = 0.0;
+    for (int d = 0; d < net.domains(); ++d) {
+        const double r = norm(net.domain_position[d] - center);
+        farthest = std::max(farthest, r);
+        if (st.held[std::size_t(d)] && !flow->drained()[std::size_t(d)]) reach = std::min(reach, r);
+    }
+    if (!std::isfinite(reach)) reach = farthest;
+    const int rings = std::max(0, int((reach - radius) / ring));
+    auto transmissivity = [&](int p) {
+        const double a = flow::hydraulic_aperture(flow->fluid(), st.aperture[p]);
+        return net.pipe_length[p] * a * a * a / 12.0;
+    };
+    // Intact: every bond at its aperture, over the flow regions' rock.
+    const double bond = flow::hydraulic_aperture(flow->fluid(), flow->spec().bond_aperture);
+    double joint_length = 0.0, rock_area = 0.0;
+    std::vector<std::uint8_t> wet(std::size_t(b.count()), 0);
+    for (int p = 0; p < net.pipes(); ++p) {
+        joint_length += net.pipe_length[p];
+        const auto [ba, bb] = flow->pipe_blocks(p);
+        wet[std::size_t(ba)] = wet[std::size_t(bb)] = 1;
+    }
+    for (int i = 0; i < b.count(); ++i)
+        if (wet[std::size_t(i)]) rock_area += b.area[i];
+    k.intact = rock_area > 0 ? joint_length * bond * bond * bond / 12.0 / rock_area : 0.0;
+
+    // Profiles: the pipes' transmissivity by ring, over each ring's area.
+    const Vec2 dc = (crown - center) / norm(crown - center), ds = (springline - center) / norm(springline - center);
+    const double cos30 = std::cos(30.0 * std::numbers::pi / 180.0);
+    std::vector<double> t_crown(std::size_t(rings), 0.0), t_spring(t_crown), t_all(t_crown);
+    auto midpoint = [&](int p) { return 0.5 * (net.domain_position[net.pipe_from[p]] + net.domain_position[net.pipe_to[p]]); };
+    for (int p = 0; p < net.pipes(); ++p) {
+        const Vec2 r = midpoint(p) - center;
+        const double d = norm(r);
+        const int i = d >= radius ? int((d - radius) / ring) : -1;
+        if (i < 0 || i >= rings) continue;
+        const double t = transmissivity(p);
+        t_all[std::size_t(i)] += t;
+        if (std::abs(dot(r, dc)) >= cos30 * d) t_crown[std::size_t(i)] += t;
+        if (std::abs(dot(r, ds)) >= cos30 * d) t_spring[std::size_t(i)] += t;
+    }
+    for (int i = 0; i < rings; ++i) {
+        const double r0 = radius + i * ring, r1 = r0 + ring, area = std::numbers::pi * (r1 * r1 - r0 * r0);
+        // The crown's and springline's sectors: both sides, 60 degrees each.
+        k.all_round.push_back(t_all[std::size_t(i)] / area);
+        k.crown.push_back(t_crown[std::size_t(i)] / (area / 3.0));
+        k.springline.push_back(t_spring[std::size_t(i)] / (area / 3.0));
+    }
+
+    // The damaged zone: fractured pipes (a^3 >= 10 a_bond^3) reached from the drained wall.
+    const double fractured_t = 10.0 * bond * bond * bond;
+    auto fractured = [&](int p) {
+        const double a = flow::hydraulic_aperture(flow->fluid(), st.aperture[p]);
+        return a > 0.0 && a * a * a >= fractured_t;
+    };
+    std::vector<std::vector<int>> pipes_at(std::size_t(net.domains()));
+    for (int p = 0; p < net.pipes(); ++p)
+        if (fractured(p)) pipes_at[std::size_t(net.pipe_from[p])].push_back(p), pipes_at[std::size_t(net.pipe_to[p])].push_back(p);
+    std::vector<std::uint8_t> reached(std::size_t(net.domains()), 0), in_zone(std::size_t(net.pipes()), 0);
+    std::vector<int> stack;
+    for (int d = 0; d < net.domains(); ++d)
+        if (flow->drained()[std::size_t(d)]) reached[std::size_t(d)] = 1, stack.push_back(d);
+    while (!stack.empty()) {
+        const int d = stack.back();
+        stack.pop_back();
+        for (int p : pipes_at[std::size_t(d)]) {
+            in_zone[std::size_t(p)] = 1;
+            for (int e : {net.pipe_from[p], net.pipe_to[p]})
+                if (!reached[std::size_t(e)]) reached[std::size_t(e)] = 1, stack.push_back(e);
+        }
+    }
+    std::vector<std::pair<double, int>> zone;
+    std::vector<std::uint8_t> bordering(std::size_t(b.count()), 0);
+    auto border_area = [&](int p) {
+        double area = 0.0;
+        const auto [ba, bb] = flow->pipe_blocks(p);
+        for (int blk : {ba, bb})
+            if (!b.removed[blk] && !bordering[std::size_t(blk)]) bordering[std::size_t(blk)] = 1, area += b.area[blk];
+        return area;
+    };
+    for (int p = 0; p < net.pipes(); ++p) {
+        if (!in_zone[std::size_t(p)]) continue;
+        const double t = transmissivity(p);
+        zone.push_back({t, p});
+        ++k.edz_joints;
+        k.edz_transmissivity += t;
+        k.edz_area += border_area(p);
+        k.edz_depth = std::max(k.edz_depth, norm(midpoint(p) - center) - radius);
+        k.parted_joints += st.aperture[p] >= flow->fluid().max_aperture;
+    }
+    k.edz_permeability = k.edz_area > 0 ? k.edz_transmissivity / k.edz_area : 0.0;
+    // Largest first, ties by pipe number: the same on any thread count.
+    std::sort(zone.begin(), zone.end(), [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
+    std::fill(bordering.begin(), bordering.end(), 0);
+    double carried = 0.0;
+    for (const auto& [t, p] : zone) {
+        if (carried >= 0.9 * k.edz_transmissivity) break;
+        carried += t;
+        ++k.core_joints;
+        k.core_area += border_area(p);
+    }
+    return k;
 }
 
 } // namespace bbm

@@ -78,6 +78,37 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
 /// contacts share each joint edge), as summary.json and failure.png give it.
 FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
 
+/// The damaged zone as a path for water along the tunnel ([flow] models; AECL's
+/// connected-permeability tests at the Mine-by tunnel: docs/field.md, "Water in the
+/// damaged zone"). Each pipe of the flow network is a joint plane running along
+/// the tunnel's axis: along the axis it carries a^3 / 12 per metre of its trace
+/// (the cubic law, per unit pressure gradient over the viscosity), so a part of the
+/// section of area A has the axial permeability k = sum(L a^3 / 12) / A. Joints at
+/// their initial positions, distances from the wall (`radius` about `center`).
+struct AxialPermeability {
+    double intact = 0;     ///< m^2: the flow regions with every bond intact (bond aperture)
+    double ring = 0;       ///< m: width of the profiles' rings, from the wall outwards
+    /// Per ring: k, m^2, within 30 deg of the crown's direction, of the springline's, and all round.
+    std::vector<double> crown, springline, all_round;
+    /// The damaged zone for water: the joints that carry at least 10 times an
+    /// intact bond (one order of magnitude in transmissivity: the EDZ of Tsang et
+    /// al. 2005), connected through such joints to the opening's drained wall.
+    int edz_joints = 0;
+    double edz_area = 0;           ///< m^2: the blocks bordering those joints
+    double edz_depth = 0;          ///< m from the wall: the deepest of their midpoints
+    double edz_transmissivity = 0; ///< m^4: sum L a^3 / 12 over them
+    double edz_permeability = 0;   ///< m^2: edz_transmissivity / edz_area
+    /// m^2: the blocks bordering the fewest of those joints (largest first) that
+    /// carry 90% of edz_transmissivity: where most of the flow goes.
+    double core_area = 0;
+    int core_joints = 0;
+    int parted_joints = 0; ///< of the zone's: blocks moved apart (the network's largest aperture)
+};
+/// Rings of `ring` metres out to the nearest held junction that is not the wall's
+/// (the interface with the dry far field). Zero figures in a dry model.
+AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown,
+                                             double ring);
+
 /// Hoop stress (tension positive) at distance r from `center` along the direction
 /// `towards`: the area-weighted mean of the block-averaged stress of rigid blocks
 /// and of the zone stresses whose centroids lie within `band` of that point (the

@@ -120,10 +120,12 @@ inline std::vector<int> threads_to_run(std::initializer_list<int> threads) {
 /// (the long suite runs them): a second deformable fraction, the Mine-by model
 /// under another in-situ stress, bolts alone where bolts and shotcrete run, the
 /// paper's tunnel with other bond values, the pressurised borehole (10,000 blocks,
-/// the water tunnel's code paths). 24 s of the default suite's 116, and 8 s.
+/// the water tunnel's code paths; the Mine-by model with water: those of the Mine-by
+/// and the water tunnel). 24 s of the default suite's 116, and 8 s.
 inline bool same_paths_as_another(const fs::path& path) {
     for (const char* name : {"deformable_f050.toml", "mineby.toml", "tunnel_voronoi_bolted.toml",
-                             "tunnel_trigon_bolted.toml", "tunnel_voronoi_calibrated.toml", "hydraulic_fracturing.toml"})
+                             "tunnel_trigon_bolted.toml", "tunnel_voronoi_calibrated.toml", "hydraulic_fracturing.toml",
+                             "mineby_edz.toml"})
         if (path.filename() == name) return true;
     return false;
 }

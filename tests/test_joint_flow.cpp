@@ -410,3 +410,18 @@ TEST_CASE("a borehole's pressurise stages: breakdown, shut-in and re-opening ram
     // Stops inside the excavation's relaxation, the shut-in ramp and the re-opening ramp.
     test::check_exact_restart(m, {50, 250, 450}, {2});
 }
+
+TEST_CASE("a steady flow with no solution stops the step with its error, on 1 and 2 threads, not the program") {
+    // Water injected where no pressure is held: no steady state. The error is
+    // thrown inside the step's parallel region, where it may not leave; the step
+    // throws it once the region is over.
+    std::string text = sliding_joint(10e6, 0.0);
+    text = text.substr(0, text.find("[[flow_boundary]]")) + "[[flow_source]]\nat = [0.0, 0.0]\nrate = 1e-6\n";
+    for (int threads : {1, 2}) {
+        CAPTURE(threads);
+        Built m = build(text);
+        m.file.analysis.solver.threads = threads;
+        Solver s(m.blocks, m.file.analysis);
+        CHECK_THROWS_WITH_AS(s.step(), doctest::Contains("no held pressure"), InputError);
+    }
+}

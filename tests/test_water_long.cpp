@@ -6,6 +6,7 @@
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
 #include "studies/labtest.hpp"
+#include "studies/opening.hpp"
 
 #include <doctest/doctest.h>
 
@@ -201,4 +202,51 @@ TEST_CASE("hydraulic fracturing: the re-opening pressure read from the pressure-
         CHECK(h.slope_after > 3.0 * h.slope_before); // a clear turn: the fracture opens
     }
     MESSAGE("mean re-opening pressure " << mean / 1e6 << " MPa");
+}
+
+// The Mine-by tunnel's damaged zone as a path for water along the tunnel (issue 49,
+// item 5), against AECL's Underground Research Laboratory at order of magnitude:
+// the damaged zone reached within about 0.6 radii of the wall (the CNS proceedings
+// paper "Characterizing excavation damage in highly-stressed granite at AECL's
+// URL"), and most of the flow along the Mine-by tunnel went through a continuous
+// zone of about 0.05 m² of highly fractured rock (Chandler, Kozak & Martin,
+// "Connected pathways in the EDZ and the potential for flow along tunnels").
+// docs/field.md, "Water in the damaged zone", has the figures per seed.
+TEST_CASE("the Mine-by damaged zone for water: within 0.6 radii of the wall, most of its flow in a core of the "
+          "order of the URL's 0.05 m2, the rock beyond it intact, 3 seeds") {
+    const double radius = 1.75, field_core = 0.05, intact_target = 2e-22;
+    for (std::uint64_t seed : {11, 21, 31}) {
+        auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/mineby_edz.toml");
+        for (auto& r : file.geometry.regions)
+            if (r.name == "bonded") r.pattern.seed = seed;
+            else if (r.name == "opening") r.pattern.seed = seed + 1;
+        file.analysis.solver.threads = 2;
+        const auto blocks = meshing::generate_blocks(file.geometry);
+        Solver s(blocks, file.analysis);
+        StageObserver quiet;
+        const auto reports = run_stages(s, file.analysis.stages, quiet);
+        const auto& rep = file.analysis.report;
+        const auto k = measure_axial_permeability(s, rep.center, rep.springline, rep.crown, 0.1 * radius);
+        MESSAGE("seed " << seed << ": intact " << k.intact << " m2; damaged zone " << k.edz_joints << " joints, "
+                        << k.edz_area << " m2, " << k.edz_depth << " m deep, k " << k.edz_permeability
+                        << " m2; 90% of its transmissivity in " << k.core_joints << " joints bordering "
+                        << k.core_area << " m2 (" << k.parted_joints << " parted); rings (crown) "
+                        << k.crown[0] << ", " << k.crown[1] << ", " << k.crown[2] << ", " << k.crown[3]
+                        << "; (springline) " << k.springline[0] << ", " << k.springline[1] << ", "
+                        << k.springline[2] << ", " << k.springline[3]);
+        const auto kind = reports.back().verdict.kind;
+        CHECK((kind == Verdict::Kind::equilibrium || kind == Verdict::Kind::equilibrium_with_fragments));
+        // The bonds' aperture gives the URL's intact granite (Rutqvist et al. 2009).
+        CHECK(k.intact == doctest::Approx(intact_target).epsilon(0.05));
+        REQUIRE(k.edz_joints > 0);
+        CHECK(k.edz_depth <= 0.6 * radius);
+        // The core within an order of magnitude of the field's.
+        CHECK(k.core_area >= field_core / 10.0);
+        CHECK(k.core_area <= field_core * 10.0);
+        // The zone conducts orders of magnitude more than the rock, and beyond it
+        // the rock is intact: the outermost rings at the intact permeability.
+        CHECK(k.edz_permeability > 1e3 * k.intact);
+        REQUIRE(k.all_round.size() >= 3);
+        CHECK(k.all_round.back() == doctest::Approx(k.intact).epsilon(0.25));
+    }
 }
