@@ -5,7 +5,10 @@
 // definite: CHOLMOD's simplicial Cholesky factorises it (through Eigen's
 // wrapper; simplicial because it does not call the BLAS, so the answer is the
 // same bits whichever BLAS the machine has). If Cholesky fails — an indefinite matrix, e.g. from joints in
-// compression with large geometric terms — a sparse LU (Eigen) is tried. A
+// compression with large geometric terms — a sparse LU (Eigen) is tried; if the
+// residual still fails (coefficients over many decades: a flow network from
+// intact bonds to parted blocks), both again on the system scaled by its
+// diagonal. A
 // singular system (a floating block, a model without supports) cannot be solved
 // either way; the caller gets the residual so it can say so.
 #pragma once
@@ -28,8 +31,8 @@ struct SparseTriplets {
 };
 
 struct SolveReport {
-    std::string method;           ///< "cholmod-simplicial-cholesky" or "sparse-lu"
-    double relative_residual = 0; ///< |K x − f| / |f|
+    std::string method;           ///< "cholmod-simplicial-cholesky" or "sparse-lu", ", diagonally scaled" if it was
+    double relative_residual = 0; ///< |K x − f| / |f| (of the scaled system if it was)
 };
 
 /// Solves K x = f. Throws std::runtime_error with the reason if no factorisation

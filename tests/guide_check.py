@@ -116,11 +116,18 @@ def main():
         (work / "examples").symlink_to(REPO / "examples")
     bin_dir = work / ".bin"
     bin_dir.mkdir(exist_ok=True)
-    link = bin_dir / "bbm"
-    if link.is_symlink() or link.exists():
-        link.unlink()
-    link.symlink_to(pathlib.Path(args.bbm).resolve())
+    # `bbm` is the build's, `python3` the interpreter running this (the one with the
+    # module's numpy), whatever else is on the PATH.
+    for name, target in (("bbm", pathlib.Path(args.bbm).resolve()), ("python3", pathlib.Path(sys.executable))):
+        link = bin_dir / name
+        if link.is_symlink() or link.exists():
+            link.unlink()
+        link.symlink_to(target)
     env = dict(os.environ)
+    # mpirun as root and with more ranks than cores (CI machines): Open MPI refuses both unless told.
+    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
     env["PATH"] = f"{bin_dir}{os.pathsep}{env.get('PATH', '')}"
     if args.python_path:
         env["PYTHONPATH"] = str(pathlib.Path(args.python_path).resolve())
