@@ -17,6 +17,7 @@ What it checks, from HTML comments the reader does not see (one per line):
     <!-- check: FILE KEY in [LOW, HIGH] -->     a JSON number in a range
     <!-- check-file: FILE -->                    the file exists and is not empty
     <!-- check-output: TEXT -->                  the commands printed TEXT
+    <!-- check-same: CSV1 CSV2 COLUMN -->         a column the same, row by row, in two tables
 
 KEY is dot-separated (list items by number: opening.failed_zone.lobes.0.depth_m).
 FILE may be CSV: KEY is then COLUMN.ROW (ROW -1: the last). Exit 0 if every command
@@ -61,7 +62,7 @@ def commands_of(text):
     return out
 
 
-CHECK = re.compile(r"<!--\s*(check|check-file|check-output):\s*(.*?)\s*-->")
+CHECK = re.compile(r"<!--\s*(check|check-file|check-output|check-same):\s*(.*?)\s*-->")
 
 
 def lookup(path, key):
@@ -94,6 +95,20 @@ def check_value(work, spec):
         return None if abs(got - value) <= tol else f"{file} {key} = {got}, the guide says {value} +- {tol}"
     low, high = (float(x) for x in rest.strip("[] ").split(","))
     return None if low <= got <= high else f"{file} {key} = {got}, the guide says within [{low}, {high}]"
+
+
+def check_same(work, spec):
+    try:
+        first, second, column = spec.split()
+        columns = []
+        for name in (first, second):
+            with open(work / name, newline="") as f:
+                columns.append([row[column] for row in csv.DictReader(f)])
+    except (OSError, KeyError, ValueError) as e:
+        return f"{spec}: cannot read it ({type(e).__name__}: {e})"
+    if not columns[0] or columns[0] != columns[1]:
+        return f"{column} differs between {first} and {second}: {columns[0]} against {columns[1]}"
+    return None
 
 
 def main():
@@ -150,6 +165,8 @@ def main():
         for kind, spec in checks:
             if kind == "check":
                 problem = check_value(work, spec)
+            elif kind == "check-same":
+                problem = check_same(work, spec)
             elif kind == "check-file":
                 p = work / spec
                 problem = None if p.is_file() and p.stat().st_size > 0 else f"{spec}: missing or empty"
