@@ -2,7 +2,8 @@
 // what it means and what its absence means, and the field of the spec it fills.
 //
 // A table of these per section (contact/joint_keys.hpp for [[joint_property]],
-// core/material_keys.hpp for [[material]]) is what the reader checks a file by, what
+// core/material_keys.hpp for [[material]], core/flow_keys.hpp for [flow]) is what the
+// reader checks a file by, what
 // the command-line flags of the same values are made from (studies/commands.hpp,
 // add_key_flags) and what the key reference in docs/reference/ is generated from,
 // so the three cannot drift apart.
@@ -24,6 +25,8 @@ enum class KeyKind {
     integer, ///< a whole number within `bounds`
     boolean, ///< true or false
     curve,   ///< an array of points [[alpha, beta], ...]
+    point,   ///< [x, y]
+    names,   ///< an array of names of other tables (regions)
 };
 
 template <class Spec>
@@ -36,7 +39,9 @@ struct Key {
     std::string_view meaning;
     /// What leaving it out means (the reference's "if absent" column).
     std::string_view absent;
-    /// The field of a number or integer key.
+    /// A choice's words, comma-separated, in the order of the spec's enumeration.
+    std::string_view words;
+    /// The field of a number, integer or boolean key.
     double (*get)(const Spec&) = nullptr;
     void (*set)(Spec&, double) = nullptr;
 };
@@ -56,10 +61,16 @@ inline std::string key_value_text(KeyKind kind, const Bounds& b) {
     case KeyKind::choice: return "word";
     case KeyKind::boolean: return "true / false";
     case KeyKind::curve: return "[[α, β], ...]";
+    case KeyKind::point: return "[x, y]" + (b.unit.empty() ? std::string() : std::string(b.unit));
+    case KeyKind::names: return "array of names";
     case KeyKind::integer: return "whole number " + b.text();
     case KeyKind::number: break;
     }
-    return "number " + b.text();
+    // An unbounded number still names its unit ("number, m").
+    const std::string range = b.text();
+    if (!range.empty()) return "number " + range;
+    const std::string_view unit = b.unit.starts_with(' ') ? b.unit.substr(1) : b.unit;
+    return unit.empty() ? std::string("number") : "number, " + std::string(unit);
 }
 
 /// The flag of a key: `--` and the key with dashes (`residual_friction` is

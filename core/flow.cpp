@@ -250,7 +250,7 @@ SteadyReport solve_steady(const Network& n, const FluidSpec& f, State& s) {
     // pressures (tests/test_flow.cpp). Such a pipe's ends are at one head (its
     // pressure drop is below 1e-10 of those across the weak pipes) and are merged,
     // unless that joins two held pressures. Only where the network's conductances
-    // span more than 10 decades: every model before keeps its bits.
+    // span more than 10 decades: a network within them keeps its bits.
     constexpr double kappa = 1e10;
     std::vector<int> cluster(n.domains());
     for (int i = 0; i < n.domains(); ++i) cluster[i] = i;

@@ -432,29 +432,6 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
     return s;
 }
 
-/// The names of a table's keys (base/keys.hpp), for check_keys.
-template <class Spec, std::size_t N>
-constexpr std::array<std::string_view, N> key_names(const Key<Spec> (&table)[N]) {
-    std::array<std::string_view, N> names;
-    for (std::size_t i = 0; i < N; ++i) names[i] = table[i].key;
-    return names;
-}
-
-/// A number or integer key as its table declares it: its bounds, required or left
-/// at the spec's default.
-template <class Spec>
-void read_declared_key(const Ctx& c, const toml::table& t, const Path& p, const Key<Spec>& k, Spec& spec) {
-    if (k.kind == KeyKind::integer) {
-        if (const toml::node* n = k.required ? &need(c, t, p, k.key, "a whole number " + k.bounds.text())
-                                             : find(c, t, p, k.key))
-            k.set(spec, double(to_whole_number(c, *n, p.key(k.key), k.bounds)));
-    } else if (k.required) {
-        k.set(spec, required_number(c, t, p, k.key, k.bounds));
-    } else if (const auto v = number(c, t, p, k.key, k.bounds)) {
-        k.set(spec, *v);
-    }
-}
-
 MaterialSpec read_material(Ctx& c, const toml::table& t, const Path& p, Names& names) {
     static constexpr auto keys = key_names(material_keys);
     check_keys(c, t, p, keys);

@@ -1,28 +1,32 @@
 // bbm io: the [flow], [[flow_boundary]] and [[flow_source]] tables of a model file —
 // water in the joints (core/joint_flow.hpp); docs/input.md "Water in the joints".
+#include "core/flow_keys.hpp"
 #include "io/reader.hpp"
 
 namespace bbm::io::reader {
 
 namespace {
 
-constexpr std::array<std::string_view, 15> flow_keys{
-    "viscosity",      "bulk_modulus", "density",     "gravity",       "aperture",
-    "bond_aperture",  "residual_aperture", "max_aperture", "regions", "water_table",
-    "pressure",       "mode",         "steady_every", "far_field",    "drain_openings"};
+/// The words of a choice key, as its declaration lists them.
+std::vector<std::string_view> words_of(const FlowKey& k) {
+    std::vector<std::string_view> words;
+    std::string_view rest = k.words;
+    while (!rest.empty()) {
+        const auto comma = rest.find(',');
+        words.push_back(rest.substr(0, comma));
+        rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 2);
+    }
+    return words;
+}
 
 void read_flow_table(Ctx& c, const toml::table& t, const Path& p, FlowSpec& f, const Names& regions) {
-    check_keys(c, t, p, flow_keys);
+    static constexpr auto keys = key_names(flow_keys);
+    check_keys(c, t, p, keys);
     f.on = true;
+    for (const FlowKey& k : flow_keys)
+        if (k.set) read_declared_key(c, t, p, k, f);
     auto& fl = f.fluid;
-    fl.viscosity = number(c, t, p, "viscosity", above(0, " Pa·s")).value_or(fl.viscosity);
-    fl.bulk_modulus = number(c, t, p, "bulk_modulus", above(0, " Pa")).value_or(fl.bulk_modulus);
-    fl.density = number(c, t, p, "density", at_least(0, " kg/m³")).value_or(fl.density);
     if (const auto g = point(c, t, p, "gravity")) fl.gravity = *g, f.gravity_given = true;
-    f.aperture = number(c, t, p, "aperture", above(0, metres)).value_or(f.aperture);
-    f.bond_aperture = number(c, t, p, "bond_aperture", at_least(0, metres)).value_or(f.bond_aperture);
-    fl.residual_aperture = number(c, t, p, "residual_aperture", at_least(0, metres)).value_or(fl.residual_aperture);
-    fl.max_aperture = number(c, t, p, "max_aperture", above(0, metres)).value_or(fl.max_aperture);
     if (!(fl.max_aperture > fl.residual_aperture))
         c.fail(t, p.key("max_aperture"),
                "must exceed residual_aperture = " + fmt(fl.residual_aperture) + " m, got " + fmt(fl.max_aperture));
@@ -30,18 +34,13 @@ void read_flow_table(Ctx& c, const toml::table& t, const Path& p, FlowSpec& f, c
         c.fail(t, p.key("aperture"),
                "must be at most max_aperture = " + fmt(fl.max_aperture) + " m, got " + fmt(f.aperture));
     f.regions = name_list(c, t, p, "regions", regions, "for every region with a block pattern");
-    f.water_table = number(c, t, p, "water_table", unbounded(metres));
-    if (const auto pr = number(c, t, p, "pressure", at_least(0, " Pa"))) {
-        if (f.water_table)
-            c.fail(t, p.key("pressure"), "give a 'water_table' (hydrostatic) or a uniform 'pressure', not both");
-        f.pressure = *pr;
-    }
-    static constexpr std::array<std::string_view, 2> modes{"steady", "transient"};
-    if (find(c, t, p, "mode")) f.mode = FlowSpec::Mode(choice(c, t, p, "mode", modes, "flow mode"));
-    f.steady_every = int(integer(c, t, p, "steady_every", 1, 1000000000).value_or(f.steady_every));
-    static constexpr std::array<std::string_view, 2> far{"held", "sealed"};
-    if (find(c, t, p, "far_field")) f.far_field_held = choice(c, t, p, "far_field", far, "far-field condition") == 0;
-    f.drain_openings = boolean(c, t, p, "drain_openings").value_or(f.drain_openings);
+    if (f.water_table && t.contains("pressure"))
+        c.fail(t, p.key("pressure"), "give a 'water_table' (hydrostatic) or a uniform 'pressure', not both");
+    if (find(c, t, p, "mode"))
+        f.mode = FlowSpec::Mode(choice(c, t, p, "mode", words_of(*find_key(flow_keys, "mode")), "flow mode"));
+    if (find(c, t, p, "far_field"))
+        f.far_field_held = choice(c, t, p, "far_field", words_of(*find_key(flow_keys, "far_field")),
+                                  "far-field condition") == 0;
 }
 
 constexpr std::array<std::string_view, 4> boundary_keys{"name", "box", "pressure", "head"};

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "base/bounds.hpp"
+#include "base/keys.hpp"
 #include "io/model_input.hpp"
 
 // toml++ 3.3 asserts in its parser a condition that input can break (parse_key
@@ -505,6 +506,31 @@ inline StressFieldSpec read_stress(const Ctx& c, const toml::table& t, const Pat
     s.dsyy_dy = number(c, t, p, "dsyy_dy", unbounded(pascals_per_metre)).value_or(0.0);
     s.dsxy_dy = number(c, t, p, "dsxy_dy", unbounded(pascals_per_metre)).value_or(0.0);
     return s;
+}
+
+/// The names of a table's keys (base/keys.hpp), for check_keys.
+template <class Spec, std::size_t N>
+constexpr std::array<std::string_view, N> key_names(const Key<Spec> (&table)[N]) {
+    std::array<std::string_view, N> names;
+    for (std::size_t i = 0; i < N; ++i) names[i] = table[i].key;
+    return names;
+}
+
+/// A number, integer or boolean key as its table declares it: its bounds, required or left
+/// at the spec's default.
+template <class Spec>
+void read_declared_key(const Ctx& c, const toml::table& t, const Path& p, const Key<Spec>& k, Spec& spec) {
+    if (k.kind == KeyKind::integer) {
+        if (const toml::node* n = k.required ? &need(c, t, p, k.key, "a whole number " + k.bounds.text())
+                                             : find(c, t, p, k.key))
+            k.set(spec, double(to_whole_number(c, *n, p.key(k.key), k.bounds)));
+    } else if (k.kind == KeyKind::boolean) {
+        if (const auto v = boolean(c, t, p, k.key)) k.set(spec, *v ? 1.0 : 0.0);
+    } else if (k.required) {
+        k.set(spec, required_number(c, t, p, k.key, k.bounds));
+    } else if (const auto v = number(c, t, p, k.key, k.bounds)) {
+        k.set(spec, *v);
+    }
 }
 
 // --- section readers (one file each) ---------------------------------------------

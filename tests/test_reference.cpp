@@ -7,6 +7,7 @@
 #include "base/error.hpp"
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
+#include "core/flow_keys.hpp"
 #include "core/material_keys.hpp"
 #include "io/model_input.hpp"
 #include "studies/commands.hpp"
@@ -88,6 +89,9 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     check_reference("joint_property.md", joints);
     for (const auto& k : contact::joint_keys) CHECK(joints.find("| `" + std::string(k.key) + "` |") != std::string::npos);
     check_reference("material.md", material_keys_markdown());
+    const std::string flow = flow_keys_markdown();
+    check_reference("flow.md", flow);
+    for (const auto& k : flow_keys) CHECK(flow.find("| `" + std::string(k.key) + "` |") != std::string::npos);
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {
