@@ -313,70 +313,70 @@ double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>&
 
 namespace bbm {
 
-AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown,
-                                             double ring) {
-    AxialPermeability k;
-    k.ring = ring;
-    const JointFlow* flow = s.flow();
-    if (!flow || !(ring > 0)) return k;
-    const auto& net = flow->network();
-    const auto& st = flow->state();
-    const auto& b = s.blocks();
-    const double radius = std::min(norm(springline - center), norm(crown - center));
-    // The rings reach the nearest held junction that is not the wall's (the
-    // interface with the dry far field, a boundary): whole rings of wet rock.
+namespace {
+
+/// What the axial-permeability measures share: the network, its state, the
+/// blocks, the opening (centre and smaller radius).
+struct AxialNetwork {
+    const JointFlow& flow;
+    const flow::Network& net;
+    const flow::State& st;
+    const Solver::Blocks& b;
+    Vec2 center;
+    double radius;
+    /// L a³ / 12: what pipe p carries along the tunnel per unit gradient over μ.
+    double transmissivity(int p) const {
+        const double a = flow::hydraulic_aperture(flow.fluid(), st.aperture[p]);
+        return net.pipe_length[p] * a * a * a / 12.0;
+    }
+    Vec2 midpoint(int p) const {
+        return 0.5 * (net.domain_position[net.pipe_from[p]] + net.domain_position[net.pipe_to[p]]);
+    }
+};
+
+/// The permeability by ring of `ring` metres out to the nearest held junction
+/// that is not the wall's (the interface with the dry far field: whole rings of
+/// wet rock), toward the crown, the springline (both sides, 60° each) and all round.
+void axial_profiles(const AxialNetwork& an, Vec2 springline, Vec2 crown, AxialPermeability& k) {
+    const auto& net = an.net;
     double reach = INFINITY, farthest = 0.0;
     for (int d = 0; d < net.domains(); ++d) {
-        const double r = norm(net.domain_position[d] - center);
+        const double r = norm(net.domain_position[d] - an.center);
         farthest = std::max(farthest, r);
-        if (st.held[std::size_t(d)] && !flow->drained()[std::size_t(d)]) reach = std::min(reach, r);
+        if (an.st.held[std::size_t(d)] && !an.flow.drained()[std::size_t(d)]) reach = std::min(reach, r);
     }
     if (!std::isfinite(reach)) reach = farthest;
-    const int rings = std::max(0, int((reach - radius) / ring));
-    auto transmissivity = [&](int p) {
-        const double a = flow::hydraulic_aperture(flow->fluid(), st.aperture[p]);
-        return net.pipe_length[p] * a * a * a / 12.0;
-    };
-    // Intact: every bond at its aperture, over the flow regions' rock.
-    const double bond = flow::hydraulic_aperture(flow->fluid(), flow->spec().bond_aperture);
-    double joint_length = 0.0, rock_area = 0.0;
-    std::vector<std::uint8_t> wet(std::size_t(b.count()), 0);
-    for (int p = 0; p < net.pipes(); ++p) {
-        joint_length += net.pipe_length[p];
-        const auto [ba, bb] = flow->pipe_blocks(p);
-        wet[std::size_t(ba)] = wet[std::size_t(bb)] = 1;
-    }
-    for (int i = 0; i < b.count(); ++i)
-        if (wet[std::size_t(i)]) rock_area += b.area[i];
-    k.intact = rock_area > 0 ? joint_length * bond * bond * bond / 12.0 / rock_area : 0.0;
-
-    // Profiles: the pipes' transmissivity by ring, over each ring's area.
-    const Vec2 dc = (crown - center) / norm(crown - center), ds = (springline - center) / norm(springline - center);
+    const int rings = std::max(0, int((reach - an.radius) / k.ring));
+    const Vec2 dc = (crown - an.center) / norm(crown - an.center);
+    const Vec2 ds = (springline - an.center) / norm(springline - an.center);
     const double cos30 = std::cos(30.0 * std::numbers::pi / 180.0);
     std::vector<double> t_crown(std::size_t(rings), 0.0), t_spring(t_crown), t_all(t_crown);
-    auto midpoint = [&](int p) { return 0.5 * (net.domain_position[net.pipe_from[p]] + net.domain_position[net.pipe_to[p]]); };
     for (int p = 0; p < net.pipes(); ++p) {
-        const Vec2 r = midpoint(p) - center;
+        const Vec2 r = an.midpoint(p) - an.center;
         const double d = norm(r);
-        const int i = d >= radius ? int((d - radius) / ring) : -1;
+        const int i = d >= an.radius ? int((d - an.radius) / k.ring) : -1;
         if (i < 0 || i >= rings) continue;
-        const double t = transmissivity(p);
+        const double t = an.transmissivity(p);
         t_all[std::size_t(i)] += t;
         if (std::abs(dot(r, dc)) >= cos30 * d) t_crown[std::size_t(i)] += t;
         if (std::abs(dot(r, ds)) >= cos30 * d) t_spring[std::size_t(i)] += t;
     }
     for (int i = 0; i < rings; ++i) {
-        const double r0 = radius + i * ring, r1 = r0 + ring, area = std::numbers::pi * (r1 * r1 - r0 * r0);
-        // The crown's and springline's sectors: both sides, 60 degrees each.
+        const double r0 = an.radius + i * k.ring, r1 = r0 + k.ring, area = std::numbers::pi * (r1 * r1 - r0 * r0);
         k.all_round.push_back(t_all[std::size_t(i)] / area);
         k.crown.push_back(t_crown[std::size_t(i)] / (area / 3.0));
         k.springline.push_back(t_spring[std::size_t(i)] / (area / 3.0));
     }
+}
 
-    // The damaged zone: fractured pipes (a^3 >= 10 a_bond^3) reached from the drained wall.
+/// The damaged zone: the fractured pipes (a³ ≥ 10 a_bond³) reached from the
+/// drained wall through fractured pipes; its area, depth, transmissivity, and
+/// the core: the fewest of its pipes (largest first) carrying 90% of it.
+void damaged_zone(const AxialNetwork& an, double bond, AxialPermeability& k) {
+    const auto& net = an.net;
     const double fractured_t = 10.0 * bond * bond * bond;
     auto fractured = [&](int p) {
-        const double a = flow::hydraulic_aperture(flow->fluid(), st.aperture[p]);
+        const double a = flow::hydraulic_aperture(an.flow.fluid(), an.st.aperture[p]);
         return a > 0.0 && a * a * a >= fractured_t;
     };
     std::vector<std::vector<int>> pipes_at(std::size_t(net.domains()));
@@ -385,7 +385,7 @@ AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 
     std::vector<std::uint8_t> reached(std::size_t(net.domains()), 0), in_zone(std::size_t(net.pipes()), 0);
     std::vector<int> stack;
     for (int d = 0; d < net.domains(); ++d)
-        if (flow->drained()[std::size_t(d)]) reached[std::size_t(d)] = 1, stack.push_back(d);
+        if (an.flow.drained()[std::size_t(d)]) reached[std::size_t(d)] = 1, stack.push_back(d);
     while (!stack.empty()) {
         const int d = stack.back();
         stack.pop_back();
@@ -396,23 +396,23 @@ AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 
         }
     }
     std::vector<std::pair<double, int>> zone;
-    std::vector<std::uint8_t> bordering(std::size_t(b.count()), 0);
+    std::vector<std::uint8_t> bordering(std::size_t(an.b.count()), 0);
     auto border_area = [&](int p) {
         double area = 0.0;
-        const auto [ba, bb] = flow->pipe_blocks(p);
+        const auto [ba, bb] = an.flow.pipe_blocks(p);
         for (int blk : {ba, bb})
-            if (!b.removed[blk] && !bordering[std::size_t(blk)]) bordering[std::size_t(blk)] = 1, area += b.area[blk];
+            if (!an.b.removed[blk] && !bordering[std::size_t(blk)]) bordering[std::size_t(blk)] = 1, area += an.b.area[blk];
         return area;
     };
     for (int p = 0; p < net.pipes(); ++p) {
         if (!in_zone[std::size_t(p)]) continue;
-        const double t = transmissivity(p);
+        const double t = an.transmissivity(p);
         zone.push_back({t, p});
         ++k.edz_joints;
         k.edz_transmissivity += t;
         k.edz_area += border_area(p);
-        k.edz_depth = std::max(k.edz_depth, norm(midpoint(p) - center) - radius);
-        k.parted_joints += st.aperture[p] >= flow->fluid().max_aperture;
+        k.edz_depth = std::max(k.edz_depth, norm(an.midpoint(p) - an.center) - an.radius);
+        k.parted_joints += an.st.aperture[p] >= an.flow.fluid().max_aperture;
     }
     k.edz_permeability = k.edz_area > 0 ? k.edz_transmissivity / k.edz_area : 0.0;
     // Largest first, ties by pipe number: the same on any thread count.
@@ -425,6 +425,32 @@ AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 
         ++k.core_joints;
         k.core_area += border_area(p);
     }
+}
+
+} // namespace
+
+AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown,
+                                             double ring) {
+    AxialPermeability k;
+    k.ring = ring;
+    const JointFlow* flow = s.flow();
+    if (!flow || !(ring > 0)) return k;
+    const AxialNetwork an{*flow, flow->network(), flow->state(), s.blocks(), center,
+                          std::min(norm(springline - center), norm(crown - center))};
+    // Intact: every bond at its aperture, over the flow regions' rock.
+    const double bond = flow::hydraulic_aperture(flow->fluid(), flow->spec().bond_aperture);
+    double joint_length = 0.0, rock_area = 0.0;
+    std::vector<std::uint8_t> wet(std::size_t(an.b.count()), 0);
+    for (int p = 0; p < an.net.pipes(); ++p) {
+        joint_length += an.net.pipe_length[p];
+        const auto [ba, bb] = flow->pipe_blocks(p);
+        wet[std::size_t(ba)] = wet[std::size_t(bb)] = 1;
+    }
+    for (int i = 0; i < an.b.count(); ++i)
+        if (wet[std::size_t(i)]) rock_area += an.b.area[i];
+    k.intact = rock_area > 0 ? joint_length * bond * bond * bond / 12.0 / rock_area : 0.0;
+    axial_profiles(an, springline, crown, k);
+    damaged_zone(an, bond, k);
     return k;
 }
 
