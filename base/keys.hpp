@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace bbm {
 
@@ -27,6 +28,8 @@ enum class KeyKind {
     curve,   ///< an array of points [[alpha, beta], ...]
     point,   ///< [x, y]
     names,   ///< an array of names of other tables (regions)
+    segments, ///< an array of segments [[[x1, y1], [x2, y2]], ...] (bolts' heads and toes)
+    table,   ///< an inline table of its own keys (a ring of bolts)
 };
 
 template <class Spec>
@@ -36,6 +39,9 @@ struct Key {
     Bounds bounds;
     /// Required by every user of the table that reads it (kn, ks; jrc, jcs of Barton-Bandis).
     bool required = false;
+    /// The types of table it belongs to, comma-separated ("excavate, pressurise" of
+    /// a [[stage]]); empty: every table of the section.
+    std::string_view only;
     std::string_view meaning;
     /// What leaving it out means (the reference's "if absent" column).
     std::string_view absent;
@@ -63,6 +69,8 @@ inline std::string key_value_text(KeyKind kind, const Bounds& b) {
     case KeyKind::curve: return "[[α, β], ...]";
     case KeyKind::point: return "[x, y]" + (b.unit.empty() ? std::string() : std::string(b.unit));
     case KeyKind::names: return "array of names";
+    case KeyKind::segments: return "[[[x1, y1], [x2, y2]], ...]" + std::string(b.unit);
+    case KeyKind::table: return "table";
     case KeyKind::integer: return "whole number " + b.text();
     case KeyKind::number: break;
     }
@@ -71,6 +79,45 @@ inline std::string key_value_text(KeyKind kind, const Bounds& b) {
     if (!range.empty()) return "number " + range;
     const std::string_view unit = b.unit.starts_with(' ') ? b.unit.substr(1) : b.unit;
     return unit.empty() ? std::string("number") : "number, " + std::string(unit);
+}
+
+/// The words of a comma-separated list ("steady, transient"), in order.
+inline std::vector<std::string_view> key_words(std::string_view list) {
+    std::vector<std::string_view> words;
+    while (!list.empty()) {
+        const auto comma = list.find(',');
+        words.push_back(list.substr(0, comma));
+        list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
+        while (list.starts_with(' ')) list.remove_prefix(1);
+    }
+    return words;
+}
+
+/// Does a key belong to a table of type `type` (its `only` names it, or is empty)?
+template <class Spec>
+bool key_applies(const Key<Spec>& k, std::string_view type) {
+    if (k.only.empty()) return true;
+    for (const std::string_view w : key_words(k.only))
+        if (w == type) return true;
+    return false;
+}
+
+/// A key reference's table: `| key | value | if absent | meaning |`, with a column
+/// `only_heading` of each key's `only` ("every" when empty) after the key if given.
+template <class Spec, std::size_t N>
+std::string key_table_markdown(const Key<Spec> (&table)[N], std::string_view only_heading = "") {
+    const bool only = !only_heading.empty();
+    std::string md = only ? "| key | " + std::string(only_heading) + " | value | if absent | meaning |\n|---|---|---|---|---|\n"
+                          : std::string("| key | value | if absent | meaning |\n|---|---|---|---|\n");
+    for (const Key<Spec>& k : table) {
+        md += "| `" + std::string(k.key) + "` | ";
+        if (only) md += (k.only.empty() ? std::string("every") : std::string(k.only)) + " | ";
+        md += (k.kind == KeyKind::choice && !k.words.empty() ? "word: " + std::string(k.words)
+                                                             : key_value_text(k.kind, k.bounds)) +
+              " | " + (k.required ? std::string("required") : std::string(k.absent)) + " | " + std::string(k.meaning) +
+              " |\n";
+    }
+    return md;
 }
 
 /// The flag of a key: `--` and the key with dashes (`residual_friction` is

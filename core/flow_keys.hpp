@@ -75,14 +75,8 @@ inline std::string flow_keys_markdown() {
                      "Generated from core/flow_keys.hpp by tests/test_reference.cpp (`BBM_WRITE_REFERENCE=1` "
                      "rewrites it; the test fails when it is stale). Water in the joints: the equations in "
                      "[theory.md](../theory.md) §16, [[flow_boundary]] and [[flow_source]] in "
-                     "[input.md](../input.md), \"Water in the joints\".\n\n"
-                     "| key | value | if absent | meaning |\n|---|---|---|---|\n";
-    for (const FlowKey& k : flow_keys)
-        md += "| `" + std::string(k.key) + "` | " +
-              (k.kind == KeyKind::choice ? "word: " + std::string(k.words) : key_value_text(k.kind, k.bounds)) +
-              " | " + (k.required ? std::string("required") : std::string(k.absent)) + " | " + std::string(k.meaning) +
-              " |\n";
-    return md;
+                     "[input.md](../input.md), \"Water in the joints\".\n\n";
+    return md + key_table_markdown(flow_keys);
 }
 
 } // namespace bbm

@@ -39,12 +39,8 @@ inline std::string material_keys_markdown() {
     std::string md = "# [[material]] keys\n\n"
                      "Generated from core/material_keys.hpp by tests/test_reference.cpp (`BBM_WRITE_REFERENCE=1` "
                      "rewrites it; the test fails when it is stale). The lab tests' flags `--density`, `--young`, "
-                     "`--poisson` and `--deformable-fraction` are the same keys, with the same bounds.\n\n"
-                     "| key | value | if absent | meaning |\n|---|---|---|---|\n";
-    for (const MaterialKey& k : material_keys)
-        md += "| `" + std::string(k.key) + "` | " + key_value_text(k.kind, k.bounds) + " | " +
-              (k.required ? std::string("required") : std::string(k.absent)) + " | " + std::string(k.meaning) + " |\n";
-    return md;
+                     "`--poisson` and `--deformable-fraction` are the same keys, with the same bounds.\n\n";
+    return md + key_table_markdown(material_keys);
 }
 
 } // namespace bbm

@@ -12,6 +12,7 @@
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
 #include "core/material_keys.hpp"
+#include "core/solver_keys.hpp"
 
 #include "core/verdict.hpp"
 
@@ -381,8 +382,6 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 
 
 // In the order of the enums of core/model_spec.hpp and meshing::JointTag.
-constexpr std::array<std::string_view, 2> solver_modes{"quasi_static", "dynamic"};
-constexpr std::array<std::string_view, 2> contact_lengths{"edge", "overlap"};
 constexpr std::array<std::string_view, 6> joint_tags{"inner", "radial", "peripheral", "real_joint",
                                                      "interface", "fracture"};
 constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
@@ -392,43 +391,25 @@ constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
 SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
                        const Names& properties) {
     const toml::table& t = to_table(c, node, p, "a [solver] table");
-    static constexpr std::array<std::string_view, 11> keys{"mode",
-                                                          "damping",
-                                                          "safety",
-                                                          "timestep",
-                                                          "gravity",
-                                                          "detection_tolerance",
-                                                          "corner_radius",
-                                                          "new_contact_property",
-                                                          "new_contact_length",
-                                                          "output_every",
-                                                          "history_every"};
+    static constexpr auto keys = key_names(solver_keys);
     check_keys(c, t, p, keys);
     SolverSpec s;
+    for (const SolverKey& k : solver_keys)
+        if (k.set) read_declared_key(c, t, p, k, s);
     if (t.contains("mode"))
-        s.mode =
-            static_cast<SolverSpec::Mode>(choice(c, t, p, "mode", solver_modes, "solver mode"));
-    s.damping = number(c, t, p, "damping", below(0, 1, "")).value_or(s.damping);
-    s.safety = number(c, t, p, "safety", Range{.lo = 0, .hi = 1, .lo_open = true, .unit = ""})
-                   .value_or(s.safety);
-    s.timestep = number(c, t, p, "timestep", at_least(0, " s")).value_or(s.timestep);
+        s.mode = static_cast<SolverSpec::Mode>(
+            choice(c, t, p, "mode", key_words(find_key(solver_keys, "mode")->words), "solver mode"));
     s.gravity = point(c, t, p, "gravity").value_or(s.gravity);
-    s.detection_tolerance =
-        number(c, t, p, "detection_tolerance", at_least(0, metres)).value_or(0.0);
-    s.corner_radius = number(c, t, p, "corner_radius", at_least(0, metres)).value_or(0.0);
     if (t.contains("new_contact_length"))
-        s.new_contact_length = static_cast<SolverSpec::NewContactLength>(
-            choice(c, t, p, "new_contact_length", contact_lengths, "new contact length"));
+        s.new_contact_length = static_cast<SolverSpec::NewContactLength>(choice(
+            c, t, p, "new_contact_length", key_words(find_key(solver_keys, "new_contact_length")->words),
+            "new contact length"));
     if (const toml::node* n = find(c, t, p, "new_contact_property")) {
         const Path np = p.key("new_contact_property");
         s.new_contact_property = to_str(c, *n, np);
         if (!s.new_contact_property.empty())
             check_ref(c, line(*n), np, s.new_contact_property, properties);
     }
-    constexpr std::int64_t int_max = std::numeric_limits<int>::max();
-    s.output_every = static_cast<int>(integer(c, t, p, "output_every", 0, int_max).value_or(0));
-    s.history_every =
-        static_cast<int>(integer(c, t, p, "history_every", 1, int_max).value_or(s.history_every));
     return s;
 }
 

@@ -1,15 +1,12 @@
 // bbm io: the [[bolt]] and [[dowel]] tables of a model file — rock bolts and
 // cables (core/bolts.hpp), dowels (core/dowels.hpp); docs/input.md "Rock bolts
 // and cables", "Dowels".
+#include "core/bolt_keys.hpp"
 #include "io/reader.hpp"
 
 namespace bbm::io::reader {
 
 namespace {
-
-constexpr std::string_view newtons = " N";
-constexpr std::string_view stiffness_per_length = " N/m per m";
-constexpr std::string_view force_per_length = " N/m";
 
 BoltSetSpec::Ring read_ring(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "a table {center, radius, length, count or spacing, from, to}");
@@ -33,23 +30,15 @@ BoltSetSpec::Ring read_ring(const Ctx& c, const toml::node& node, const Path& p)
     return r;
 }
 
-constexpr std::array<std::string_view, 17> bolt_keys{
-    "name",          "bolts",          "ring",             "segment_length", "young",
-    "area",          "diameter",       "density",          "yield_force",    "rupture_strain",
-    "cable",         "bond_stiffness", "bond_strength",    "normal_stiffness", "spacing",
-    "face_plate",    "end_anchor"};
-/// A dowel's: a bolt's but the cable, and its pretension.
-constexpr std::array<std::string_view, 17> dowel_keys{
-    "name",          "bolts",          "ring",             "segment_length", "young",
-    "area",          "diameter",       "density",          "yield_force",    "rupture_strain",
-    "pretension",    "bond_stiffness", "bond_strength",    "normal_stiffness", "spacing",
-    "face_plate",    "end_anchor"};
-
-/// The keys a bolt and a dowel share (`keys`: the table's own, checked first).
-BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& names,
-                          std::span<const std::string_view> keys) {
-    check_keys(c, t, p, keys);
-    BoltSetSpec b;
+/// A [[bolt]] (`type` "bolt") or [[dowel]] table: the keys of core/bolt_keys.hpp
+/// that belong to it.
+DowelSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& names, std::string_view type) {
+    static constexpr auto all_keys = key_names(bolt_keys);
+    std::vector<std::string_view> keys;
+    for (const BoltKey& k : bolt_keys)
+        if (key_applies(k, type)) keys.push_back(k.key);
+    check_keys(c, t, p, keys, all_keys, "a " + std::string(type) + " set");
+    DowelSetSpec b;
     b.name = read_name(c, t, p, names);
     if (const toml::node* n = find(c, t, p, "bolts")) {
         const Path bp = p.key("bolts");
@@ -65,23 +54,13 @@ BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& na
     if (const toml::node* n = find(c, t, p, "ring")) b.ring = read_ring(c, *n, p.key("ring"));
     if (b.bolts.empty() && !b.ring)
         c.fail(t, p, c.in_owner() + "no bolts: give 'bolts' (head and toe of each) or a 'ring' around an opening");
-    b.segment_length = number(c, t, p, "segment_length", above(0, metres)).value_or(b.segment_length);
-    b.young = number(c, t, p, "young", above(0, " Pa")).value_or(b.young);
-    const auto area = number(c, t, p, "area", above(0, " m²"));
-    const auto diameter = number(c, t, p, "diameter", above(0, metres));
+    for (const BoltKey& k : bolt_keys)
+        if (k.set && key_applies(k, type)) read_declared_key(c, t, p, k, b);
+    const auto area = number(c, t, p, "area", find_key(bolt_keys, "area")->bounds);
+    const auto diameter = number(c, t, p, "diameter", find_key(bolt_keys, "diameter")->bounds);
     if (area && diameter) c.fail(t, p.key("diameter"), "give the steel's 'area' or its 'diameter', not both");
     if (area) b.area = *area;
     if (diameter) b.area = 0.25 * 3.141592653589793 * *diameter * *diameter;
-    b.density = number(c, t, p, "density", above(0, " kg/m³")).value_or(b.density);
-    b.yield_force = number(c, t, p, "yield_force", above(0, newtons)).value_or(0.0);
-    b.rupture_strain = number(c, t, p, "rupture_strain", above(0, "")).value_or(0.0);
-    b.cable = boolean(c, t, p, "cable").value_or(false);
-    b.bond_stiffness = required_number(c, t, p, "bond_stiffness", above(0, stiffness_per_length));
-    b.bond_strength = number(c, t, p, "bond_strength", above(0, force_per_length)).value_or(0.0);
-    b.normal_stiffness = number(c, t, p, "normal_stiffness", above(0, stiffness_per_length)).value_or(0.0);
-    b.spacing = number(c, t, p, "spacing", above(0, metres)).value_or(1.0);
-    b.face_plate = boolean(c, t, p, "face_plate").value_or(false);
-    b.end_anchor = boolean(c, t, p, "end_anchor").value_or(false);
     return b;
 }
 
@@ -89,14 +68,13 @@ BoltSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& na
 
 void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names) {
     read_tables(c, doc, "bolt", [&](const toml::table& t, const Path& p, std::size_t) {
-        bolts.push_back(read_bolt_set(c, t, p, names, bolt_keys));
+        bolts.push_back(read_bolt_set(c, t, p, names, "bolt"));
     });
 }
 
 void read_dowel_sets(Ctx& c, const toml::table& doc, std::vector<DowelSetSpec>& dowels, Names& names) {
     read_tables(c, doc, "dowel", [&](const toml::table& t, const Path& p, std::size_t) {
-        DowelSetSpec d{read_bolt_set(c, t, p, names, dowel_keys)};
-        d.pretension = number(c, t, p, "pretension", at_least(0, newtons)).value_or(0.0);
+        const DowelSetSpec d = read_bolt_set(c, t, p, names, "dowel");
         if (d.pretension > 0.0 && !(d.face_plate && d.end_anchor))
             c.fail(t, p.key("pretension"),
                    "a pretension is held by the face plate and the end anchor: set face_plate = true and "

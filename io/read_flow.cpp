@@ -7,18 +7,6 @@ namespace bbm::io::reader {
 
 namespace {
 
-/// The words of a choice key, as its declaration lists them.
-std::vector<std::string_view> words_of(const FlowKey& k) {
-    std::vector<std::string_view> words;
-    std::string_view rest = k.words;
-    while (!rest.empty()) {
-        const auto comma = rest.find(',');
-        words.push_back(rest.substr(0, comma));
-        rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 2);
-    }
-    return words;
-}
-
 void read_flow_table(Ctx& c, const toml::table& t, const Path& p, FlowSpec& f, const Names& regions) {
     static constexpr auto keys = key_names(flow_keys);
     check_keys(c, t, p, keys);
@@ -37,9 +25,9 @@ void read_flow_table(Ctx& c, const toml::table& t, const Path& p, FlowSpec& f, c
     if (f.water_table && t.contains("pressure"))
         c.fail(t, p.key("pressure"), "give a 'water_table' (hydrostatic) or a uniform 'pressure', not both");
     if (find(c, t, p, "mode"))
-        f.mode = FlowSpec::Mode(choice(c, t, p, "mode", words_of(*find_key(flow_keys, "mode")), "flow mode"));
+        f.mode = FlowSpec::Mode(choice(c, t, p, "mode", key_words(find_key(flow_keys, "mode")->words), "flow mode"));
     if (find(c, t, p, "far_field"))
-        f.far_field_held = choice(c, t, p, "far_field", words_of(*find_key(flow_keys, "far_field")),
+        f.far_field_held = choice(c, t, p, "far_field", key_words(find_key(flow_keys, "far_field")->words),
                                   "far-field condition") == 0;
 }
 

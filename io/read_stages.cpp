@@ -1,6 +1,7 @@
 // bbm io: the [[history]] and [[stage]] tables of a model file (docs/input.md).
 #include "io/reader.hpp"
 
+#include "core/stage_keys.hpp"
 #include "core/verdict.hpp"
 
 namespace bbm::io::reader {
@@ -16,8 +17,6 @@ constexpr std::array<std::string_view, 15> quantities{"unbalanced_ratio",  "disp
                                                       "kinetic_energy",    "strain_energy",
                                                       "dissipated_energy", "work",
                                                       "inflow"};
-constexpr std::array<std::string_view, 7> stage_types{"initialize", "solve",   "excavate",  "cycle",
-                                                      "elastic",    "install", "pressurise"};
 
 } // namespace
 
@@ -57,21 +56,7 @@ HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& nam
 
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
                      const Names& regions, const Names& supports) {
-    static constexpr std::array<std::string_view, 19> all_keys{
-        "name",    "type",    "sxx",   "syy",       "sxy",     "y_ref",       "dsxx_dy", "dsyy_dy",
-        "dsxy_dy", "ratio", "max_steps", "until", "quiet_steps", "regions", "relax_steps", "steps", "supports",
-        "keep",    "pressure"};
-    static constexpr std::array<std::string_view, 3> install_keys{"name", "type", "supports"};
-    static constexpr std::array<std::string_view, 9> initialize_keys{
-        "name", "type", "sxx", "syy", "sxy", "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
-    static constexpr std::array<std::string_view, 6> solve_keys{"name",  "type",       "ratio",
-                                                                "max_steps", "until", "quiet_steps"};
-    static constexpr std::array<std::string_view, 3> until_options{"ratio", "rest", "equilibrium"};
-    static constexpr std::array<std::string_view, 7> excavate_keys{"name",  "type", "regions",  "relax_steps",
-                                                                   "steps", "keep", "pressure"};
-    static constexpr std::array<std::string_view, 3> cycle_keys{"name", "type", "steps"};
-    static constexpr std::array<std::string_view, 2> elastic_keys{"name", "type"};
-    static constexpr std::array<std::string_view, 4> pressurise_keys{"name", "type", "pressure", "steps"};
+    static constexpr auto all_keys = key_names(stage_keys);
     check_keys(c, t, p, all_keys);
     StageSpec s;
     using Kind = StageSpec::Kind;
@@ -86,44 +71,41 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     }
     add_name(c, names, s.name, name_line, np, line(t));
     c.owner = "stage " + quoted(s.name);
-    s.kind = static_cast<Kind>(choice(c, t, p, "type", stage_types, "stage type"));
-    const Keys keys = s.kind == Kind::initialize ? Keys(initialize_keys)
-                      : s.kind == Kind::solve    ? Keys(solve_keys)
-                      : s.kind == Kind::excavate ? Keys(excavate_keys)
-                      : s.kind == Kind::cycle    ? Keys(cycle_keys)
-                      : s.kind == Kind::install  ? Keys(install_keys)
-                      : s.kind == Kind::pressurise ? Keys(pressurise_keys)
-                                                 : Keys(elastic_keys);
-    check_keys(c, t, p, keys, all_keys,
-               article(stage_types[static_cast<std::size_t>(s.kind)]) + " stage");
-    constexpr std::int64_t long_max = std::numeric_limits<long>::max();
+    const auto types = key_words(stage_type_words);
+    s.kind = static_cast<Kind>(choice(c, t, p, "type", types, "stage type"));
+    const std::string_view type = types[static_cast<std::size_t>(s.kind)];
+    std::vector<std::string_view> keys;
+    for (const StageKey& k : stage_keys)
+        if (key_applies(k, type)) keys.push_back(k.key);
+    check_keys(c, t, p, keys, all_keys, article(type) + " stage");
+    const auto bounds = stage_key_bounds;
     switch (s.kind) {
     case Kind::initialize:
         s.stress = read_stress(c, t, p);
         break;
     case Kind::solve:
-        s.ratio = number(c, t, p, "ratio",
-                         Range{.lo = 0, .hi = 1, .lo_open = true, .hi_open = true, .unit = ""})
-                      .value_or(s.ratio);
-        s.max_steps = integer(c, t, p, "max_steps", 1, long_max).value_or(s.max_steps);
+        s.ratio = number(c, t, p, "ratio", bounds("ratio")).value_or(s.ratio);
+        s.max_steps = whole_number(c, t, p, "max_steps", bounds("max_steps")).value_or(s.max_steps);
         if (const toml::node* n = find(c, t, p, "until"))
-            s.until = StageSpec::Until(to_choice(c, *n, p.key("until"), until_options, "stopping rule"));
-        s.quiet_steps = integer(c, t, p, "quiet_steps", StageMonitor::sample_every, long_max).value_or(s.quiet_steps);
+            s.until = StageSpec::Until(
+                to_choice(c, *n, p.key("until"), key_words(find_key(stage_keys, "until")->words), "stopping rule"));
+        s.quiet_steps = whole_number(c, t, p, "quiet_steps", bounds("quiet_steps")).value_or(s.quiet_steps);
         break;
     case Kind::excavate:
         s.regions = name_list(c, t, p, "regions", regions, "");
-        s.relax_steps = integer(c, t, p, "relax_steps", 0, long_max).value_or(0);
+        s.relax_steps = whole_number(c, t, p, "relax_steps", bounds("relax_steps")).value_or(0);
         // Steps run in this stage: fewer than relax_steps stops part-way through the
         // relaxation (which goes on in the next stages), e.g. to install support.
-        s.steps = integer(c, t, p, "steps", 0, long_max).value_or(s.relax_steps);
-        s.keep = number(c, t, p, "keep", below(0, 1, "")).value_or(0.0);
-        s.pressure = number(c, t, p, "pressure", at_least(0, " Pa")).value_or(0.0);
+        s.steps = whole_number(c, t, p, "steps", bounds("steps")).value_or(s.relax_steps);
+        s.keep = number(c, t, p, "keep", bounds("keep")).value_or(0.0);
+        s.pressure = number(c, t, p, "pressure", bounds("pressure")).value_or(0.0);
         if (s.steps > s.relax_steps)
             c.fail(*find(c, t, p, "steps"), p.key("steps"),
                    "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));
         break;
     case Kind::cycle:
-        s.steps = required_integer(c, t, p, "steps", 1, long_max);
+        // A cycle runs at least one step.
+        s.steps = required_integer(c, t, p, "steps", 1, std::numeric_limits<long>::max());
         break;
     case Kind::elastic:
         break;
@@ -131,8 +113,8 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         s.supports = name_list(c, t, p, "supports", supports, "");
         break;
     case Kind::pressurise:
-        s.pressure = required_number(c, t, p, "pressure", at_least(0, " Pa"));
-        s.steps = integer(c, t, p, "steps", 0, long_max).value_or(0);
+        s.pressure = required_number(c, t, p, "pressure", bounds("pressure"));
+        s.steps = whole_number(c, t, p, "steps", bounds("steps")).value_or(0);
         break;
     }
     return s;

@@ -299,6 +299,14 @@ inline std::int64_t to_whole_number(const Ctx& c, const toml::node& n, const Pat
     return i->get();
 }
 
+/// A whole number within `b`, if the key is there.
+inline std::optional<std::int64_t> whole_number(const Ctx& c, const toml::table& t, const Path& p, std::string_view key,
+                                                const Bounds& b) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return std::nullopt;
+    return to_whole_number(c, *n, p.key(key), b);
+}
+
 inline std::optional<std::int64_t> integer(const Ctx& c, const toml::table& t, const Path& p,
                                     std::string_view key, std::int64_t lo, std::int64_t hi) {
     const toml::node* n = find(c, t, p, key);

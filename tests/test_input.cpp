@@ -851,7 +851,7 @@ TEST_CASE("solver and material mistakes") {
     check_error(with("[solver]\ncorner_radius = -1\n"), "corner_radius", "solver.corner_radius",
                 "must be >= 0 m, got -1");
     check_error(with("[solver]\nhistory_every = 0\n"), "history_every", "solver.history_every",
-                "must be an integer >= 1, got 0");
+                "must be a whole number in [1, 2147483647] steps, got 0");
     check_error(with("[solver]\ngravity = -9.81\n"), "gravity", "solver.gravity",
                 "expected a point [x, y], got float -9.81");
     check_error(with("[solver]\nnew_contact_property = \"slip\"\n"), "new_contact_property",
@@ -1061,7 +1061,7 @@ TEST_CASE("history and stage mistakes") {
     check_error(with("[[stage]]\ntype = \"solve\"\nratio = 1\n"), "ratio", "stage[0].ratio",
                 "must be in (0, 1), got 1");
     check_error(with("[[stage]]\ntype = \"solve\"\nmax_steps = 1.5\n"), "max_steps",
-                "stage[0].max_steps", "expected an integer >= 1, got float 1.5");
+                "stage[0].max_steps", "expected a whole number >= 1 steps, got float 1.5");
     check_error(with("[[stage]]\ntype = \"initialize\"\nratio = 1e-5\n"), "ratio", "stage[0].ratio",
                 "does not apply to an initialize stage");
     check_error(with("[[stage]]\ntype = \"run\"\n"), "run", "stage[0].type",

@@ -7,8 +7,12 @@
 #include "base/error.hpp"
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
+#include "core/bolt_keys.hpp"
 #include "core/flow_keys.hpp"
+#include "core/liner_keys.hpp"
 #include "core/material_keys.hpp"
+#include "core/solver_keys.hpp"
+#include "core/stage_keys.hpp"
 #include "io/model_input.hpp"
 #include "studies/commands.hpp"
 #include "studies/shear.hpp"
@@ -92,6 +96,10 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     const std::string flow = flow_keys_markdown();
     check_reference("flow.md", flow);
     for (const auto& k : flow_keys) CHECK(flow.find("| `" + std::string(k.key) + "` |") != std::string::npos);
+    check_reference("solver.md", solver_keys_markdown());
+    check_reference("stage.md", stage_keys_markdown());
+    check_reference("bolt.md", bolt_keys_markdown());
+    check_reference("liner.md", liner_keys_markdown());
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {

@@ -1,0 +1,96 @@
+// bbm core: the keys of a [[stage]] table — the steps of an analysis — one
+// declaration each (base/keys.hpp), with the stage types each belongs to. The
+// model file's reader checks a stage by them, the keys of its type only
+// (io/read_stages.cpp), and docs/reference/stage.md is generated from them
+// (tests/test_reference.cpp).
+#pragma once
+
+#include "base/keys.hpp"
+#include "core/model_spec.hpp"
+
+#include <string>
+
+namespace bbm {
+
+using StageKey = Key<StageSpec>;
+
+/// The stage types, in the order of StageSpec::Kind.
+inline constexpr std::string_view stage_type_words = "initialize, solve, excavate, cycle, elastic, install, pressurise";
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+/// Every key of [[stage]], in the order the reference lists them. The values are
+/// read by io/read_stages.cpp with these bounds; which keys a stage may have is
+/// its type's rows.
+inline constexpr StageKey stage_keys[] = {
+    {.key = "name", .kind = KeyKind::text, .meaning = "Non-empty, unique; used in outputs", .absent = "\"stage N\""},
+    {.key = "type", .kind = KeyKind::choice, .required = true,
+     .meaning = "What the stage does; each type takes only its own keys (a key of another type is an error)",
+     .words = stage_type_words},
+    {.key = "sxx", .bounds = unbounded(" Pa"), .only = "initialize",
+     .meaning = "The in-situ stress field, as for a stress boundary (σ = σ0 + dσ/dy (y − y_ref)): joints and zones "
+                "start from it, in equilibrium (SPEC §5)",
+     .absent = "0"},
+    {.key = "syy", .bounds = unbounded(" Pa"), .only = "initialize", .meaning = "σyy at y_ref", .absent = "0"},
+    {.key = "sxy", .bounds = unbounded(" Pa"), .only = "initialize", .meaning = "σxy at y_ref", .absent = "0"},
+    {.key = "y_ref", .bounds = unbounded(" m"), .only = "initialize", .meaning = "The level the stresses are given at",
+     .absent = "0"},
+    {.key = "dsxx_dy", .bounds = unbounded(" Pa/m"), .only = "initialize", .meaning = "dσxx/dy", .absent = "0"},
+    {.key = "dsyy_dy", .bounds = unbounded(" Pa/m"), .only = "initialize", .meaning = "dσyy/dy", .absent = "0"},
+    {.key = "dsxy_dy", .bounds = unbounded(" Pa/m"), .only = "initialize", .meaning = "dσxy/dy", .absent = "0"},
+    {.key = "ratio", .bounds = {.lo = 0, .hi = 1, .lo_open = true, .hi_open = true}, .only = "solve",
+     .meaning = "Run until the unbalanced-force ratio falls below it, or max_steps", .absent = "1e-5"},
+    {.key = "max_steps", .kind = KeyKind::integer, .bounds = at_least(1, " steps"), .only = "solve",
+     .meaning = "The stage's step limit", .absent = "200000"},
+    {.key = "until", .kind = KeyKind::choice, .only = "solve",
+     .meaning = "ratio: stop at the model's ratio; rest: also once the rock mass is at rest, no crack in the last "
+                "quiet_steps and the ratio of the rock mass without its detached fragments at ratio (theory.md "
+                "§10.3); equilibrium: only at the verdict of equilibrium, no crack over the verdict's window and the "
+                "ratio at ratio (a brittle rock can reach the ratio while it still cracks)",
+     .absent = "ratio", .words = "ratio, rest, equilibrium"},
+    {.key = "quiet_steps", .kind = KeyKind::integer, .bounds = at_least(100, " steps"), .only = "solve",
+     .meaning = "The crack-free stretch until = \"rest\" asks for", .absent = "2000"},
+    {.key = "regions", .kind = KeyKind::names, .required = true, .only = "excavate",
+     .meaning = "Existing region names, not empty, no repeats: their blocks are removed"},
+    {.key = "relax_steps", .kind = KeyKind::integer, .bounds = at_least(0, " steps"), .only = "excavate",
+     .meaning = "The removed blocks' support on the new boundary is relaxed to zero over this many steps (0 = at "
+                "once)",
+     .absent = "0"},
+    {.key = "keep", .bounds = below(0, 1, ""), .only = "excavate",
+     .meaning = "The fraction of the removed blocks' support that stays on the new boundary for good: a support "
+                "pressure, (1 − λ) × the in-situ support in the convergence–confinement method; a later excavate "
+                "replaces it",
+     .absent = "0"},
+    {.key = "pressure", .bounds = at_least(0, " Pa"), .only = "excavate, pressurise",
+     .meaning = "excavate: a constant pressure on the new boundary, normal to it, from this stage on (a later "
+                "excavate replaces it); with [flow] also the water's pressure in the opening, held at its wall's "
+                "junctions (0: drained). pressurise (required): the latest opening's new pressure, ramped to over "
+                "steps (that opening's excavate must have given one > 0)",
+     .absent = "0"},
+    {.key = "steps", .kind = KeyKind::integer, .bounds = at_least(0, " steps"), .only = "excavate, cycle, pressurise",
+     .meaning = "excavate: steps run in this stage, at most relax_steps (fewer stop part-way through the relaxation, "
+                "to install support there); cycle (required, ≥ 1): run exactly this many steps; pressurise: the "
+                "ramp's steps (0: at once; under steady flow the water is solved at every step of it)",
+     .absent = "excavate: relax_steps; pressurise: 0"},
+    {.key = "supports", .kind = KeyKind::names, .required = true, .only = "install",
+     .meaning = "Names of [[bolt]], [[dowel]] sets and [[liner]]s, not empty, no repeats: put in place, tied to the "
+                "rock where it is now and unstressed (theory.md §13); a bolt's head and toe must lie in rock"},
+};
+#pragma GCC diagnostic pop
+
+/// The bounds a stage's number or integer key is read with.
+inline const Bounds& stage_key_bounds(std::string_view key) { return find_key(stage_keys, key)->bounds; }
+
+/// docs/reference/stage.md: the table of keys.
+inline std::string stage_keys_markdown() {
+    return "# [[stage]] keys\n\n"
+           "Generated from core/stage_keys.hpp by tests/test_reference.cpp (`BBM_WRITE_REFERENCE=1` rewrites it; the "
+           "test fails when it is stale). The analysis runs the stages in file order; `type` selects what a stage "
+           "does and which keys it takes (the column *types*). An `elastic` stage has no keys of its own: it puts "
+           "the model into elastic equilibrium by one implicit sparse solve (SPEC §5, [theory.md](../theory.md) §9); "
+           "a floating block, or a model its boundaries do not hold, stops the run. Examples of every type: "
+           "[input.md](../input.md).\n\n" +
+           key_table_markdown(stage_keys, "types");
+}
+
+} // namespace bbm
