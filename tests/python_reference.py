@@ -70,7 +70,7 @@ def reference():
     lines = ["# The Python module `bbm`", "",
              "Generated from the module's own docstrings by tests/python_reference.py "
              "(`ctest -R python.reference` fails when this file is stale; run the script "
-             "with `--write` to rewrite it). The guide is docs/guide.md, \"Python\".", ""]
+             "with `--write` to rewrite it). The guide is docs/running.md, \"Python\".", ""]
     lines += [doc_of(bbm), ""]
     members = [(n, o) for n, o in vars(bbm).items() if not n.startswith("_")]
     classes = sorted((n, o) for n, o in members if inspect.isclass(o) and not issubclass(o, BaseException))
