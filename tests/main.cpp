@@ -10,7 +10,10 @@
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
 
+#include "tests/validation_record.hpp"
+
 #include <cstdlib>
+#include <string>
 
 namespace {
 
@@ -24,7 +27,13 @@ struct SelectedCount : doctest::IReporter {
     void test_run_end(const doctest::TestRunStats& stats) override {
         selected_test_cases = stats.numTestCasesPassingFilters;
     }
-    void test_case_start(const doctest::TestCaseData&) override {}
+    void test_case_start(const doctest::TestCaseData& data) override {
+        // For tests/validation_record.hpp: which test case a record belongs to.
+        bbm::test::current_test_case = data.m_name;
+        const std::string file = data.m_file.c_str();
+        const auto tests = file.rfind("tests/");
+        bbm::test::current_test_file = tests == std::string::npos ? file : file.substr(tests);
+    }
     void test_case_reenter(const doctest::TestCaseData&) override {}
     void test_case_end(const doctest::CurrentTestCaseStats&) override {}
     void test_case_exception(const doctest::TestCaseException&) override {}

@@ -5,6 +5,8 @@
 #include "meshing/blocks.hpp"
 #include "meshing/spec.hpp"
 
+#include "tests/validation_record.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -96,6 +98,10 @@ TEST_CASE("flow: a fracture between two held pressures carries the cubic law's r
     INFO("cubic law " << exact << " m2/s, bbm " << out_right);
     CHECK(out_right == doctest::Approx(exact).epsilon(1e-6));
     CHECK(out_left == doctest::Approx(-exact).epsilon(1e-6)); // what goes in at the left comes out at the right
+    test::record_check(test::Against::closed_form, "flow along a fracture through 0.2 m Voronoi blocks, a 0.1 mm",
+                       "cubic law q = a³ Δp / (12 μ L) = " + test::figure(exact) + " m²/s", "1e-6 relative",
+                       test::figure(out_right, 7) + " m²/s (" + test::percent(out_right, exact, 1) + ")",
+                       std::abs(out_right / exact - 1.0) <= 1e-6);
     // The pressure falls linearly along the fracture.
     int on_fracture = 0;
     for (int i = 0; i < n.domains(); ++i) {
@@ -156,6 +162,10 @@ TEST_CASE("flow: a pressure step diffuses along one fracture as p0 erfc(x / (2 s
     MESSAGE("largest difference from erfc: " << worst / p0 * 100.0 << "% of p0 over " << compared << " domains");
     CHECK(compared > 60);
     CHECK(worst < 1e-3 * p0); // 0.003% measured: the fracture's pipes are short against sqrt(D t)
+    test::record_check(test::Against::closed_form, "pressure step diffusing along a fracture, √(Dt) 1.5 m",
+                       "p0 erfc(x / 2√(Dt)), D = K_w a² / (12 μ)", "largest difference < 0.1% of p0",
+                       test::figure(100.0 * worst / p0, 2) + "% of p0 at " + std::to_string(compared) + " domains",
+                       worst < 1e-3 * p0);
 }
 
 namespace {
@@ -191,6 +201,8 @@ TEST_CASE("flow: steady inflow into a circular tunnel below the water table, aga
     // whose conductivity κ is measured on a sample of the same pattern.
     const double size = 0.3, aperture = 5e-5, r = 1.0, depth = 5.0, pressure = 1e5;
     const double half_width = 20.0, bottom = -20.0;
+    std::string differences;
+    bool all_within = true;
     for (std::uint64_t seed : {11, 12, 13}) { // the sample and the tunnel on other seeds
         const double kappa = equivalent_conductivity(8.0, size, aperture, seed);
         const auto a = voronoi_region({-half_width, bottom}, {half_width, 0.0}, size, seed + 100, {}, {0.0, -depth}, r);
@@ -213,7 +225,12 @@ TEST_CASE("flow: steady inflow into a circular tunnel below the water table, aga
                         << " (" << (inflow / goodman - 1.0) * 100.0 << "%) and the circle's image solution " << circle
                         << " (" << (inflow / circle - 1.0) * 100.0 << "%)");
         CHECK(inflow == doctest::Approx(goodman).epsilon(0.10));
+        differences += (differences.empty() ? "" : ", ") + test::percent(inflow, goodman);
+        all_within = all_within && std::abs(inflow / goodman - 1.0) <= 0.10;
     }
+    test::record_check(test::Against::closed_form, "inflow into a tunnel 5 m below the water table, 0.3 m blocks",
+                       "Goodman Q = 2π k H / ln(2H/r), k measured on the same pattern", "within 10%, each of 3 seeds",
+                       differences, all_within);
 }
 
 TEST_CASE("flow: a chain of joints over 16 decades of conductance (intact bonds beside parted blocks) solves to its "

@@ -12,6 +12,8 @@
 
 #include "model_text.hpp"
 
+#include "tests/validation_record.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -111,6 +113,13 @@ TEST_CASE("a joint with water at pressure p slides at tau = (sigma - p) tan(phi)
         // blocks, σ, balances the load on the top.
         CHECK(sn == doctest::Approx(sigma - p).epsilon(1e-3));
         CHECK(tau == doctest::Approx((sigma - p) * tan_phi).epsilon(1e-3));
+        const double tau_exact = (sigma - p) * tan_phi;
+        test::record_check(test::Against::closed_form,
+                           "shear strength of a Coulomb joint (φ 30°, σ 10 MPa) with water at " +
+                               test::figure(p / 1e6) + " MPa",
+                           "τ = (σ − p) tan φ = " + test::figure(tau_exact / 1e6, 4) + " MPa", "within 0.1%",
+                           test::figure(tau / 1e6, 5) + " MPa (" + test::percent(tau, tau_exact, 2) + ")",
+                           std::abs(tau / tau_exact - 1.0) <= 1e-3 && std::abs(sn / (sigma - p) - 1.0) <= 1e-3);
         const auto& c = s.contacts();
         double total = 0, length = 0;
         for (int i = 0; i < c.size(); ++i) total += dot(contact::contact_force(c, i), c.normal[i]), length += c.length[i];
@@ -254,6 +263,11 @@ TEST_CASE("a pressurised crack in elastic blocks opens as Sneddon's: w = 4 (1 - 
     MESSAGE("Sneddon: worst relative error of the opening over |x| <= 0.8 c: ", worst, " at ", checked, " nodes");
     CHECK(checked > 20);
     CHECK(worst < 0.05);
+    test::record_check(test::Against::closed_form, "opening of a pressurised crack in elastic blocks, |x| ≤ 0.8 c",
+                       "Sneddon w = 4 (1 − ν²) p / E √(c² − x²)", "within 5%",
+                       "largest difference " + test::figure(100.0 * worst, 2) + "% at " + std::to_string(checked) +
+                           " nodes",
+                       checked > 20 && worst < 0.05);
 }
 
 TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far field, inflow; exact on restart "
@@ -369,6 +383,10 @@ pressure = 1e6
                                 << compared << " domains");
     CHECK(compared > 30);
     CHECK(worst < 1e-3 * p0); // 0.026% measured
+    test::record_check(test::Against::closed_form, "transient flow as a stage of a dynamic run, √(Dt) 1.5 m",
+                       "p0 erfc(x / 2√(Dt))", "largest difference < 0.1% of p0",
+                       test::figure(100.0 * worst / p0, 2) + "% of p0 at " + std::to_string(compared) + " domains",
+                       compared > 30 && worst < 1e-3 * p0);
     // The water pushes on the fracture's faces, the blocks held: no contact has
     // moved, and the apertures are a0 still.
     for (double a : flow.contact_apertures(s.contacts())) CHECK((a == 0.0 || a == doctest::Approx(a0)));

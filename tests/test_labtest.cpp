@@ -8,9 +8,11 @@
 
 #include <doctest/doctest.h>
 #include "tests/validation.hpp"
+#include "tests/validation_record.hpp"
 
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -21,6 +23,7 @@ TEST_CASE("direct tension, paper specimen: mean strength of 3 realizations withi
     // compression to stay quasi-static (halving this rate changes it by < 1%; at
     // the compression rate the peak overshoots by ~15%).
     double mean = 0.0;
+    std::string seeds; // the record's per-seed strengths
     for (std::uint64_t seed : {1, 2, 3}) {
         auto o = LabTestOptions::paper_ucs();
         o.kind = LabTestOptions::Kind::tension;
@@ -31,10 +34,16 @@ TEST_CASE("direct tension, paper specimen: mean strength of 3 realizations withi
         CHECK(r.peak_passed);
         CHECK(r.cracks_tensile > r.cracks_shear);
         mean += r.peak_stress / 3;
+        seeds += (seeds.empty() ? "" : ", ") + test::figure(r.peak_stress / 1e6);
     }
     INFO("mean tensile strength " << mean / 1e6 << " MPa");
     CHECK(mean > 0.5 * 3e6);
     CHECK(mean < 1.1 * 3e6);
+    test::record_check(test::Against::paper, "direct tensile strength, mean of seeds 1-3",
+                       "the paper's bond sigma_t = 3 MPa (SPEC §8)", "in (0.5, 1.1) sigma_t",
+                       test::figure(mean / 1e6) + " MPa = " + test::figure(mean / 3e6) + " sigma_t (seeds 1-3: " +
+                           seeds + ")",
+                       mean > 0.5 * 3e6 && mean < 1.1 * 3e6);
 }
 
 TEST_CASE("uniaxial compression, paper specimen, 3 realizations: the paper's modulus and strength, the lattice modulus, little scatter, axial splitting" * validation) {
@@ -45,6 +54,8 @@ TEST_CASE("uniaxial compression, paper specimen, 3 realizations: the paper's mod
     const auto base = LabTestOptions::paper_ucs();
     const double kn = base.joint.kn, ks = base.joint.ks;
     double E = 0, peak = 0, peak2 = 0;
+    std::string seeds_E, seeds_peak, seeds_lattice; // the records' per-seed figures
+    bool lattice_held = true;
     for (std::uint64_t seed : {1, 2, 3}) {
         auto o = base;
         o.seed = seed;
@@ -59,6 +70,8 @@ TEST_CASE("uniaxial compression, paper specimen, 3 realizations: the paper's mod
         CHECK(r.peak_passed);
         CHECK_FALSE(r.post_peak_locking);
         CHECK(r.E == doctest::Approx(lattice).epsilon(0.05));
+        lattice_held = lattice_held && (r.E == doctest::Approx(lattice).epsilon(0.05));
+        seeds_lattice += (seeds_lattice.empty() ? "" : ", ") + test::percent(r.E, lattice);
         CHECK(r.nu > 0.1);
         CHECK(r.nu < 0.3);
         // Voronoi failure dominated by axial splitting (issue 5: at least 2 to 1 by the
@@ -67,7 +80,12 @@ TEST_CASE("uniaxial compression, paper specimen, 3 realizations: the paper's mod
         CHECK(r.cracks_near_vertical >= r.cracks_near_horizontal * 3 / 2);
         CHECK(r.cracks_tensile > r.cracks_shear);
         E += r.E / 3, peak += r.peak_stress / 3, peak2 += r.peak_stress * r.peak_stress / 3;
+        seeds_E += (seeds_E.empty() ? "" : ", ") + test::figure(r.E / 1e9);
+        seeds_peak += (seeds_peak.empty() ? "" : ", ") + test::figure(r.peak_stress / 1e6);
     }
+    test::record_check(test::Against::closed_form, "E of each seed against the hexagonal lattice's",
+                       "E = 2a kn(kn+ks)/(3kn+ks), a from the mean block area (hexagonal lattice)",
+                       "each seed within 5%", seeds_lattice + " (seeds 1-3)", lattice_held);
     // The whole loaded face moves with the platens, so the strength is a property
     // of the material, not of where the platen rows happen to end: the
     // realizations agree to a few per cent (measured 3%).
@@ -78,7 +96,15 @@ TEST_CASE("uniaxial compression, paper specimen, 3 realizations: the paper's mod
     // Issue 5: the paper's calibration (SPEC §8) reproduced, blocks of 0.3 m average
     // dimension (mean Feret diameter), the cells of random points.
     CHECK(E == doctest::Approx(20.0e9).epsilon(0.10));
+    test::record_check(test::Against::paper, "E, mean of seeds 1-3", "E 20.0 GPa (the paper, SPEC §8)", "within 10%",
+                       test::figure(E / 1e9) + " GPa (" + test::percent(E, 20.0e9) + "; seeds 1-3: " + seeds_E + ")",
+                       E == doctest::Approx(20.0e9).epsilon(0.10));
     CHECK(peak == doctest::Approx(20.7e6).epsilon(0.15));
+    test::record_check(test::Against::paper, "UCS, mean of seeds 1-3", "UCS 20.7 MPa (the paper, SPEC §8)",
+                       "within 15%",
+                       test::figure(peak / 1e6) + " MPa (" + test::percent(peak, 20.7e6) + "; seeds 1-3: " +
+                           seeds_peak + ")",
+                       peak == doctest::Approx(20.7e6).epsilon(0.15));
 }
 
 TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear part within 3% of the closed form" * validation) {
@@ -113,7 +139,15 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
     INFO("E " << r.E / 1e9 << " GPa (closed form " << E / 1e9 << "), nu " << r.nu << " (" << nu << "), E50 "
               << r.E50 / 1e9 << ", peak " << r.peak_stress / 1e6 << " MPa");
     CHECK(r.E == doctest::Approx(E).epsilon(0.03));
+    test::record_check(test::Against::closed_form, "E of the linear part",
+                       "E = 2a kn(kn+ks)/(3kn+ks) = " + test::figure(E / 1e9) + " GPa (hexagonal lattice)", "within 3%",
+                       test::figure(r.E / 1e9) + " GPa (" + test::percent(r.E, E) + ")",
+                       r.E == doctest::Approx(E).epsilon(0.03));
     CHECK(r.nu == doctest::Approx(nu).epsilon(0.03));
+    test::record_check(test::Against::closed_form, "nu of the linear part",
+                       "nu = (kn-ks)/(3kn+ks) = " + test::figure(nu) + " (hexagonal lattice)", "within 3%",
+                       test::figure(r.nu) + " (" + test::percent(r.nu, nu) + ")",
+                       r.nu == doctest::Approx(nu).epsilon(0.03));
     // The linear part ends before the first crack, and cracking starts before the peak.
     CHECK(r.linear_limit_stress > 0);
     CHECK(r.linear_limit_stress <= r.crack_initiation_stress);
@@ -124,6 +158,8 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
     // load far past σci. Then it fails (a shear band from the platen corners) and
     // softens instead of locking.
     int before = 0, after = 0;
+    bool inclined_held = true; // the record's summary of the frames after splitting
+    double inclined_low = 1e300, inclined_high = -1e300;
     for (const auto& f : frames) {
         if (f.strain >= r.strain_at_peak) continue; // after the peak the band unloads it
         INFO("sigma1 " << f.stress / 1e6 << " MPa: axial joints " << f.axial << " sigma1, inclined " << f.inclined);
@@ -134,10 +170,19 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
             ++after;
             CHECK(std::abs(f.axial) < 0.02);
             CHECK(f.inclined == doctest::Approx(0.75).epsilon(0.04));
+            inclined_held = inclined_held && (f.inclined == doctest::Approx(0.75).epsilon(0.04));
+            inclined_low = std::min(inclined_low, f.inclined), inclined_high = std::max(inclined_high, f.inclined);
         }
     }
     CHECK(before >= 1);
     CHECK(after >= 3);
+    test::record_check(test::Against::closed_form, "normal stress on the ±30° joints once the axial joints split",
+                       "sigma_n = 0.75 sigma1 (statics of a hexagon on two faces; docs/calibration.md)",
+                       "each frame within 4%, at least 3 frames",
+                       (after > 0 ? test::figure(inclined_low) + " to " + test::figure(inclined_high)
+                                  : std::string("-")) +
+                           " sigma1 over " + std::to_string(after) + " frames",
+                       inclined_held && after >= 3);
     CHECK(r.peak_stress > 2.5 * r.crack_initiation_stress);
     CHECK_FALSE(r.post_peak_locking);
 }
@@ -298,6 +343,13 @@ TEST_CASE("a single plane of weakness slides where Jaeger's closed form says (bi
         const double jaeger = 5e6 + 2.0 * mu * 5e6 / ((1.0 - mu / std::tan(b)) * std::sin(2.0 * b));
         CAPTURE(beta);
         CHECK(r.joint_slip_stress == doctest::Approx(jaeger).epsilon(0.02));
+        test::record_check(test::Against::closed_form,
+                           "sigma1 at slip (90% of the joint), beta " + test::figure(beta) + "°",
+                           "Jaeger (1960), phi_j 30°, c_j 0, sigma3 5 MPa: " + test::figure(jaeger / 1e6) + " MPa",
+                           "within 2%",
+                           test::figure(r.joint_slip_stress / 1e6) + " MPa (" +
+                               test::percent(r.joint_slip_stress, jaeger) + ")",
+                           r.joint_slip_stress == doctest::Approx(jaeger).epsilon(0.02));
         CHECK(r.joint_slip_stress_half > 0.8 * jaeger);
     }
 }

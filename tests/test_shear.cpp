@@ -7,9 +7,11 @@
 
 #include <doctest/doctest.h>
 #include "tests/validation.hpp"
+#include "tests/validation_record.hpp"
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 using namespace bbm;
 
@@ -33,6 +35,8 @@ ShearTestOptions shear_specimen(meshing::PatternSpec::Kind pattern, double size)
 
 TEST_CASE("direct shear: a planar unbonded joint slides at its Coulomb strength, sigma_n tan(phi)" * validation) {
     // Rigid halves (one block each): one contact, exact to the servo's error.
+    std::string peak_got, residual_got; // the records' figures at each sigma_n
+    bool peak_held = true, residual_held = true;
     for (double sn : {1e6, 5e6, 10e6}) {
         auto o = shear_specimen(meshing::PatternSpec::Kind::single, 0.1);
         o.normal_stress = sn;
@@ -43,9 +47,25 @@ TEST_CASE("direct shear: a planar unbonded joint slides at its Coulomb strength,
         CHECK(r.residual_shear_stress == doctest::Approx(sn * tan_deg(30.0)).epsilon(1e-3));
         CHECK(r.normal_stress_error < 1e-3);
         CHECK(std::abs(r.final_dilation) < 1e-8); // a flat joint does not dilate
+        const std::string sep = peak_got.empty() ? "" : ", ";
+        peak_held = peak_held && (r.peak_shear_stress == doctest::Approx(sn * tan_deg(30.0)).epsilon(1e-3));
+        residual_held =
+            residual_held && (r.residual_shear_stress == doctest::Approx(sn * tan_deg(30.0)).epsilon(1e-3));
+        peak_got += sep + test::figure(r.peak_shear_stress / 1e6) + " (" +
+                    test::percent(r.peak_shear_stress, sn * tan_deg(30.0)) + ")";
+        residual_got += sep + test::figure(r.residual_shear_stress / 1e6) + " (" +
+                        test::percent(r.residual_shear_stress, sn * tan_deg(30.0)) + ")";
     }
+    test::record_check(test::Against::closed_form, "peak shear stress, rigid halves, sigma_n 1, 5, 10 MPa",
+                       "Coulomb, sigma_n tan 30° = 0.577, 2.89, 5.77 MPa", "each within 0.1%", peak_got + " MPa",
+                       peak_held);
+    test::record_check(test::Against::closed_form, "residual shear stress, rigid halves, sigma_n 1, 5, 10 MPa",
+                       "Coulomb, sigma_n tan 30° = 0.577, 2.89, 5.77 MPa", "each within 0.1%", residual_got + " MPa",
+                       residual_held);
     // Bonded Voronoi halves: 39 joint segments along the plane slide together
     // (measured 0.57737, 0.57722 of sigma_n).
+    std::string voronoi_got;
+    bool voronoi_held = true;
     for (double sn : {1e6, 5e6}) {
         auto o = shear_specimen(meshing::PatternSpec::Kind::voronoi, 0.1);
         o.normal_stress = sn;
@@ -55,7 +75,13 @@ TEST_CASE("direct shear: a planar unbonded joint slides at its Coulomb strength,
         CHECK(r.plane_joints > 20);
         CHECK(r.peak_shear_stress == doctest::Approx(sn * tan_deg(30.0)).epsilon(5e-3));
         CHECK(r.normal_stress_error < 2e-3);
+        voronoi_held = voronoi_held && (r.peak_shear_stress == doctest::Approx(sn * tan_deg(30.0)).epsilon(5e-3));
+        voronoi_got += (voronoi_got.empty() ? "" : ", ") + test::figure(r.peak_shear_stress / 1e6) + " (" +
+                       test::percent(r.peak_shear_stress, sn * tan_deg(30.0)) + ")";
     }
+    test::record_check(test::Against::closed_form, "peak shear stress, bonded Voronoi halves, sigma_n 1, 5 MPa",
+                       "Coulomb, sigma_n tan 30° = 0.577, 2.89 MPa", "each within 0.5%", voronoi_got + " MPa",
+                       voronoi_held);
 }
 
 TEST_CASE("direct shear: a weak brittle bond peaks at c + sigma_n tan(phi) and falls to sigma_n tan(phi_r)") {
@@ -137,6 +163,8 @@ TEST_CASE("direct shear: rock bridges make a joint stronger, the more of them th
 TEST_CASE("direct shear: a Barton-Bandis joint peaks at sigma_n tan(phi_r + JRC log10(JCS / sigma_n)) and dilates") {
     // Rigid halves (one block each), JRC 10, JCS 100 MPa, phi_r 30 deg, no
     // post-peak fall (no joint length): the peak of Barton & Choubey (1977).
+    std::string peak_ref, peak_got, dilation_ref, dilation_got; // the records' figures at each sigma_n
+    bool peak_held = true, dilation_held = true;
     for (double sn : {1e6, 5e6}) {
         auto o = shear_specimen(meshing::PatternSpec::Kind::single, 0.1);
         o.plane.law = JointPropertySpec::Law::barton_bandis;
@@ -155,5 +183,23 @@ TEST_CASE("direct shear: a Barton-Bandis joint peaks at sigma_n tan(phi_r + JRC 
         // Sliding opens the joint at the dilation angle ½ JRC log10(JCS/σn).
         MESSAGE("dilation angle " << r.peak_dilation_angle << " deg, final dilation " << r.final_dilation << " m");
         CHECK(r.peak_dilation_angle == doctest::Approx(0.5 * 10.0 * std::log10(100e6 / sn)).epsilon(0.05));
+        const std::string sep = peak_ref.empty() ? "" : ", ";
+        const double dilation = 0.5 * 10.0 * std::log10(100e6 / sn);
+        peak_held = peak_held && (r.peak_shear_stress == doctest::Approx(at_peak * tan_deg(angle)).epsilon(2e-3));
+        dilation_held = dilation_held && (r.peak_dilation_angle == doctest::Approx(dilation).epsilon(0.05));
+        peak_ref += sep + test::figure(at_peak * tan_deg(angle) / 1e6);
+        peak_got += sep + test::figure(r.peak_shear_stress / 1e6) + " (" +
+                    test::percent(r.peak_shear_stress, at_peak * tan_deg(angle)) + ")";
+        dilation_ref += sep + test::figure(dilation);
+        dilation_got +=
+            sep + test::figure(r.peak_dilation_angle) + "° (" + test::percent(r.peak_dilation_angle, dilation) + ")";
     }
+    test::record_check(test::Against::closed_form, "peak shear stress at the sigma_n of the peak, sigma_n 1, 5 MPa",
+                       "sigma_n tan(phi_r + JRC log10(JCS/sigma_n)), JRC 10, JCS 100 MPa, phi_r 30° "
+                       "(Barton & Choubey 1977): " +
+                           peak_ref + " MPa",
+                       "each within 0.2%", peak_got + " MPa", peak_held);
+    test::record_check(test::Against::closed_form, "peak dilation angle, sigma_n 1, 5 MPa",
+                       "1/2 JRC log10(JCS/sigma_n) = " + dilation_ref + "° (docs/joints.md)", "each within 5%",
+                       dilation_got, dilation_held);
 }

@@ -10,12 +10,14 @@
 #include "meshing/blocks.hpp"
 
 #include "model_text.hpp"
+#include "tests/validation_record.hpp"
 
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <memory>
 #include <sstream>
+#include <string>
 
 using namespace bbm;
 
@@ -99,15 +101,28 @@ TEST_CASE("a grouted bolt pulled out of fixed rock: axial force decays as sinh(b
     const double ea = young * area, beta = std::sqrt(k_bond / ea), P = 100e3;
     const auto r = pull(m, P, 1);
     MESSAGE("elastic pull-out: " << r.steps << " steps");
+    std::string measured; // the record's figures at the four points
+    bool held = true;
     for (double x : {0.1, 0.3, 0.6, 1.0}) {
         const int seg = int(x / segment);
         const double exact = P * std::sinh(beta * (L - r.x[seg])) / std::sinh(beta * L);
         MESSAGE("x = " << r.x[seg] << " m: N = " << r.axial[seg] << " N/m, closed form " << exact);
         CHECK(r.axial[seg] == doctest::Approx(exact).epsilon(0.005));
+        held = held && (r.axial[seg] == doctest::Approx(exact).epsilon(0.005));
+        measured += (measured.empty() ? "" : ", ") + test::figure(r.axial[seg] / 1e3) + " (" +
+                    test::percent(r.axial[seg], exact) + ")";
     }
+    test::record_check(test::Against::closed_form, "axial force along the bolt, x = 0.1, 0.3, 0.6, 1.0 m",
+                       "N = P sinh(beta(L - x)) / sinh(beta L), P 100 kN/m (shear lag, Farmer 1975)",
+                       "each within 0.5%", measured + " kN/m", held);
     const double u0 = P / (ea * beta * std::tanh(beta * L));
     MESSAGE("head displacement " << r.head_displacement << " m, closed form " << u0);
     CHECK(r.head_displacement == doctest::Approx(u0).epsilon(0.005));
+    test::record_check(test::Against::closed_form, "displacement of the bolt's head",
+                       "u0 = P coth(beta L) / (EA beta) = " + test::figure(u0 * 1e3) + " mm (Farmer 1975)",
+                       "within 0.5%",
+                       test::figure(r.head_displacement * 1e3) + " mm (" + test::percent(r.head_displacement, u0) + ")",
+                       r.head_displacement == doctest::Approx(u0).epsilon(0.005));
     // The same bits on two threads (the bolt pass is serial, in the bolts' order).
     const auto r2 = pull(m, P, 2);
     CHECK(r2.steps == r.steps);
@@ -368,6 +383,11 @@ TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and
     MESSAGE("unlined wall convergence " << u0 * 1e3 << " mm, closed form (round boundary at 10 m) " << u_closed * 1e3
                                         << " mm");
     CHECK(u0 == doctest::Approx(u_closed).epsilon(0.02));
+    test::record_check(test::Against::closed_form, "wall convergence, unlined",
+                       "u = -(A a + B/a), a 1 m hole in ground held at b = 10 m, plane strain: " +
+                           test::figure(u_closed * 1e3) + " mm",
+                       "within 2%", test::figure(u0 * 1e3) + " mm (" + test::percent(u0, u_closed) + ")",
+                       u0 == doctest::Approx(u_closed).epsilon(0.02));
     const double k_ground = p0 / u0;
 
     const auto lined = run(true);
@@ -383,8 +403,19 @@ TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and
                                        << thrust / 1e3 << " kN/m (p a = " << p_mean * a / 1e3 << "), convergence "
                                        << u1 * 1e3 << " mm (" << (p0 - p_expected) / k_ground * 1e3 << ")");
     CHECK(p_mean == doctest::Approx(p_expected).epsilon(0.01));
+    test::record_check(test::Against::closed_form, "support pressure of an elastic liner",
+                       "p = K p0 / (K + k_g) = " + test::figure(p_expected / 1e6) +
+                           " MPa (convergence-confinement, k_g of the unlined run; docs/theory.md §14)",
+                       "within 1%", test::figure(p_mean / 1e6) + " MPa (" + test::percent(p_mean, p_expected) + ")",
+                       p_mean == doctest::Approx(p_expected).epsilon(0.01));
     CHECK(thrust == doctest::Approx(p_mean * a).epsilon(0.01));
     CHECK(u1 == doctest::Approx((p0 - p_expected) / k_ground).epsilon(0.01));
+    test::record_check(test::Against::closed_form, "wall convergence, elastic liner",
+                       "(p0 - p) / k_g = " + test::figure((p0 - p_expected) / k_ground * 1e3) +
+                           " mm (the ground reaction at that pressure)",
+                       "within 1%",
+                       test::figure(u1 * 1e3) + " mm (" + test::percent(u1, (p0 - p_expected) / k_ground) + ")",
+                       u1 == doctest::Approx((p0 - p_expected) / k_ground).epsilon(0.01));
     // No bending under an isotropic load.
     const auto summary = lined->support<LinerSupport>().set_summary();
     REQUIRE(summary.size() == 1);
@@ -407,8 +438,18 @@ TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and
                                       << " MPa, convergence " << u_yield * 1e3 << " mm ("
                                       << (p0 - 3e6 / a) / k_ground * 1e3 << ")");
     CHECK(thrust_yield == doctest::Approx(3e6).epsilon(0.01));
+    test::record_check(test::Against::closed_form, "thrust of a liner yielding at 3 MN/m", "its capacity, 3 MN/m",
+                       "within 1%",
+                       test::figure(thrust_yield / 1e3) + " kN/m (" + test::percent(thrust_yield, 3e6) + ")",
+                       thrust_yield == doctest::Approx(3e6).epsilon(0.01));
     CHECK(p_yield == doctest::Approx(3e6 / a).epsilon(0.01));
     CHECK(u_yield == doctest::Approx((p0 - 3e6 / a) / k_ground).epsilon(0.01));
+    test::record_check(test::Against::closed_form, "wall convergence, yielding liner",
+                       "(p0 - T_y/a) / k_g = " + test::figure((p0 - 3e6 / a) / k_ground * 1e3) +
+                           " mm (the ground reaction at p = T_y/a)",
+                       "within 1%",
+                       test::figure(u_yield * 1e3) + " mm (" + test::percent(u_yield, (p0 - 3e6 / a) / k_ground) + ")",
+                       u_yield == doctest::Approx((p0 - 3e6 / a) / k_ground).epsilon(0.01));
     CHECK(yielding->support<LinerSupport>().set_summary()[0].yielded == Y.element_count());
 }
 
@@ -499,6 +540,9 @@ TEST_CASE("a liner under an anisotropic stress: thrust and moment against the cl
     // interface bonded in shear (c = 10¹² Pa: no slip) or frictionless (full slip).
     // Measured: thrust within 0.9%, moment 0.5–1.6% low (zones of 0.08 m at the wall;
     // 0.04 m changes them by under 0.5%).
+    // The records' figures, case by case (K 0.5 no slip, full slip; K 2 no slip, full slip).
+    std::string spring_ref, spring_off, crown_ref, crown_off, moment_ref, moment_off;
+    bool spring_held = true, crown_held = true, moment_held = true;
     for (const double ratio : {0.5, 2.0})
         for (const bool no_slip : {true, false}) {
             CAPTURE(ratio);
@@ -524,7 +568,27 @@ TEST_CASE("a liner under an anisotropic stress: thrust and moment against the cl
             CHECK(got.thrust0 + got.thrust2 == doctest::Approx(closed.thrust0 + closed.thrust2).epsilon(0.015));
             CHECK(got.thrust0 - got.thrust2 == doctest::Approx(closed.thrust0 - closed.thrust2).epsilon(0.015));
             CHECK(got.moment2 == doctest::Approx(closed.moment2).epsilon(0.025));
+            const std::string sep = spring_ref.empty() ? "" : ", ";
+            spring_held = spring_held && (got.thrust0 + got.thrust2 ==
+                                          doctest::Approx(closed.thrust0 + closed.thrust2).epsilon(0.015));
+            crown_held = crown_held && (got.thrust0 - got.thrust2 ==
+                                        doctest::Approx(closed.thrust0 - closed.thrust2).epsilon(0.015));
+            moment_held = moment_held && (got.moment2 == doctest::Approx(closed.moment2).epsilon(0.025));
+            spring_ref += sep + test::figure((closed.thrust0 + closed.thrust2) / 1e3);
+            spring_off += sep + test::percent(got.thrust0 + got.thrust2, closed.thrust0 + closed.thrust2);
+            crown_ref += sep + test::figure((closed.thrust0 - closed.thrust2) / 1e3);
+            crown_off += sep + test::percent(got.thrust0 - got.thrust2, closed.thrust0 - closed.thrust2);
+            moment_ref += sep + test::figure(closed.moment2 / 1e3);
+            moment_off += sep + test::percent(got.moment2, closed.moment2);
         }
+    const std::string cases = " (K 0.5 no slip, full slip; K 2 no slip, full slip)";
+    const std::string source = "thin ring in an elastic plane (docs/theory.md §14): ";
+    test::record_check(test::Against::closed_form, "thrust at the springline, K 0.5 and 2, no slip and full slip",
+                       source + spring_ref + " kN/m", "each within 1.5%", spring_off + cases, spring_held);
+    test::record_check(test::Against::closed_form, "thrust at the crown, K 0.5 and 2, no slip and full slip",
+                       source + crown_ref + " kN/m", "each within 1.5%", crown_off + cases, crown_held);
+    test::record_check(test::Against::closed_form, "moment at the springline, K 0.5 and 2, no slip and full slip",
+                       source + moment_ref + " kNm/m", "each within 2.5%", moment_off + cases, moment_held);
 }
 
 TEST_CASE("a lined opening resumes exactly from a checkpoint, and runs to the same bits on 2 threads") {

@@ -7,6 +7,8 @@
 
 #include "tests/softening_reference.hpp"
 
+#include "tests/validation_record.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -80,6 +82,13 @@ TEST_CASE("verification 1: a bonded joint opened monotonically follows the tensi
     CHECK(s.cracks(contact::JointState::broken_tension) == 2);
     CHECK(s.dissipated_energy() == doctest::Approx(149.07).epsilon(0.01));
     CHECK(work == doctest::Approx(1.6 * st * st / kn).epsilon(0.01));
+    const double g_i = 1.6 * st * st / kn;
+    test::record_check(test::Against::closed_form, "work of opening a bonded joint to failure (SPEC's bilinear law)",
+                       "G_I = area under the tension curve = " + test::figure(g_i, 4) + " J/m²",
+                       "within 1%; the curve's points within 1e-6 of σt",
+                       test::figure(work, 4) + " J/m² (" + test::percent(work, g_i) + "); points within " +
+                           test::figure(max_err, 1),
+                       std::abs(work / g_i - 1.0) <= 0.01 && max_err < 1e-6);
 }
 
 TEST_CASE("verification 2: a bonded joint in shear at sn = 0 and sn = 5 MPa") {
@@ -157,6 +166,14 @@ TEST_CASE("verification 4: square lattice under uniaxial stress: E = kn d, nu = 
     }
     const double uy = 4 * sigma / kn;
     CHECK(max_ux < 1e-6 * uy); // ν = 0 (to second order in the strain, see the model file)
+    double top_strain = 0.0;
+    for (int i = 0; i < b.count(); ++i)
+        if (b.centroid0[i].y > 2.0) top_strain = -(b.centroid[i].y - b.centroid0[i].y) / (4 * d);
+    test::record_check(test::Against::closed_form, "modulus of a square lattice of blocks, uniaxial stress",
+                       "E = kn d = " + test::figure(kn * d / 1e9) + " GPa, ν = 0", "1e-6 relative",
+                       test::figure(sigma / top_strain / 1e9, 7) + " GPa, lateral displacement " +
+                           test::figure(max_ux / uy, 1) + " of the axial",
+                       std::abs(sigma / top_strain / (kn * d) - 1.0) <= 1e-6 && max_ux < 1e-6 * uy);
 }
 
 TEST_CASE("verification 5: undamped oscillation on a joint conserves energy over 1000 periods") {
@@ -430,4 +447,11 @@ TEST_CASE("hexagonal lattice of rigid blocks: E and nu match the closed form") {
     INFO("E " << 1e6 / -eyy << " (closed form " << E << "), nu " << -exx / eyy << " (" << nu << ")");
     CHECK(1e6 / -eyy == doctest::Approx(E).epsilon(0.01));
     CHECK(-exx / eyy == doctest::Approx(nu).epsilon(0.02));
+    test::record_check(test::Against::closed_form, "E and ν of a hexagonal lattice of rigid blocks",
+                       "E = 2a kn (kn + ks) / (3kn + ks) = " + test::figure(E / 1e9) + " GPa, ν = (kn − ks) / (3kn + ks) = " +
+                           test::figure(nu),
+                       "E within 1%, ν within 2%",
+                       "E " + test::figure(1e6 / -eyy / 1e9) + " GPa (" + test::percent(1e6 / -eyy, E) + "), ν " +
+                           test::figure(-exx / eyy) + " (" + test::percent(-exx / eyy, nu) + ")",
+                       std::abs(1e6 / -eyy / E - 1.0) <= 0.01 && std::abs(-exx / eyy / nu - 1.0) <= 0.02);
 }

@@ -8,6 +8,8 @@
 #include "studies/labtest.hpp"
 #include "studies/opening.hpp"
 
+#include "tests/validation_record.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -82,6 +84,8 @@ TEST_CASE("hydraulic fracturing: breakdown pressure against Hubbert-Willis (Pb =
     MESSAGE("tensile strength of the block rock " << tensile / 1e6 << " MPa; Hubbert-Willis breakdown "
                                                   << hubbert_willis / 1e6 << " MPa");
     double mean = 0.0;
+    std::string breakdowns, directions;
+    bool within = true, perpendicular = true;
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
         // Bisection on the borehole's pressure between stable and fractured.
         double lo = 5.0e6, hi = 7.0e6;
@@ -104,9 +108,21 @@ TEST_CASE("hydraulic fracturing: breakdown pressure against Hubbert-Willis (Pb =
         // σh is the least stress (along y): the fracture runs along x.
         CHECK(fractured.far > 50);
         CHECK(fractured.along_x > 0.8);
+        breakdowns += (breakdowns.empty() ? "" : ", ") + test::figure(breakdown / 1e6);
+        directions += (directions.empty() ? "" : ", ") + test::figure(100.0 * fractured.along_x, 2) + "%";
+        within = within && std::abs(breakdown / hubbert_willis - 1.0) < 0.15;
+        perpendicular = perpendicular && fractured.far > 50 && fractured.along_x > 0.8;
     }
     MESSAGE("mean breakdown " << mean / 1e6 << " MPa, " << 100.0 * (mean / hubbert_willis - 1.0)
                               << "% from Hubbert-Willis");
+    test::record_check(test::Against::closed_form, "breakdown pressure of a borehole, σH 10, σh 5 MPa, 3 seeds",
+                       "Hubbert-Willis Pb = 3σh − σH + T = " + test::figure(hubbert_willis / 1e6) +
+                           " MPa (T measured by direct tension)",
+                       "within 15%, each seed", breakdowns + " MPa (mean " + test::percent(mean, hubbert_willis) + ")",
+                       within);
+    test::record_check(test::Against::closed_form, "direction of the hydraulic fracture, 3 seeds",
+                       "perpendicular to the least stress (along x)",
+                       "over 80% of the cracks beyond 1.5 radii within 30° of x", directions, perpendicular);
 }
 
 namespace {
@@ -183,6 +199,8 @@ TEST_CASE("hydraulic fracturing: the re-opening pressure read from the pressure-
     const double sigma_H = 10e6, sigma_h = 5e6;
     const double mouth = (3 * sigma_h - sigma_H) / 2, classical = 3 * sigma_h - sigma_H;
     double mean = 0.0;
+    std::string pressures;
+    bool within = true;
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
         auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/hydraulic_fracturing.toml");
         file.geometry.regions[0].pattern.seed = seed;
@@ -200,8 +218,15 @@ TEST_CASE("hydraulic fracturing: the re-opening pressure read from the pressure-
         CHECK(h.pressure > 0.9 * mouth);
         CHECK(h.pressure < 1.1 * classical);
         CHECK(h.slope_after > 3.0 * h.slope_before); // a clear turn: the fracture opens
+        pressures += (pressures.empty() ? "" : ", ") + test::figure(h.pressure / 1e6);
+        within = within && h.pressure > 0.9 * mouth && h.pressure < 1.1 * classical &&
+                 h.slope_after > 3.0 * h.slope_before;
     }
     MESSAGE("mean re-opening pressure " << mean / 1e6 << " MPa");
+    test::record_check(test::Against::closed_form, "re-opening pressure of the fracture, 3 seeds",
+                       "between the mouth's (3σh − σH)/2 = 2.5 MPa and the classical 3σh − σH = 5 MPa",
+                       "in [0.9 × 2.5, 1.1 × 5] MPa and a turn over 3×, each seed",
+                       pressures + " MPa (mean " + test::figure(mean / 1e6) + ")", within);
 }
 
 // The Mine-by tunnel's damaged zone as a path for water along the tunnel (issue 49,
@@ -215,6 +240,8 @@ TEST_CASE("hydraulic fracturing: the re-opening pressure read from the pressure-
 TEST_CASE("the Mine-by damaged zone for water: within 0.6 radii of the wall, most of its flow in a core of the "
           "order of the URL's 0.05 m2, the rock beyond it intact, 3 seeds") {
     const double radius = 1.75, field_core = 0.05, intact_target = 2e-22;
+    std::string reaches, cores;
+    bool reach_within = true, core_within = true;
     for (std::uint64_t seed : {11, 21, 31}) {
         auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/mineby_edz.toml");
         for (auto& r : file.geometry.regions)
@@ -248,5 +275,15 @@ TEST_CASE("the Mine-by damaged zone for water: within 0.6 radii of the wall, mos
         CHECK(k.edz_permeability > 1e3 * k.intact);
         REQUIRE(k.all_round.size() >= 3);
         CHECK(k.all_round.back() == doctest::Approx(k.intact).epsilon(0.25));
+        reaches += (reaches.empty() ? "" : ", ") + test::figure(k.edz_depth, 2);
+        cores += (cores.empty() ? "" : ", ") + test::figure(k.core_area, 2);
+        reach_within = reach_within && k.edz_depth <= 0.6 * radius;
+        core_within = core_within && k.core_area >= field_core / 10.0 && k.core_area <= field_core * 10.0;
     }
+    test::record_check(test::Against::field, "reach of the Mine-by tunnel's connected damaged zone, 3 seeds",
+                       "within about 0.6 radii (1.05 m) of the wall (AECL's URL)", "at most 1.05 m, each seed",
+                       reaches + " m", reach_within);
+    test::record_check(test::Against::field, "area of the damaged zone's core carrying 90% of its flow, 3 seeds",
+                       "about 0.05 m² (Chandler, Kozak & Martin, URL)", "within 10× either way, each seed",
+                       cores + " m²", core_within);
 }
