@@ -12,6 +12,8 @@
 namespace bbm {
 
 using FlowKey = Key<FlowSpec>;
+using FlowBoundaryKey = Key<FlowBoundarySpec>;
+using FlowSourceKey = Key<FlowSourceSpec>;
 
 // Each row names only the members it sets; the rest keep their defaults.
 #pragma GCC diagnostic push
@@ -67,6 +69,24 @@ inline constexpr FlowKey flow_keys[] = {
                 "summary.json's flow.inflow)",
      .absent = "true", BBM_KEY_FIELD(FlowSpec, drain_openings)},
 };
+
+/// Every key of [[flow_boundary]]: the junctions of the network inside a box held at
+/// a pressure or a hydraulic head.
+inline constexpr FlowBoundaryKey flow_boundary_keys[] = {
+    {.key = "name", .kind = KeyKind::text, .required = true, .meaning = "Non-empty, unique"},
+    {.key = "box", .kind = KeyKind::table, .bounds = unbounded(" m"), .required = true,
+     .meaning = "{ min = [x, y], max = [x, y] }: the junctions inside it are held; a box that holds none is an error"},
+    {.key = "pressure", .bounds = at_least(0, " Pa"), .meaning = "The pressure held; or head"},
+    {.key = "head", .bounds = unbounded(" m"), .meaning = "The hydraulic head held, p = ρ_w |g| (head − y) (needs gravity); or pressure"},
+};
+
+/// Every key of [[flow_source]]: a rate injected at the junction nearest a point.
+inline constexpr FlowSourceKey flow_source_keys[] = {
+    {.key = "at", .kind = KeyKind::point, .bounds = unbounded(" m"), .required = true,
+     .meaning = "The point: the junction nearest it gets the rate"},
+    {.key = "rate", .bounds = unbounded(" m²/s per m"), .required = true,
+     .meaning = "Injected (negative: extracted), per metre of depth; where no pressure is held it has no steady state"},
+};
 #pragma GCC diagnostic pop
 
 /// docs/reference/flow.md: the table of keys.
@@ -76,7 +96,8 @@ inline std::string flow_keys_markdown() {
                      "rewrites it; the test fails when it is stale). Water in the joints: the equations in "
                      "[theory.md](../theory.md) §16, [[flow_boundary]] and [[flow_source]] in "
                      "[input.md](../input.md), \"Water in the joints\".\n\n";
-    return md + key_table_markdown(flow_keys);
+    return md + key_table_markdown(flow_keys) + "\n## [[flow_boundary]]\n\n" + key_table_markdown(flow_boundary_keys) +
+           "\n## [[flow_source]]\n\n" + key_table_markdown(flow_source_keys);
 }
 
 } // namespace bbm

@@ -11,10 +11,13 @@
 
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
+#include "core/boundary_keys.hpp"
+#include "core/history_keys.hpp"
 #include "core/material_keys.hpp"
 #include "core/solver_keys.hpp"
 
 #include "core/verdict.hpp"
+#include "meshing/model_keys.hpp"
 
 #include <algorithm>
 #include <array>
@@ -382,9 +385,6 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 
 
 // In the order of the enums of core/model_spec.hpp and meshing::JointTag.
-constexpr std::array<std::string_view, 6> joint_tags{"inner", "radial", "peripheral", "real_joint",
-                                                     "interface", "fracture"};
-constexpr std::array<std::string_view, 2> boundary_types{"velocity", "stress"};
 
 
 
@@ -522,8 +522,9 @@ JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& 
 
 JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Path& p,
                                           const Names& properties, const Names& regions) {
-    static constexpr std::array<std::string_view, 3> keys{"property", "tags", "regions"};
+    static constexpr auto keys = key_names(assignment_keys);
     check_keys(c, t, p, keys);
+    const auto joint_tags = key_words(joint_tag_words);
     JointAssignmentSpec a;
     const Path pp = p.key("property");
     const toml::node& n = need(c, t, p, "property", "the name of a [[joint_property]]");
@@ -542,21 +543,18 @@ JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Pa
 
 BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& names,
                            const Names& regions) {
-    static constexpr std::array<std::string_view, 8> velocity_keys{"name", "type", "regions", "box",
-                                                                   "touching", "vx", "vy", "omega"};
-    static constexpr std::array<std::string_view, 11> stress_boundary_keys{
-        "name", "type",  "regions", "box",     "sxx",    "syy",
-        "sxy",  "y_ref", "dsxx_dy", "dsyy_dy", "dsxy_dy"};
-    static constexpr std::array<std::string_view, 15> all_keys{
-        "name", "type", "regions", "box",   "touching", "vx",      "vy",      "omega",
-        "sxx",  "syy",  "sxy",     "y_ref", "dsxx_dy",  "dsyy_dy", "dsxy_dy"};
+    static constexpr auto all_keys = key_names(boundary_keys);
     check_keys(c, t, p, all_keys);
     BoundarySpec b;
     using Kind = BoundarySpec::Kind;
     b.name = read_name(c, t, p, names);
-    b.kind = static_cast<Kind>(choice(c, t, p, "type", boundary_types, "boundary type"));
-    check_keys(c, t, p, b.kind == Kind::velocity ? Keys(velocity_keys) : Keys(stress_boundary_keys),
-               all_keys, article(boundary_types[static_cast<std::size_t>(b.kind)]) + " boundary");
+    const auto types = key_words(boundary_type_words);
+    b.kind = static_cast<Kind>(choice(c, t, p, "type", types, "boundary type"));
+    const std::string_view type = types[static_cast<std::size_t>(b.kind)];
+    std::vector<std::string_view> keys;
+    for (const BoundaryKey& k : boundary_keys)
+        if (key_applies(k, type)) keys.push_back(k.key);
+    check_keys(c, t, p, keys, all_keys, article(type) + " boundary");
     b.select.regions = name_list(c, t, p, "regions", regions, "to select by box only (or all)");
     if (const toml::node* n = find(c, t, p, "box")) b.select.box = read_box(c, *n, p.key("box"));
     if (b.kind == Kind::stress) {
@@ -564,9 +562,9 @@ BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& n
         return b;
     }
     b.select.touching = boolean(c, t, p, "touching").value_or(false);
-    b.vx = number(c, t, p, "vx", unbounded(" m/s"));
-    b.vy = number(c, t, p, "vy", unbounded(" m/s"));
-    b.omega = number(c, t, p, "omega", unbounded(" rad/s"));
+    b.vx = number(c, t, p, "vx", find_key(boundary_keys, "vx")->bounds);
+    b.vy = number(c, t, p, "vy", find_key(boundary_keys, "vy")->bounds);
+    b.omega = number(c, t, p, "omega", find_key(boundary_keys, "omega")->bounds);
     if (!b.vx && !b.vy && !b.omega)
         c.fail(t, p,
                c.in_owner() + "a velocity boundary needs at least one of vx, vy, omega "
@@ -624,7 +622,7 @@ void read_report(Ctx& c, const toml::table& doc, ReportSpec& r) {
     if (const toml::node* n = find(c, doc, Path{}, "report")) {
         const Path p = Path{}.key("report");
         const toml::table& t = to_table(c, *n, p, "a [report] table");
-        static constexpr std::array<std::string_view, 4> keys{"center", "springline", "crown", "window"};
+        static constexpr auto keys = key_names(report_keys);
         check_keys(c, t, p, keys);
         if (find(c, t, p, "center") || find(c, t, p, "springline") || find(c, t, p, "crown")) {
             r.opening = true;
@@ -847,12 +845,12 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     if (const toml::node* n = find(c, doc, root, "model")) {
         const Path p = root.key("model");
         const toml::table& t = to_table(c, *n, p, "a [model] table");
-        static constexpr std::array<std::string_view, 3> keys{"title", "max_segment", "max_elements"};
+        static constexpr auto keys = key_names(meshing::model_keys);
         check_keys(c, t, p, keys);
         if (const toml::node* title = find(c, t, p, "title"))
             mf.title = to_str(c, *title, p.key("title"));
-        mf.geometry.max_segment = number(c, t, p, "max_segment", above(0, metres)).value_or(0.1);
-        mf.geometry.max_elements = number(c, t, p, "max_elements", above(0, "")).value_or(0.0);
+        for (const meshing::ModelKey& k : meshing::model_keys)
+            if (k.set) read_declared_key(c, t, p, k, mf.geometry);
     }
 
     const toml::node* rn = find(c, doc, root, "region");

@@ -31,8 +31,6 @@ void read_flow_table(Ctx& c, const toml::table& t, const Path& p, FlowSpec& f, c
                                   "far-field condition") == 0;
 }
 
-constexpr std::array<std::string_view, 4> boundary_keys{"name", "box", "pressure", "head"};
-constexpr std::array<std::string_view, 2> source_keys{"at", "rate"};
 
 } // namespace
 
@@ -43,22 +41,24 @@ void read_flow(Ctx& c, const toml::table& doc, FlowSpec& f, const Names& regions
     }
     Names names{"flow boundary", "flow boundaries", "flow_boundary", {}, {}};
     read_tables(c, doc, "flow_boundary", [&](const toml::table& t, const Path& p, std::size_t) {
-        check_keys(c, t, p, boundary_keys);
+        static constexpr auto keys = key_names(flow_boundary_keys);
+        check_keys(c, t, p, keys);
         FlowBoundarySpec b;
         b.name = read_name(c, t, p, names);
         b.box = read_box(c, need(c, t, p, "box", "a box { min = [x, y], max = [x, y] }"), p.key("box"));
-        b.pressure = number(c, t, p, "pressure", at_least(0, " Pa"));
-        b.head = number(c, t, p, "head", unbounded(metres));
+        b.pressure = number(c, t, p, "pressure", find_key(flow_boundary_keys, "pressure")->bounds);
+        b.head = number(c, t, p, "head", find_key(flow_boundary_keys, "head")->bounds);
         if (b.pressure.has_value() == b.head.has_value())
             c.fail(t, p, c.in_owner() + "give the held 'pressure' or the 'head' (one of them)");
         if (!f.on) c.fail(t, p, "a [[flow_boundary]] needs a [flow] table (the fluid and the joints' apertures)");
         f.boundaries.push_back(b);
     });
     read_tables(c, doc, "flow_source", [&](const toml::table& t, const Path& p, std::size_t) {
-        check_keys(c, t, p, source_keys);
+        static constexpr auto keys = key_names(flow_source_keys);
+        check_keys(c, t, p, keys);
         FlowSourceSpec s;
         s.at = required_point(c, t, p, "at");
-        s.rate = required_number(c, t, p, "rate", unbounded(" m²/s per m"));
+        s.rate = required_number(c, t, p, "rate", find_key(flow_source_keys, "rate")->bounds);
         if (!f.on) c.fail(t, p, "a [[flow_source]] needs a [flow] table (the fluid and the joints' apertures)");
         f.sources.push_back(s);
     });

@@ -1,29 +1,16 @@
 // bbm io: the [[history]] and [[stage]] tables of a model file (docs/input.md).
 #include "io/reader.hpp"
 
+#include "core/history_keys.hpp"
 #include "core/stage_keys.hpp"
 #include "core/verdict.hpp"
 
 namespace bbm::io::reader {
 
-namespace {
-
-// In the order of the enums of core/model_spec.hpp.
-constexpr std::array<std::string_view, 15> quantities{"unbalanced_ratio",  "displacement_x",
-                                                      "displacement_y",    "velocity_x",
-                                                      "velocity_y",        "rotation",
-                                                      "boundary_force_x",  "boundary_force_y",
-                                                      "cracks_tensile",    "cracks_shear",
-                                                      "kinetic_energy",    "strain_energy",
-                                                      "dissipated_energy", "work",
-                                                      "inflow"};
-
-} // namespace
-
 HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& names,
                          const Names& boundaries) {
-    static constexpr std::array<std::string_view, 4> all_keys{"name", "quantity", "point",
-                                                              "boundary"};
+    static constexpr auto all_keys = key_names(history_keys);
+    const auto quantities = key_words(history_quantity_words);
     static constexpr std::array<std::string_view, 3> point_keys{"name", "quantity", "point"};
     static constexpr std::array<std::string_view, 3> boundary_keys{"name", "quantity", "boundary"};
     check_keys(c, t, p, all_keys);

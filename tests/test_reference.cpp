@@ -8,12 +8,15 @@
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
 #include "core/bolt_keys.hpp"
+#include "core/boundary_keys.hpp"
 #include "core/flow_keys.hpp"
+#include "core/history_keys.hpp"
 #include "core/liner_keys.hpp"
 #include "core/material_keys.hpp"
 #include "core/solver_keys.hpp"
 #include "core/stage_keys.hpp"
 #include "io/model_input.hpp"
+#include "meshing/model_keys.hpp"
 #include "studies/commands.hpp"
 #include "studies/shear.hpp"
 
@@ -100,6 +103,9 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     check_reference("stage.md", stage_keys_markdown());
     check_reference("bolt.md", bolt_keys_markdown());
     check_reference("liner.md", liner_keys_markdown());
+    check_reference("boundary.md", boundary_keys_markdown());
+    check_reference("history.md", history_keys_markdown());
+    check_reference("model.md", meshing::model_keys_markdown());
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {
