@@ -66,7 +66,7 @@ inline std::string key_value_text(KeyKind kind, const Bounds& b) {
     case KeyKind::text: return "string";
     case KeyKind::choice: return "word";
     case KeyKind::boolean: return "true / false";
-    case KeyKind::curve: return "[[α, β], ...]";
+    case KeyKind::curve: return b.unit.empty() ? "[[α, β], ...]" : "[[x, y], ...]" + std::string(b.unit);
     case KeyKind::point: return "[x, y]" + (b.unit.empty() ? std::string() : std::string(b.unit));
     case KeyKind::names: return "array of names";
     case KeyKind::segments: return "[[[x1, y1], [x2, y2]], ...]" + std::string(b.unit);

@@ -18,6 +18,7 @@
 
 #include "core/verdict.hpp"
 #include "meshing/model_keys.hpp"
+#include "meshing/region_keys.hpp"
 
 #include <algorithm>
 #include <array>
@@ -47,62 +48,19 @@ using namespace reader;
 
 // --- the model's tables ------------------------------------------------------------
 
-// In the order of OutlineSpec::Kind and PatternSpec::Kind.
-constexpr std::array<std::string_view, 5> outline_types{"rectangle", "polygon", "circle", "path",
-                                                        "opening"};
-constexpr std::array<std::string_view, 6> pattern_types{"voronoi",   "trigon", "delaunay",
-                                                        "hexagonal", "brick",  "single"};
-
-constexpr std::array<std::string_view, 3> rectangle_keys{"type", "min", "max"};
-constexpr std::array<std::string_view, 2> polygon_keys{"type", "points"};
-constexpr std::array<std::string_view, 4> circle_keys{"type", "center", "radius", "max_segment"};
-constexpr std::array<std::string_view, 4> path_keys{"type", "start", "steps", "max_segment"};
-constexpr std::array<std::string_view, 6> opening_keys{"type",  "center", "width",
-                                                       "floor", "half",   "max_segment"};
-constexpr std::array<std::string_view, 12> all_outline_keys{
-    "type",  "min",   "max",   "points", "center", "radius",
-    "start", "steps", "width", "floor",  "half",   "max_segment"};
-
-constexpr std::array<std::string_view, 6> random_pattern_keys{"type", "size",  "size_measure",
-                                                              "lloyd", "min_edge", "seed"};
-constexpr std::array<std::string_view, 5> hexagonal_keys{"type", "size", "min_edge", "origin",
-                                                         "angle"};
-constexpr std::array<std::string_view, 7> brick_keys{"type",  "size",   "min_edge", "origin",
-                                                     "angle", "aspect", "bond"};
-constexpr std::array<std::string_view, 1> single_keys{"type"};
-constexpr std::array<std::string_view, 10> all_pattern_keys{
-    "type", "size", "size_measure", "lloyd", "min_edge", "seed", "origin", "angle", "aspect", "bond"};
-
-Keys outline_keys(OutlineSpec::Kind k) {
-    switch (k) {
-    case OutlineSpec::Kind::rectangle:
-        return rectangle_keys;
-    case OutlineSpec::Kind::polygon:
-        return polygon_keys;
-    case OutlineSpec::Kind::circle:
-        return circle_keys;
-    case OutlineSpec::Kind::path:
-        return path_keys;
-    case OutlineSpec::Kind::opening:
-        return opening_keys;
-    }
-    return {};
+/// The keys of `table` that belong to type `type`, for check_keys.
+template <class Spec, std::size_t N>
+std::vector<std::string_view> keys_of_type(const Key<Spec> (&table)[N], std::string_view type) {
+    std::vector<std::string_view> keys;
+    for (const Key<Spec>& k : table)
+        if (key_applies(k, type)) keys.push_back(k.key);
+    return keys;
 }
 
-Keys pattern_keys(PatternSpec::Kind k) {
-    switch (k) {
-    case PatternSpec::Kind::voronoi:
-    case PatternSpec::Kind::trigon:
-    case PatternSpec::Kind::delaunay:
-        return random_pattern_keys;
-    case PatternSpec::Kind::hexagonal:
-        return hexagonal_keys;
-    case PatternSpec::Kind::brick:
-        return brick_keys;
-    case PatternSpec::Kind::single:
-        return single_keys;
-    }
-    return {};
+/// The bounds a key is read with: its declaration's.
+template <class Spec, std::size_t N>
+const Bounds& bounds_of(const Key<Spec> (&table)[N], std::string_view key) {
+    return find_key(table, key)->bounds;
 }
 
 /// A path step's arc must end on its circle: the radius is taken from the start.
@@ -119,12 +77,14 @@ void check_arc(const Ctx& c, const toml::node& n, const Path& p, Vec2 from,
 
 OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "an outline table { type = ..., ... }");
-    check_keys(c, t, p, all_outline_keys);
+    static constexpr auto all_keys = key_names(meshing::outline_keys);
+    check_keys(c, t, p, all_keys);
     OutlineSpec o;
-    o.kind = static_cast<OutlineSpec::Kind>(choice(c, t, p, "type", outline_types, "outline type"));
-    const std::string kind =
-        "a " + std::string(outline_types[static_cast<int>(o.kind)]) + " outline";
-    check_keys(c, t, p, outline_keys(o.kind), all_outline_keys, kind);
+    const auto types = key_words(meshing::outline_type_words);
+    o.kind = static_cast<OutlineSpec::Kind>(choice(c, t, p, "type", types, "outline type"));
+    const std::string_view type = types[static_cast<std::size_t>(o.kind)];
+    check_keys(c, t, p, keys_of_type(meshing::outline_keys, type), all_keys, "a " + std::string(type) + " outline");
+    const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(meshing::outline_keys, key); };
 
     switch (o.kind) {
     case OutlineSpec::Kind::rectangle: {
@@ -149,7 +109,7 @@ OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
     }
     case OutlineSpec::Kind::circle:
         o.center = required_point(c, t, p, "center");
-        o.radius = required_number(c, t, p, "radius", above(0, metres));
+        o.radius = required_number(c, t, p, "radius", bounds("radius"));
         break;
     case OutlineSpec::Kind::path: {
         o.start = required_point(c, t, p, "start");
@@ -183,8 +143,8 @@ OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
     }
     case OutlineSpec::Kind::opening: {
         o.center = required_point(c, t, p, "center");
-        o.width = required_number(c, t, p, "width", above(0, metres));
-        o.floor_y = required_number(c, t, p, "floor", unbounded(metres));
+        o.width = required_number(c, t, p, "width", bounds("width"));
+        o.floor_y = required_number(c, t, p, "floor", bounds("floor"));
         if (!(o.floor_y < o.center.y))
             c.fail(*t.get("floor"), p.key("floor"),
                    "must be below the springline center.y = " + fmt(o.center.y) + " m, got " +
@@ -193,44 +153,41 @@ OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
         break;
     }
     }
-    if (o.kind == OutlineSpec::Kind::circle || o.kind == OutlineSpec::Kind::path ||
-        o.kind == OutlineSpec::Kind::opening)
-        o.max_segment = number(c, t, p, "max_segment", above(0, metres)).value_or(0.0);
+    if (key_applies(*find_key(meshing::outline_keys, "max_segment"), type))
+        o.max_segment = number(c, t, p, "max_segment", bounds("max_segment")).value_or(0.0);
     return o;
 }
 
 PatternSpec read_pattern(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "a pattern table { type = ..., size = ... }");
-    check_keys(c, t, p, all_pattern_keys);
+    static constexpr auto all_keys = key_names(meshing::pattern_keys);
+    check_keys(c, t, p, all_keys);
     PatternSpec s;
-    s.kind = static_cast<PatternSpec::Kind>(choice(c, t, p, "type", pattern_types, "pattern type"));
-    const std::string kind =
-        "a " + std::string(pattern_types[static_cast<int>(s.kind)]) + " pattern";
-    check_keys(c, t, p, pattern_keys(s.kind), all_pattern_keys, kind);
+    const auto types = key_words(meshing::pattern_type_words);
+    s.kind = static_cast<PatternSpec::Kind>(choice(c, t, p, "type", types, "pattern type"));
+    const std::string_view type = types[static_cast<std::size_t>(s.kind)];
+    check_keys(c, t, p, keys_of_type(meshing::pattern_keys, type), all_keys, "a " + std::string(type) + " pattern");
     if (s.kind == PatternSpec::Kind::single) return s;
+    const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(meshing::pattern_keys, key); };
 
-    s.size = required_number(c, t, p, "size", above(0, metres));
-    if (const auto e = number(c, t, p, "min_edge", at_least(0, metres))) {
+    s.size = required_number(c, t, p, "size", bounds("size"));
+    if (const auto e = number(c, t, p, "min_edge", bounds("min_edge"))) {
         if (!(*e < s.size))
             c.fail(*t.get("min_edge"), p.key("min_edge"),
                    "must be smaller than size = " + fmt(s.size) + " m, got " + fmt(*e));
         s.min_edge = *e;
     }
-    if (t.contains("size_measure")) {
-        static constexpr std::array<std::string_view, 2> measures{"feret", "area"};
-        s.size_measure = static_cast<PatternSpec::SizeMeasure>(
-            choice(c, t, p, "size_measure", measures, "size measure"));
-    }
-    s.lloyd_iterations =
-        static_cast<int>(integer(c, t, p, "lloyd", 0, std::numeric_limits<int>::max()).value_or(0));
+    if (t.contains("size_measure"))
+        s.size_measure = static_cast<PatternSpec::SizeMeasure>(choice(
+            c, t, p, "size_measure", key_words(find_key(meshing::pattern_keys, "size_measure")->words), "size measure"));
+    s.lloyd_iterations = static_cast<int>(whole_number(c, t, p, "lloyd", bounds("lloyd")).value_or(0));
     s.seed = seed(c, t, p).value_or(1);
     s.origin = point(c, t, p, "origin").value_or(Vec2{});
-    s.angle = number(c, t, p, "angle", unbounded(degrees)).value_or(0.0);
-    s.aspect = number(c, t, p, "aspect", above(0, "")).value_or(2.0);
-    if (t.contains("bond")) {
-        static constexpr std::array<std::string_view, 2> bonds{"running", "stack"};
-        s.running_bond = choice(c, t, p, "bond", bonds, "brick bond") == 0;
-    }
+    s.angle = number(c, t, p, "angle", bounds("angle")).value_or(0.0);
+    s.aspect = number(c, t, p, "aspect", bounds("aspect")).value_or(2.0);
+    if (t.contains("bond"))
+        s.running_bond =
+            choice(c, t, p, "bond", key_words(find_key(meshing::pattern_keys, "bond")->words), "brick bond") == 0;
     return s;
 }
 
@@ -243,24 +200,11 @@ SegmentSpec read_joint(const Ctx& c, const toml::node& node, const Path& p) {
 
 JointSetSpec read_joint_set(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "a joint set table ([[region.joint_set]])");
-    static constexpr std::array<std::string_view, 9> keys{"angle",
-                                                          "spacing",
-                                                          "trace",
-                                                          "gap",
-                                                          "angle_deviation",
-                                                          "spacing_deviation",
-                                                          "length_deviation",
-                                                          "origin",
-                                                          "seed"};
+    static constexpr auto keys = key_names(meshing::joint_set_keys);
     check_keys(c, t, p, keys);
     JointSetSpec s;
-    s.angle = required_number(c, t, p, "angle", unbounded(degrees));
-    s.spacing = required_number(c, t, p, "spacing", above(0, metres));
-    s.trace_length = number(c, t, p, "trace", at_least(0, metres)).value_or(0.0);
-    s.gap = number(c, t, p, "gap", at_least(0, metres)).value_or(0.0);
-    s.angle_deviation = number(c, t, p, "angle_deviation", below(0, 90, degrees)).value_or(0.0);
-    s.spacing_deviation = number(c, t, p, "spacing_deviation", below(0, 1, "")).value_or(0.0);
-    s.length_deviation = number(c, t, p, "length_deviation", below(0, 1, "")).value_or(0.0);
+    for (const meshing::JointSetKey& k : meshing::joint_set_keys)
+        if (k.set) read_declared_key(c, t, p, k, s);
     s.origin = point(c, t, p, "origin").value_or(Vec2{});
     s.seed = seed(c, t, p).value_or(1);
     return s;
@@ -280,18 +224,18 @@ void read_list(const Ctx& c, const toml::table& t, const Path& p, std::string_vi
 /// checked with the other region names, once all regions are read.
 MeshSpec read_mesh(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "a mesh table { size = ..., ... }");
-    static constexpr std::array<std::string_view, 4> keys{"size", "size_far", "grading", "toward"};
+    static constexpr auto keys = key_names(meshing::mesh_keys);
     check_keys(c, t, p, keys);
     MeshSpec m;
     m.enabled = true;
-    m.size = required_number(c, t, p, "size", above(0, metres));
-    if (const auto far = number(c, t, p, "size_far", above(0, metres))) {
+    for (const meshing::MeshKey& k : meshing::mesh_keys)
+        if (k.set) read_declared_key(c, t, p, k, m);
+    if (const auto far = number(c, t, p, "size_far", bounds_of(meshing::mesh_keys, "size_far"))) {
         if (!(*far >= m.size))
             c.fail(*t.get("size_far"), p.key("size_far"),
                    "must be >= size = " + fmt(m.size) + " m, got " + fmt(*far));
         m.size_far = *far;
     }
-    m.grading = number(c, t, p, "grading", at_least(0, " m/m")).value_or(0.0);
     read_list(c, t, p, "toward", "an array of region names",
               [&](const toml::node& n, const Path& ep) { m.toward.push_back(to_str(c, n, ep)); });
     if (m.grading > 0 && m.toward.empty())
@@ -306,8 +250,7 @@ MeshSpec read_mesh(const Ctx& c, const toml::node& node, const Path& p) {
 RegionSpec read_region(Ctx& c, const toml::node& node, const Path& p,
                        std::optional<std::string>& material) {
     const toml::table& t = to_table(c, node, p, "a [[region]] table");
-    static constexpr std::array<std::string_view, 10> keys{
-        "name", "outline", "holes", "minus", "pattern", "joints", "joint_set", "dfn", "material", "mesh"};
+    static constexpr auto keys = key_names(meshing::region_keys);
     check_keys(c, t, p, keys);
     RegionSpec r;
     const Path np = p.key("name");

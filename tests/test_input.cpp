@@ -342,7 +342,7 @@ name = "a"
 outline = { type = "circle", center = [0, 0], radius = 1 }
 pattern = { type = "voronoi", size = 0.3, lloyd = 1.5 }
 )",
-                "lloyd", "region[0].pattern.lloyd", "expected an integer >= 0, got float 1.5");
+                "lloyd", "region[0].pattern.lloyd", "expected a whole number in [0, 2147483647], got float 1.5");
     check_error(R"([[region]]
 name = 3
 )",
@@ -416,7 +416,7 @@ pattern = { type = "voronoi", size = -0.3 }
     check_error(region("{ type = \"circle\", center = [0, 0], radius = 0 }", voronoi), "radius",
                 "region[0].outline.radius", "must be > 0 m, got 0");
     check_error(region(circle, "{ type = \"voronoi\", size = 0.3, lloyd = -1 }"), "lloyd",
-                "region[0].pattern.lloyd", "must be an integer >= 0, got -1");
+                "region[0].pattern.lloyd", "must be a whole number in [0, 2147483647], got -1");
     check_error(region(circle, "{ type = \"voronoi\", size = 0.3, seed = -2 }"), "seed",
                 "region[0].pattern.seed", "must be an integer >= 0, got -2");
     check_error(region(circle, "{ type = \"voronoi\", size = 0.3, min_edge = 0.5 }"), "min_edge",

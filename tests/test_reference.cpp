@@ -17,6 +17,7 @@
 #include "core/stage_keys.hpp"
 #include "io/model_input.hpp"
 #include "meshing/model_keys.hpp"
+#include "meshing/region_keys.hpp"
 #include "studies/commands.hpp"
 #include "studies/shear.hpp"
 
@@ -106,6 +107,7 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     check_reference("boundary.md", boundary_keys_markdown());
     check_reference("history.md", history_keys_markdown());
     check_reference("model.md", meshing::model_keys_markdown());
+    check_reference("region.md", meshing::region_keys_markdown());
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {
