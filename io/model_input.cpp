@@ -48,21 +48,6 @@ using namespace reader;
 
 // --- the model's tables ------------------------------------------------------------
 
-/// The keys of `table` that belong to type `type`, for check_keys.
-template <class Spec, std::size_t N>
-std::vector<std::string_view> keys_of_type(const Key<Spec> (&table)[N], std::string_view type) {
-    std::vector<std::string_view> keys;
-    for (const Key<Spec>& k : table)
-        if (key_applies(k, type)) keys.push_back(k.key);
-    return keys;
-}
-
-/// The bounds a key is read with: its declaration's.
-template <class Spec, std::size_t N>
-const Bounds& bounds_of(const Key<Spec> (&table)[N], std::string_view key) {
-    return find_key(table, key)->bounds;
-}
-
 /// A path step's arc must end on its circle: the radius is taken from the start.
 void check_arc(const Ctx& c, const toml::node& n, const Path& p, Vec2 from,
                const OutlineSpec::Step& s) {

@@ -3,6 +3,7 @@
 // (docs/input.md "Fracture networks"), or from a DXF drawing (io/dxf.hpp).
 #include "io/dxf.hpp"
 #include "io/reader.hpp"
+#include "meshing/dfn_keys.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -17,43 +18,29 @@ using meshing::SegmentSpec;
 
 namespace {
 
-constexpr std::array<std::string_view, 4> length_laws{"fixed", "power_law", "lognormal", "exponential"};
-constexpr std::array<std::string_view, 3> angle_laws{"von_mises", "uniform", "list"};
-constexpr std::array<std::string_view, 2> centre_kinds{"poisson", "clustered"};
+using meshing::dfn_keys;
+using meshing::fracture_length_keys;
+using meshing::fracture_orientation_keys;
 
 FractureLengthSpec read_length(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "a length table { distribution = ..., ... }");
     using K = FractureLengthSpec::Kind;
     FractureLengthSpec l;
-    l.kind = static_cast<K>(choice(c, t, p, "distribution", length_laws, "length distribution"));
-    static constexpr std::array<std::string_view, 7> all{"distribution", "value", "exponent", "mean",
-                                                         "std",          "min",   "max"};
-    static constexpr std::array<std::string_view, 2> fixed_keys{"distribution", "value"};
-    static constexpr std::array<std::string_view, 4> power_keys{"distribution", "exponent", "min", "max"};
-    static constexpr std::array<std::string_view, 5> lognormal_keys{"distribution", "mean", "std", "min", "max"};
-    static constexpr std::array<std::string_view, 4> exponential_keys{"distribution", "mean", "min", "max"};
-    const Keys keys = l.kind == K::fixed       ? Keys(fixed_keys)
-                      : l.kind == K::power_law ? Keys(power_keys)
-                      : l.kind == K::lognormal ? Keys(lognormal_keys)
-                                               : Keys(exponential_keys);
-    check_keys(c, t, p, keys, all,
-               "a " + std::string(length_laws[static_cast<std::size_t>(l.kind)]) + " length distribution");
-    switch (l.kind) {
-    case K::fixed: l.value = required_number(c, t, p, "value", above(0, metres)); break;
-    case K::power_law:
-        l.exponent = required_number(c, t, p, "exponent", above(0, ""));
+    const auto laws = key_words(meshing::length_law_words);
+    l.kind = static_cast<K>(choice(c, t, p, "distribution", laws, "length distribution"));
+    const std::string_view law = laws[static_cast<std::size_t>(l.kind)];
+    static constexpr auto all = key_names(fracture_length_keys);
+    check_keys(c, t, p, keys_of_type(fracture_length_keys, law), all, "a " + std::string(law) + " length distribution");
+    for (const meshing::FractureLengthKey& k : fracture_length_keys)
+        if (k.set && key_applies(k, law)) read_declared_key(c, t, p, k, l);
+    const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(fracture_length_keys, key); };
+    if (l.kind == K::power_law) {
+        // A power law has no mass at zero: both ends are required, the lower above 0.
         l.min = required_number(c, t, p, "min", above(0, metres));
-        l.max = required_number(c, t, p, "max", above(0, metres));
-        break;
-    case K::lognormal:
-        l.mean = required_number(c, t, p, "mean", above(0, metres));
-        l.std_dev = required_number(c, t, p, "std", above(0, metres));
-        [[fallthrough]];
-    case K::exponential:
-        if (l.kind == K::exponential) l.mean = required_number(c, t, p, "mean", above(0, metres));
-        l.min = number(c, t, p, "min", at_least(0, metres)).value_or(0.0);
-        l.max = number(c, t, p, "max", above(0, metres)).value_or(0.0);
-        break;
+        l.max = required_number(c, t, p, "max", bounds("max"));
+    } else if (l.kind != K::fixed) {
+        l.min = number(c, t, p, "min", bounds("min")).value_or(0.0);
+        l.max = number(c, t, p, "max", bounds("max")).value_or(0.0);
     }
     if (l.max > 0.0 && !(l.max > l.min))
         c.fail(*t.get("max"), p.key("max"), "must be above min = " + fmt(l.min) + " m, got " + fmt(l.max));
@@ -64,21 +51,15 @@ FractureOrientationSpec read_orientation(const Ctx& c, const toml::node& node, c
     const toml::table& t = to_table(c, node, p, "an orientation table { distribution = ..., ... }");
     using K = FractureOrientationSpec::Kind;
     FractureOrientationSpec o;
-    o.kind = static_cast<K>(choice(c, t, p, "distribution", angle_laws, "orientation distribution"));
-    static constexpr std::array<std::string_view, 5> all{"distribution", "mean", "concentration", "angles",
-                                                         "weights"};
-    static constexpr std::array<std::string_view, 3> von_mises_keys{"distribution", "mean", "concentration"};
-    static constexpr std::array<std::string_view, 1> uniform_keys{"distribution"};
-    static constexpr std::array<std::string_view, 3> list_keys{"distribution", "angles", "weights"};
-    const Keys keys = o.kind == K::von_mises ? Keys(von_mises_keys)
-                      : o.kind == K::uniform ? Keys(uniform_keys)
-                                             : Keys(list_keys);
-    check_keys(c, t, p, keys, all,
-               "a " + std::string(angle_laws[static_cast<std::size_t>(o.kind)]) + " orientation distribution");
-    if (o.kind == K::von_mises) {
-        o.mean = required_number(c, t, p, "mean", unbounded(degrees));
-        o.concentration = required_number(c, t, p, "concentration", at_least(0, ""));
-    } else if (o.kind == K::list) {
+    const auto laws = key_words(meshing::orientation_law_words);
+    o.kind = static_cast<K>(choice(c, t, p, "distribution", laws, "orientation distribution"));
+    const std::string_view law = laws[static_cast<std::size_t>(o.kind)];
+    static constexpr auto all = key_names(fracture_orientation_keys);
+    check_keys(c, t, p, keys_of_type(fracture_orientation_keys, law), all,
+               "a " + std::string(law) + " orientation distribution");
+    for (const meshing::FractureOrientationKey& k : fracture_orientation_keys)
+        if (k.set && key_applies(k, law)) read_declared_key(c, t, p, k, o);
+    if (o.kind == K::list) {
         auto numbers = [&](std::string_view key, const Range& r, std::vector<double>& out) {
             const toml::node* n = key == "angles" ? &need(c, t, p, key, "an array of angles in degrees")
                                                   : find(c, t, p, key);
@@ -88,8 +69,8 @@ FractureOrientationSpec read_orientation(const Ctx& c, const toml::node& node, c
             if (a.empty()) c.fail(*n, kp, "must list at least one number, got an empty array");
             for_each_element(c, a, kp, [&](const toml::node& e, const Path& ep) { out.push_back(checked_number(c, e, ep, r)); });
         };
-        numbers("angles", unbounded(degrees), o.angles);
-        numbers("weights", above(0, ""), o.weights);
+        numbers("angles", bounds_of(fracture_orientation_keys, "angles"), o.angles);
+        numbers("weights", bounds_of(fracture_orientation_keys, "weights"), o.weights);
         if (!o.weights.empty() && o.weights.size() != o.angles.size())
             c.fail(*t.get("weights"), p.key("weights"),
                    "must give one weight per angle: " + std::to_string(o.angles.size()) + " angles, " +
@@ -223,22 +204,15 @@ void check_reaches_region(const Ctx& c, const toml::node& n, const Path& p, cons
                " m (other coordinates or units? see 'units')");
 }
 
-constexpr std::array<std::string_view, 5> unit_names{"m", "cm", "mm", "ft", "in"};
-constexpr std::array<double, 5> unit_metres{1.0, 0.01, 0.001, 0.3048, 0.0254};
 
 } // namespace
 
 meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier,
                                  const meshing::OutlineSpec& outline) {
     const toml::table& t = to_table(c, node, p, "a fracture set table ([[region.dfn]])");
-    static constexpr std::array<std::string_view, 13> all{"name",  "seed",      "centres",  "cluster",
-                                                          "orientation", "length", "p21", "count",
-                                                          "terminate", "property", "file", "set", "units"};
-    static constexpr std::array<std::string_view, 10> generated_keys{
-        "name", "seed", "centres", "cluster", "orientation", "length", "p21", "count", "terminate", "property"};
-    static constexpr std::array<std::string_view, 5> file_keys{"name", "file", "set", "units", "property"};
+    static constexpr auto all = key_names(dfn_keys);
     const bool from_file = t.contains("file");
-    check_keys(c, t, p, from_file ? Keys(file_keys) : Keys(generated_keys), all,
+    check_keys(c, t, p, keys_of_type(dfn_keys, from_file ? "file" : "generated"), all,
                from_file ? "a fracture set read from a file" : "a generated fracture set");
     DfnSetSpec s;
     const Path np = p.key("name");
@@ -260,7 +234,8 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
         if (const toml::node* n = find(c, t, p, "set")) only = to_str(c, *n, p.key("set"));
         double scale = 0.0; // metres per file unit; 0 = the file's own (a DXF's header) or metres
         if (const toml::node* n = find(c, t, p, "units"))
-            scale = unit_metres[to_choice(c, *n, p.key("units"), unit_names, "length unit")];
+            scale = meshing::length_unit_metres[to_choice(c, *n, p.key("units"),
+                                                          key_words(meshing::length_unit_words), "length unit")];
         const std::string path = (std::filesystem::path(c.file).parent_path() / s.file).string();
         std::string ext = std::filesystem::path(s.file).extension().string();
         for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
@@ -278,7 +253,8 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
     }
     s.seed = seed(c, t, p).value_or(1);
     if (const toml::node* n = find(c, t, p, "centres"))
-        s.centres = static_cast<DfnSetSpec::Centres>(to_choice(c, *n, p.key("centres"), centre_kinds, "centres"));
+        s.centres = static_cast<DfnSetSpec::Centres>(
+            to_choice(c, *n, p.key("centres"), key_words(meshing::centre_words), "centres"));
     const toml::node* cluster = find(c, t, p, "cluster");
     if (s.centres == DfnSetSpec::Centres::clustered) {
         if (!cluster) c.fail(t, p.key("cluster"), "clustered centres need cluster = { size = ..., radius = ... }");
@@ -293,8 +269,8 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
     }
     s.orientation = read_orientation(c, need(c, t, p, "orientation", "an orientation table"), p.key("orientation"));
     s.length = read_length(c, need(c, t, p, "length", "a length table"), p.key("length"));
-    const auto p21 = number(c, t, p, "p21", above(0, " 1/m"));
-    const auto count = integer(c, t, p, "count", 1, 100'000'000);
+    const auto p21 = number(c, t, p, "p21", bounds_of(dfn_keys, "p21"));
+    const auto count = whole_number(c, t, p, "count", bounds_of(dfn_keys, "count"));
     if (p21.has_value() == count.has_value())
         c.fail(t, p, c.in_owner() + "give the set's intensity as 'p21' (trace length per m²) or 'count', one of them");
     s.p21 = p21.value_or(0.0);

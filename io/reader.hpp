@@ -524,6 +524,21 @@ constexpr std::array<std::string_view, N> key_names(const Key<Spec> (&table)[N])
     return names;
 }
 
+/// The keys of `table` that belong to type `type`, for check_keys.
+template <class Spec, std::size_t N>
+std::vector<std::string_view> keys_of_type(const Key<Spec> (&table)[N], std::string_view type) {
+    std::vector<std::string_view> keys;
+    for (const Key<Spec>& k : table)
+        if (key_applies(k, type)) keys.push_back(k.key);
+    return keys;
+}
+
+/// The bounds a key is read with: its declaration's.
+template <class Spec, std::size_t N>
+const Bounds& bounds_of(const Key<Spec> (&table)[N], std::string_view key) {
+    return find_key(table, key)->bounds;
+}
+
 /// A number, integer or boolean key as its table declares it: its bounds, required or left
 /// at the spec's default.
 template <class Spec>

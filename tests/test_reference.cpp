@@ -16,6 +16,7 @@
 #include "core/solver_keys.hpp"
 #include "core/stage_keys.hpp"
 #include "io/model_input.hpp"
+#include "meshing/dfn_keys.hpp"
 #include "meshing/model_keys.hpp"
 #include "meshing/region_keys.hpp"
 #include "studies/commands.hpp"
@@ -108,6 +109,7 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     check_reference("history.md", history_keys_markdown());
     check_reference("model.md", meshing::model_keys_markdown());
     check_reference("region.md", meshing::region_keys_markdown());
+    check_reference("dfn.md", meshing::dfn_keys_markdown());
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {
