@@ -443,3 +443,31 @@ TEST_CASE("a steady flow with no solution stops the step with its error, on 1 an
         CHECK_THROWS_WITH_AS(s.step(), doctest::Contains("no held pressure"), InputError);
     }
 }
+
+TEST_CASE("flow boundaries the network cannot use are refused with their key: a box outside it, a head or a water "
+          "table with no gravity, a water table with nothing held") {
+    // These are found when the network is built from the blocks, not when the file
+    // is read: the error names the key, and `bbm run` its line (exit status 2).
+    const std::string text = sliding_joint(10e6, 1e6);
+    const std::string dry = text.substr(0, text.find("[[flow_boundary]]"));
+    auto refused = [&](const std::string& model, const std::string& key, const std::string& words) {
+        CAPTURE(key);
+        Built m = build(model);
+        try {
+            Solver s(m.blocks, m.file.analysis);
+            FAIL("accepted");
+        } catch (const InputError& e) {
+            CHECK(std::string(e.what()).find(key) != std::string::npos);
+            CHECK(std::string(e.what()).find(words) != std::string::npos);
+        }
+    };
+    refused(dry + "[[flow_boundary]]\nname = \"far\"\nbox = { min = [50.0, 50.0], max = [51.0, 51.0] }\npressure = 1e5\n",
+            "flow_boundary[0].box", "holds no junction");
+    refused(dry + "[[flow_boundary]]\nname = \"joint\"\nbox = { min = [-1.01, -0.01], max = [1.01, 0.01] }\nhead = 10.0\n",
+            "flow_boundary[0].head", "needs gravity");
+    std::string table = dry;
+    table.insert(table.find("far_field"), "water_table = 5.0\n");
+    refused(table, "flow.water_table", "needs gravity");
+    table.insert(table.find("[flow]\n") + 7, "gravity = [0.0, -9.81]\ndrain_openings = false\n");
+    refused(table, "flow.water_table", "no held boundary");
+}
