@@ -65,10 +65,8 @@ OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
     static constexpr auto all_keys = key_names(meshing::outline_keys);
     check_keys(c, t, p, all_keys);
     OutlineSpec o;
-    const auto types = key_words(meshing::outline_type_words);
-    o.kind = static_cast<OutlineSpec::Kind>(choice(c, t, p, "type", types, "outline type"));
-    const std::string_view type = types[static_cast<std::size_t>(o.kind)];
-    check_keys(c, t, p, keys_of_type(meshing::outline_keys, type), all_keys, "a " + std::string(type) + " outline");
+    o.kind = static_cast<OutlineSpec::Kind>(
+        read_typed_keys(c, t, p, meshing::outline_keys, "type", "outline type", "outline"));
     const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(meshing::outline_keys, key); };
 
     switch (o.kind) {
@@ -138,7 +136,8 @@ OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
         break;
     }
     }
-    if (key_applies(*find_key(meshing::outline_keys, "max_segment"), type))
+    if (key_applies(*find_key(meshing::outline_keys, "max_segment"),
+                    key_words(meshing::outline_type_words)[static_cast<std::size_t>(o.kind)]))
         o.max_segment = number(c, t, p, "max_segment", bounds("max_segment")).value_or(0.0);
     return o;
 }
@@ -148,10 +147,8 @@ PatternSpec read_pattern(const Ctx& c, const toml::node& node, const Path& p) {
     static constexpr auto all_keys = key_names(meshing::pattern_keys);
     check_keys(c, t, p, all_keys);
     PatternSpec s;
-    const auto types = key_words(meshing::pattern_type_words);
-    s.kind = static_cast<PatternSpec::Kind>(choice(c, t, p, "type", types, "pattern type"));
-    const std::string_view type = types[static_cast<std::size_t>(s.kind)];
-    check_keys(c, t, p, keys_of_type(meshing::pattern_keys, type), all_keys, "a " + std::string(type) + " pattern");
+    s.kind = static_cast<PatternSpec::Kind>(
+        read_typed_keys(c, t, p, meshing::pattern_keys, "type", "pattern type", "pattern"));
     if (s.kind == PatternSpec::Kind::single) return s;
     const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(meshing::pattern_keys, key); };
 
@@ -476,13 +473,7 @@ BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& n
     BoundarySpec b;
     using Kind = BoundarySpec::Kind;
     b.name = read_name(c, t, p, names);
-    const auto types = key_words(boundary_type_words);
-    b.kind = static_cast<Kind>(choice(c, t, p, "type", types, "boundary type"));
-    const std::string_view type = types[static_cast<std::size_t>(b.kind)];
-    std::vector<std::string_view> keys;
-    for (const BoundaryKey& k : boundary_keys)
-        if (key_applies(k, type)) keys.push_back(k.key);
-    check_keys(c, t, p, keys, all_keys, article(type) + " boundary");
+    b.kind = static_cast<Kind>(read_typed_keys(c, t, p, boundary_keys, "type", "boundary type", "boundary"));
     b.select.regions = name_list(c, t, p, "regions", regions, "to select by box only (or all)");
     if (const toml::node* n = find(c, t, p, "box")) b.select.box = read_box(c, *n, p.key("box"));
     if (b.kind == Kind::stress) {

@@ -26,11 +26,9 @@ FractureLengthSpec read_length(const Ctx& c, const toml::node& node, const Path&
     const toml::table& t = to_table(c, node, p, "a length table { distribution = ..., ... }");
     using K = FractureLengthSpec::Kind;
     FractureLengthSpec l;
-    const auto laws = key_words(meshing::length_law_words);
-    l.kind = static_cast<K>(choice(c, t, p, "distribution", laws, "length distribution"));
-    const std::string_view law = laws[static_cast<std::size_t>(l.kind)];
-    static constexpr auto all = key_names(fracture_length_keys);
-    check_keys(c, t, p, keys_of_type(fracture_length_keys, law), all, "a " + std::string(law) + " length distribution");
+    l.kind = static_cast<K>(
+        read_typed_keys(c, t, p, fracture_length_keys, "distribution", "length distribution", "length distribution"));
+    const std::string_view law = key_words(meshing::length_law_words)[static_cast<std::size_t>(l.kind)];
     for (const meshing::FractureLengthKey& k : fracture_length_keys)
         if (k.set && key_applies(k, law)) read_declared_key(c, t, p, k, l);
     const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(fracture_length_keys, key); };
@@ -51,12 +49,9 @@ FractureOrientationSpec read_orientation(const Ctx& c, const toml::node& node, c
     const toml::table& t = to_table(c, node, p, "an orientation table { distribution = ..., ... }");
     using K = FractureOrientationSpec::Kind;
     FractureOrientationSpec o;
-    const auto laws = key_words(meshing::orientation_law_words);
-    o.kind = static_cast<K>(choice(c, t, p, "distribution", laws, "orientation distribution"));
-    const std::string_view law = laws[static_cast<std::size_t>(o.kind)];
-    static constexpr auto all = key_names(fracture_orientation_keys);
-    check_keys(c, t, p, keys_of_type(fracture_orientation_keys, law), all,
-               "a " + std::string(law) + " orientation distribution");
+    o.kind = static_cast<K>(read_typed_keys(c, t, p, fracture_orientation_keys, "distribution",
+                                            "orientation distribution", "orientation distribution"));
+    const std::string_view law = key_words(meshing::orientation_law_words)[static_cast<std::size_t>(o.kind)];
     for (const meshing::FractureOrientationKey& k : fracture_orientation_keys)
         if (k.set && key_applies(k, law)) read_declared_key(c, t, p, k, o);
     if (o.kind == K::list) {

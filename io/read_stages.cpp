@@ -58,13 +58,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     }
     add_name(c, names, s.name, name_line, np, line(t));
     c.owner = "stage " + quoted(s.name);
-    const auto types = key_words(stage_type_words);
-    s.kind = static_cast<Kind>(choice(c, t, p, "type", types, "stage type"));
-    const std::string_view type = types[static_cast<std::size_t>(s.kind)];
-    std::vector<std::string_view> keys;
-    for (const StageKey& k : stage_keys)
-        if (key_applies(k, type)) keys.push_back(k.key);
-    check_keys(c, t, p, keys, all_keys, article(type) + " stage");
+    s.kind = static_cast<Kind>(read_typed_keys(c, t, p, stage_keys, "type", "stage type", "stage"));
     const auto bounds = stage_key_bounds;
     switch (s.kind) {
     case Kind::initialize:

@@ -539,6 +539,22 @@ const Bounds& bounds_of(const Key<Spec> (&table)[N], std::string_view key) {
     return find_key(table, key)->bounds;
 }
 
+/// A table whose keys depend on a word in it (a stage's `type`, a length law's
+/// `distribution`): the word's index among its row's words, once the table is
+/// checked to have only that word's keys ("key 'lloyd' does not apply to a
+/// hexagonal pattern"). `what` names the word in an error ("pattern type"), `noun`
+/// the table ("pattern").
+template <class Spec, std::size_t N>
+std::size_t read_typed_keys(const Ctx& c, const toml::table& t, const Path& p, const Key<Spec> (&table)[N],
+                            std::string_view type_key, std::string_view what, std::string_view noun) {
+    const auto words = key_words(find_key(table, type_key)->words);
+    const std::size_t i = choice(c, t, p, type_key, words, what);
+    std::vector<std::string_view> all;
+    for (const Key<Spec>& k : table) all.push_back(k.key);
+    check_keys(c, t, p, keys_of_type(table, words[i]), all, article(words[i]) + " " + std::string(noun));
+    return i;
+}
+
 /// A number, integer or boolean key as its table declares it: its bounds, required or left
 /// at the spec's default.
 template <class Spec>
