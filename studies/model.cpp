@@ -121,6 +121,8 @@ nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
                               {"threshold_broken_fraction", zone.threshold},
                               {"sector_deg", 360.0 / double(zone.depth.size())},
                               {"depth_by_sector_m", zone.depth},
+                              {"depth_by_sector_cells_m", zone.depth_cells},
+                              {"resolution_m", zone.resolution},
                               {"depth_springline", zone.depth_springline},
                               {"depth_crown", zone.depth_crown},
                               {"extent_springline_deg", zone.extent_springline_deg},

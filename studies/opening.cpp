@@ -72,6 +72,9 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
 namespace {
 
 constexpr double pi = 3.141592653589793;
+/// The failed zone's depth is read on this many polar grids, their rings shifted
+/// by a fraction of a cell (measure_failed_zone).
+constexpr int grid_shifts = 8;
 
 /// Cells of `cell` width in rings around the opening from the smaller radius out,
 /// `sectors` to a ring, ring-major.
@@ -97,6 +100,12 @@ struct PolarCells {
 struct CellJoints {
     std::vector<double> all, broken;
     std::vector<std::uint8_t> edge;
+    /// Per contact of the rock's joints: its cell (−1: not the rock's, or inside
+    /// the radius), whether broken, and its distance from the centre at its
+    /// initial position (the contact point: the vertex the joint's force acts at).
+    std::vector<int> cell;
+    std::vector<std::uint8_t> is_broken;
+    std::vector<double> distance;
 };
 
 CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
@@ -107,10 +116,11 @@ CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
         const int node = b.vertex_node[v];
         return node >= 0 ? n.position0[node] : b.centroid0[blk] + b.local[v];
     };
-    std::vector<std::pair<int, bool>> where(std::size_t(c.size()), {-1, false});
-    std::vector<std::pair<int, int>> at(std::size_t(c.size()), {-1, 0});
+    CellJoints j;
+    j.cell.assign(std::size_t(c.size()), -1), j.is_broken.assign(j.cell.size(), 0), j.distance.assign(j.cell.size(), 0.0);
     for (int i = 0; i < c.size(); ++i) {
-        const auto [ring, sector] = g.of(initial(c.vertex_id[i], c.vertex_block[i]));
+        const Vec2 x0 = initial(c.vertex_id[i], c.vertex_block[i]);
+        const auto [ring, sector] = g.of(x0);
         if (ring < 0) continue;
         g.rings = std::max(g.rings, ring + 1);
         // Joints of the rock only: a contact formed unbonded during the run (between
@@ -118,9 +128,9 @@ CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
         const auto& h = c.history[i];
         const bool is_broken = h.broken == contact::JointState::broken_tension || h.broken == contact::JointState::broken_shear;
         if (!h.bonded && !is_broken) continue;
-        where[std::size_t(i)] = {ring * g.sectors + sector, is_broken};
+        j.cell[std::size_t(i)] = ring * g.sectors + sector, j.is_broken[std::size_t(i)] = is_broken;
+        j.distance[std::size_t(i)] = norm(x0 - g.center);
     }
-    CellJoints j;
     j.all.assign(std::size_t(g.size()), 0.0), j.broken.assign(j.all.size(), 0.0);
     j.edge.assign(j.all.size(), 0);
     for (int i = 0; i < c.size(); ++i) {
@@ -131,10 +141,10 @@ CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
         if (ring >= 0 && ring < g.rings) j.edge[std::size_t(ring * g.sectors + sector)] = 1;
     }
     for (int i = 0; i < c.size(); ++i) {
-        const auto [cell_index, is_broken] = where[std::size_t(i)];
+        const int cell_index = j.cell[std::size_t(i)];
         if (cell_index < 0) continue;
         j.all[std::size_t(cell_index)] += c.length[i];
-        if (is_broken) j.broken[std::size_t(cell_index)] += c.length[i];
+        if (j.is_broken[std::size_t(i)]) j.broken[std::size_t(cell_index)] += c.length[i];
     }
     return j;
 }
@@ -176,26 +186,63 @@ void zone_toward(const FailedZone& z, int sectors, Vec2 towards, double& depth, 
 
 } // namespace
 
+namespace {
+
+/// The zone on one polar grid: the rock's joints per cell, each sector's wall
+/// ring, and the damaged cells connected to the wall.
+struct GridZone {
+    PolarCells grid;
+    CellJoints joints;
+    std::vector<int> wall;
+    std::vector<std::uint8_t> in_zone;
+    bool damaged(int k, double threshold) const {
+        return joints.all[std::size_t(k)] > 0 && joints.broken[std::size_t(k)] >= threshold * joints.all[std::size_t(k)];
+    }
+};
+
+GridZone zone_on_grid(const Solver& s, PolarCells grid, double threshold) {
+    CellJoints joints = joints_per_cell(s, grid); // counts the grid's rings
+    GridZone z{grid, std::move(joints), {}, {}};
+    const int sectors = z.grid.sectors, rings = z.grid.rings;
+    // The wall in each sector: its innermost ring that holds rock (an opening that
+    // is not a circle leaves the first rings of its longer directions empty).
+    z.wall.assign(std::size_t(sectors), rings);
+    for (int sector = 0; sector < sectors; ++sector)
+        for (int ring = 0; ring < rings; ++ring)
+            if (z.joints.all[std::size_t(ring * sectors + sector)] > 0) {
+                z.wall[std::size_t(sector)] = ring;
+                break;
+            }
+    z.in_zone = flood_from_wall(z.grid, z.wall, [&](int k) { return z.damaged(k, threshold); });
+    return z;
+}
+
+/// Per sector, the distance from the centre of the zone's outermost broken
+/// contact point (−inf: none).
+std::vector<double> outermost_broken(const GridZone& z) {
+    const auto sectors = std::size_t(z.grid.sectors);
+    std::vector<double> out(sectors, -INFINITY);
+    for (std::size_t i = 0; i < z.joints.cell.size(); ++i) {
+        const int k = z.joints.cell[i];
+        if (k >= 0 && z.joints.is_broken[i] && z.in_zone[std::size_t(k)])
+            out[std::size_t(k) % sectors] = std::max(out[std::size_t(k) % sectors], z.joints.distance[i]);
+    }
+    return out;
+}
+
+} // namespace
+
 FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
                                double threshold, int sectors) {
     FailedZone z;
     z.cell = cell, z.threshold = threshold, z.center = center;
     z.radius = std::min(norm(springline - center), norm(crown - center));
-    z.depth.assign(std::size_t(sectors), 0.0);
-    PolarCells g{center, z.radius, cell, sectors};
-    const CellJoints j = joints_per_cell(s, g);
-    const int rings = g.rings;
-    auto damaged = [&](int k) { return j.all[std::size_t(k)] > 0 && j.broken[std::size_t(k)] >= threshold * j.all[std::size_t(k)]; };
-    // The wall in each sector: its innermost ring that holds rock (rings start at
-    // the smaller radius; an opening that is not a circle leaves the first rings of
-    // its longer directions empty).
-    std::vector<int> wall(std::size_t(sectors), rings);
-    for (int sector = 0; sector < sectors; ++sector)
-        for (int ring = 0; ring < rings; ++ring)
-            if (j.all[std::size_t(ring * sectors + sector)] > 0) {
-                wall[std::size_t(sector)] = ring;
-                break;
-            }
+    z.depth.assign(std::size_t(sectors), 0.0), z.depth_cells.assign(std::size_t(sectors), 0.0);
+    const GridZone g0 = zone_on_grid(s, PolarCells{center, z.radius, cell, sectors}, threshold);
+    const CellJoints& j = g0.joints;
+    const std::vector<int>& wall = g0.wall;
+    const std::vector<std::uint8_t>& in_zone = g0.in_zone;
+    const int rings = g0.grid.rings;
     // The band along the region's edge: its cells and their neighbours, inside it.
     auto near_edge = [&](int k) {
         const int ring = k / sectors, sector = k % sectors;
@@ -206,9 +253,8 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
             }
         return false;
     };
-    for (int k = 0; k < g.size(); ++k)
-        if (j.all[std::size_t(k)] > 0 && near_edge(k)) ++z.edge_cells, z.edge_cells_damaged += damaged(k);
-    const std::vector<std::uint8_t> in_zone = flood_from_wall(g, wall, damaged);
+    for (int k = 0; k < g0.grid.size(); ++k)
+        if (j.all[std::size_t(k)] > 0 && near_edge(k)) ++z.edge_cells, z.edge_cells_damaged += g0.damaged(k, threshold);
     for (std::size_t k = 0; k < in_zone.size(); ++k) {
         if (!in_zone[k]) continue;
         const int ring = int(k) / sectors, sector = int(k) % sectors;
@@ -217,13 +263,62 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
             z.reaches_region_edge = true;
             z.region_edge_point = center + (z.radius + (ring + 0.5) * cell) * Vec2{std::cos(mid), std::sin(mid)};
         }
-        z.depth[std::size_t(sector)] = std::max(z.depth[std::size_t(sector)], (ring + 1 - wall[std::size_t(sector)]) * cell);
+        z.depth_cells[std::size_t(sector)] =
+            std::max(z.depth_cells[std::size_t(sector)], (ring + 1 - wall[std::size_t(sector)]) * cell);
         const double r0 = z.radius + ring * cell, r1 = r0 + cell;
         z.area += pi * (r1 * r1 - r0 * r0) / sectors;
     }
+    // The wall in each sector at the contacts' resolution: its innermost contact point of the rock.
+    std::vector<double> wall_distance(std::size_t(sectors), INFINITY);
+    for (std::size_t i = 0; i < j.cell.size(); ++i)
+        if (j.cell[i] >= 0) {
+            const auto sector = std::size_t(j.cell[i] % sectors);
+            wall_distance[sector] = std::min(wall_distance[sector], j.distance[i]);
+        }
     z.wall_offset.assign(std::size_t(sectors), 0.0);
-    for (int sector = 0; sector < sectors; ++sector)
-        if (wall[std::size_t(sector)] < rings) z.wall_offset[std::size_t(sector)] = wall[std::size_t(sector)] * cell;
+    for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector)
+        if (std::isfinite(wall_distance[sector])) z.wall_offset[sector] = std::max(0.0, wall_distance[sector] - z.radius);
+    // The depth: the zone's outermost broken contact point, on grids whose rings
+    // start `grid_shifts` fractions of a cell apart, the median over them. On one
+    // grid the outermost broken contact of a dense zone sits at the outer edge of
+    // its deepest cell (the next cell out is under the threshold), so one grid would
+    // still step a cell; the shifted grids' edges are a cell / grid_shifts apart.
+    std::vector<std::vector<double>> depths(z.depth.size());
+    for (int shift = 0; shift < grid_shifts; ++shift) {
+        const GridZone g = shift == 0 ? g0
+                                      : zone_on_grid(s, PolarCells{center, z.radius - shift * cell / grid_shifts, cell, sectors},
+                                                     threshold);
+        const auto outermost = outermost_broken(g);
+        for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector)
+            depths[sector].push_back(std::isfinite(outermost[sector]) ? outermost[sector] - wall_distance[sector] : 0.0);
+    }
+    for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector) {
+        auto& d = depths[sector];
+        std::sort(d.begin(), d.end());
+        z.depth[sector] = 0.5 * (d[(d.size() - 1) / 2] + d[d.size() / 2]);
+    }
+    // The resolution: the larger of the grids' step and the mean radial step
+    // between the distinct contact points a depth can end at, within four cells of
+    // the wall, the median over sectors (a sector along a symmetry plane holds only
+    // that plane's points).
+    std::vector<std::vector<double>> band(z.depth.size());
+    for (std::size_t i = 0; i < j.cell.size(); ++i)
+        if (j.cell[i] >= 0) {
+            const auto sector = std::size_t(j.cell[i] % sectors);
+            if (j.distance[i] <= wall_distance[sector] + 4 * cell) band[sector].push_back(j.distance[i]);
+        }
+    std::vector<double> step;
+    for (auto& d : band) {
+        // A contact point is a block's corner, which several joints' contacts share.
+        std::sort(d.begin(), d.end());
+        d.erase(std::unique(d.begin(), d.end(), [](double x, double y) { return y - x < 1e-9; }), d.end());
+        if (d.size() >= 2) step.push_back((d.back() - d.front()) / double(d.size() - 1));
+    }
+    if (!step.empty()) {
+        std::nth_element(step.begin(), step.begin() + std::ptrdiff_t(step.size() / 2), step.end());
+        z.resolution = step[step.size() / 2];
+    }
+    z.resolution = std::max(z.resolution, cell / grid_shifts);
     zone_toward(z, sectors, springline, z.depth_springline, z.extent_springline_deg);
     zone_toward(z, sectors, crown, z.depth_crown, z.extent_crown_deg);
     return z;

@@ -35,16 +35,28 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
 /// area over that of the intact pattern: independent of the block size); the zone
 /// is the damaged cells connected through damaged neighbours (across rings and
 /// sectors) to a damaged cell at the wall (a sector's innermost ring with rock).
-/// Its depth in a sector is the outer edge of its deepest cell less the wall's
-/// inner edge — a resolution of one cell. A scattered
+/// Its depth in a sector is measured finer than the cells, from the broken
+/// contacts themselves: the distance of the zone's outermost broken contact point
+/// (at its initial position) less the wall's (the sector's innermost contact point
+/// of the rock), the median over 8 grids whose rings start an eighth of a cell
+/// apart (on one grid a dense zone's outermost crack sits at its deepest cell's
+/// outer edge). Its step (`resolution`) is the larger of an eighth of a cell and
+/// the radial spacing of contact points, not a cell. A scattered
 /// crack deep in the rock, not connected to the wall, is not in it (the deepest
 /// single crack is OpeningMeasures' failed depth).
 struct FailedZone {
     double cell = 0, threshold = 0, radius = 0;
     Vec2 center{};
     std::vector<double> depth; ///< per sector, counter-clockwise from +x, from the wall, m (0: none)
-    /// Per sector, the wall's distance beyond `radius` (whole cells: non-zero where
-    /// the opening is wider than its smaller radius).
+    /// Per sector, the outer edge of the zone's deepest cell from the wall's cell
+    /// (whole cells: the coarse measure, at least `depth`).
+    std::vector<double> depth_cells;
+    /// The step of `depth`, m: the larger of cell / 8 and the mean radial spacing
+    /// of the rock's distinct contact points within four cells of the wall (the
+    /// median over sectors).
+    double resolution = 0;
+    /// Per sector, the wall's distance beyond `radius` (non-zero where the opening
+    /// is wider than its smaller radius).
     std::vector<double> wall_offset;
     double depth_springline = 0, depth_crown = 0; ///< deepest within +/-15 deg of each direction
     /// Angular width of the zone (sectors with a depth) within +/-45 deg of each direction.

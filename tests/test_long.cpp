@@ -471,6 +471,14 @@ TEST_CASE("field: the Mine-by tunnel in rock calibrated on crack initiation notc
                        "no comparable failure at the side walls (Mine-by; Martin 1997, docs/field.md)",
                        "area < 0.5 x the smaller notch's, each side",
                        side_got + " against " + test::figure(smaller_notch) + " m²", side_held);
+    // Issue 48: the depth is measured at the broken contacts, finer than a block;
+    // its step under 5% of the field's depth (the cells of the zone are 0.144 m).
+    MESSAGE("failed-zone depth resolution " << zone.resolution << " m (cells " << zone.cell << " m)");
+    CHECK(zone.resolution < 0.05 * 0.79);
+    test::record_check(test::Against::field, "step of the failed zone's depth (broken contact points)",
+                       "finer than a block: under 5% of the field's notch depth, 0.79 m (issue 48)",
+                       "< 0.0395 m", test::figure(zone.resolution) + " m (blocks 0.12 m, cells " + test::figure(zone.cell) + " m)",
+                       zone.resolution < 0.05 * 0.79);
     CHECK_FALSE(zone.reaches_region_edge);
     CHECK(reports.back().verdict.kind == Verdict::Kind::equilibrium);
 }
