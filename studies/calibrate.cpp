@@ -17,16 +17,16 @@ namespace bbm {
 
 namespace {
 double lattice_ratio(double nu) { return (1.0 - 3.0 * nu) / (1.0 + nu); }
+} // namespace
 
 void mean_std(const std::vector<double>& v, double& mean, double& sd) {
     mean = 0.0;
     for (double x : v) mean += x;
-    mean /= double(v.size());
+    mean /= double(std::max<std::size_t>(1, v.size()));
     double s = 0.0;
     for (double x : v) s += (x - mean) * (x - mean);
     sd = v.size() > 1 ? std::sqrt(s / double(v.size() - 1)) : 0.0;
 }
-} // namespace
 
 ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOptions& base) {
     // The specimen with elastic joints, bottom rows held, 1 MPa on the top edge;

@@ -173,6 +173,10 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
                                               const std::vector<double>& confinements = {});
 
 
+/// Mean and sample standard deviation (0 for fewer than two values; the mean of
+/// none is 0) of the realizations' measures.
+void mean_std(const std::vector<double>& v, double& mean, double& sd);
+
 /// The misfit of measured properties against the targets (CalibrationIteration::misfit);
 /// with `with_ci`, |σci/UCS / target − 1| too.
 double calibration_misfit(const CalibrationIteration& it, const CalibrationTargets& t, bool with_ci = false);

@@ -7,6 +7,7 @@
 #include "studies/commands.hpp"
 #include "studies/envelope.hpp"
 #include "studies/ranks.hpp"
+#include "studies/residual_friction.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -79,6 +80,10 @@ CalibrationOptions calibration_options(CalibrateCli& values) {
     if (o.fit_confined_friction && values.targets.envelope.empty())
         throw InputError("--fit-confined-friction", 0, "",
                          "needs a confined target (--target-biaxial, --target-record or --target-mi) for phi2");
+    if (values.residual_confinement > 0.0 && !(values.residual_target > 0.0))
+        throw InputError("--residual-confinement", 0, "", "goes with --target-residual-friction");
+    if (values.residual_target > 0.0 && !(values.residual_confinement > 0.0))
+        values.residual_confinement = 0.1 * values.targets.ucs;
     if (o.fit_ci && !(values.targets.ci_ratio > 0))
         throw InputError("--fit-ci", 0, "", "needs the record's sigma_ci / UCS (--target-ci-ratio)");
     check_specimen_size(c);
@@ -118,6 +123,10 @@ void print_calibration_header(const CalibrateCli& values, const CalibrationOptio
     std::fprintf(stderr, "first estimates kn = E/d %.2f, ks = G/d %.2f GPa/m; start kn %.2f, ks %.2f GPa/m (%s)\n",
                  first.kn / 1e9, first.ks / 1e9, start.kn / 1e9, start.ks / 1e9,
                  o.start_kn || o.start_ks ? "as given" : "lattice inversion on the generated blocks");
+}
+
+/// The iteration table's column heads.
+void print_iteration_columns() {
     std::fprintf(stderr, "%4s %10s %10s %9s %9s | %9s %9s %7s %10s %10s %8s\n", "iter", "kn GPa/m", "ks GPa/m",
                  "st MPa", "c MPa", "E GPa", "E(curve)", "nu", "UCS MPa", "T MPa", "s");
 }
@@ -226,6 +235,32 @@ std::string calibrated_set_toml(const CalibrateCli& values, const CalibrationOpt
     return toml;
 }
 
+/// One iteration of the broken joints' friction on the console (0: the fresh-seed check).
+void print_residual_step(int k, const ResidualFrictionStep& s) {
+    if (k > 0) std::fprintf(stderr, "  r%d ", k);
+    std::fprintf(stderr, "broken joints %5.2f deg: rubble %5.2f deg (std %.2f), residual %.4g MPa, peak %.4g MPa, %.0f s%s",
+                 s.residual_friction, s.rubble_friction, s.rubble_std, s.residual_stress / 1e6, s.peak_stress / 1e6,
+                 s.seconds, s.converged ? "  converged" : "");
+    if (s.unmeasured > 0) std::fprintf(stderr, "  (%d run%s ended too soon after the peak)", s.unmeasured, s.unmeasured == 1 ? "" : "s");
+    std::fprintf(stderr, "\n");
+}
+
+/// calibration.json's "residual_friction": the target, the iterations and the fresh-seed check.
+nlohmann::json residual_record(const ResidualFrictionTarget& t, const std::vector<ResidualFrictionStep>& steps,
+                               const ResidualFrictionStep& fresh, bool converged) {
+    auto row = [](const ResidualFrictionStep& s) {
+        return nlohmann::json{{"residual_friction", s.residual_friction}, {"rubble_friction", s.rubble_friction},
+                              {"rubble_friction_std", s.rubble_std}, {"residual_stress", s.residual_stress},
+                              {"peak_stress", s.peak_stress}, {"unmeasured", s.unmeasured}, {"seconds", s.seconds},
+                              {"converged", s.converged}};
+    };
+    nlohmann::json iterations = nlohmann::json::array();
+    for (const auto& s : steps) iterations.push_back(row(s));
+    return {{"target", t.friction}, {"confinement", t.confinement}, {"tolerance", t.tolerance},
+            {"max_strain", t.max_strain}, {"calibrated", best_residual_step(steps, t.friction).residual_friction},
+            {"iterations", iterations}, {"fresh_seeds", row(fresh)}, {"converged", converged}};
+}
+
 /// calibration.json: the targets, the start, the iterations, the set on fresh
 /// seeds and the set's model-file text.
 nlohmann::json calibration_record(const CalibrateCli& values, const CalibrationOptions& o, const FirstEstimates& first,
@@ -265,7 +300,7 @@ nlohmann::json calibration_record(const CalibrateCli& values, const CalibrationO
 /// set as a TOML fragment, with the iteration table as JSON.
 int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string* calibration_json) {
     quiet = quiet || !Ranks::root(); // under mpirun, rank 0 reports and writes
-    const CalibrationOptions o = calibration_options(values);
+    CalibrationOptions o = calibration_options(values);
     if (check_only) return 0;
     const CalibrationTargets& targets = values.targets;
     const FirstEstimates first{targets.E / o.base.size, targets.E / (2.0 * (1.0 + targets.nu)) / o.base.size};
@@ -276,6 +311,24 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     std::vector<double> sigma3;
     for (const auto& p : targets.envelope) sigma3.push_back(p.first);
     if (!quiet) print_calibration_header(values, o, first, start);
+    // The broken joints' friction first, on the rubble's: the bonds' confined
+    // strengths depend on it, it hardly on them (residual_friction.hpp).
+    const ResidualFrictionTarget residual{values.residual_target, values.residual_confinement};
+    std::vector<ResidualFrictionStep> residual_steps;
+    if (residual.friction > 0.0) {
+        if (!quiet)
+            std::fprintf(stderr, "the broken joints' friction first: the rubble's friction %.3g deg (within %.2g) on "
+                                 "biaxial tests at sigma3 %.4g MPa to %.2g%% strain, with the start's bonds\n",
+                         residual.friction, residual.tolerance, residual.confinement / 1e6, 100 * residual.max_strain);
+        int r = 0;
+        residual_steps = calibrate_residual_friction(start, residual, o, [&](const ResidualFrictionStep& step) {
+            if (!quiet) print_residual_step(++r, step);
+        });
+        o.base.joint.residual_friction = best_residual_step(residual_steps, residual.friction).residual_friction;
+        if (!quiet)
+            std::fprintf(stderr, "broken joints' friction %.4g deg; now the bonds\n", o.base.joint.residual_friction);
+    }
+    if (!quiet) print_iteration_columns();
     nlohmann::json table = nlohmann::json::array();
     int k = 0;
     const auto iterations_done = calibrate(targets, o, [&](const CalibrationIteration& it) {
@@ -290,17 +343,30 @@ int run_calibrate(CalibrateCli& values, bool quiet, bool check_only, std::string
     fresh.misfit = calibration_misfit(fresh, targets, o.fit_ci);
     if (!quiet) print_fresh_seeds(fresh, o, targets, sigma3, last, last_number);
     const std::string toml = calibrated_set_toml(values, o, last, last_number);
-    const nlohmann::json calibration =
+    nlohmann::json calibration =
         calibration_record(values, o, first, start, last, last_number, fresh, std::move(table), toml);
+    bool residual_converged = true;
+    if (!residual_steps.empty()) {
+        // The calibrated set's rubble on the fresh seeds: the friction it will slide at.
+        const auto fresh_rubble = measure_rubble_friction(last.joint, residual, o, o.base.seed + 1000);
+        residual_converged = std::abs(fresh_rubble.rubble_friction - residual.friction) <= residual.tolerance &&
+                             fresh_rubble.unmeasured < o.realizations;
+        if (!quiet) {
+            std::fprintf(stderr, "fresh seeds, the rubble: ");
+            print_residual_step(0, fresh_rubble);
+        }
+        calibration["residual_friction"] = residual_record(residual, residual_steps, fresh_rubble, residual_converged);
+    }
+    const bool converged = last.converged && residual_converged;
     if (calibration_json) *calibration_json = calibration.dump();
     if (values.lab.write_files && Ranks::root()) {
         io::write_text_atomically(out / "joint_property.toml", toml);
         io::write_text_atomically(out / "calibration.json", calibration.dump(2) + "\n");
         if (!quiet)
             std::fprintf(stderr, "wrote %s/joint_property.toml and calibration.json%s\n", out.string().c_str(),
-                         last.converged ? "" : " (not converged within the iteration limit)");
+                         converged ? "" : " (not converged within the iteration limit)");
     }
-    return last.converged ? 0 : 4;
+    return converged ? 0 : 4;
 }
 
 void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
@@ -340,6 +406,15 @@ void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
                   "Calibrate the bonds' confined friction phi2 (docs/input.md, confined_friction) on the confined "
                   "targets, the friction and sigma* held (--confined-friction-from; default --target-ucs) and the "
                   "cohesion steered by the UCS alone (--confined-friction is the start; default 55)");
+    cmd->add_option("--target-residual-friction", v.residual_target,
+                    "Optional: the friction angle of the rock's rubble in degrees, as the laboratory measures it "
+                    "(the residual strength of a confined test: asin((sr - s3)/(sr + s3)); broken crystalline rock "
+                    "slides at 40.4, Byerlee 1978); calibrates the broken joints' friction (--residual-friction is "
+                    "the start) before the bonds, on biaxial tests run to 2% strain")
+        ->check(cli::in_range(1.0, 75.0));
+    cmd->add_option("--residual-confinement", v.residual_confinement,
+                    "sigma3 of the --target-residual-friction tests (Pa; default a tenth of --target-ucs)")
+        ->check(cli::positive());
     cmd->add_option("--iterations", v.iterations, "Iteration limit")->check(cli::positive())->capture_default_str();
 }
 

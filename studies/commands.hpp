@@ -108,6 +108,9 @@ struct CalibrateCli {
     int iterations = 6;
     bool fit_ci = false; ///< calibrate σci/UCS too (--fit-ci: by the bonds' strength heterogeneity)
     bool fit_confined_friction = false; ///< --fit-confined-friction: σ*, φ2 on the confined targets
+    /// --target-residual-friction (degrees) and --residual-confinement (Pa): the
+    /// broken joints' friction calibrated first, on the rubble's (residual_friction.hpp).
+    double residual_target = 0.0, residual_confinement = 0.0;
     /// Joint values given (they are the starting point rather than estimates).
     bool given_kn = false, given_ks = false, given_tensile = false, given_cohesion = false;
     CalibrateCli() { lab.realizations = 3; }

@@ -5,6 +5,7 @@
 // tests (test_long.cpp).
 #include "base/error.hpp"
 #include "studies/calibrate.hpp"
+#include "studies/residual_friction.hpp"
 #include "studies/commands.hpp"
 
 #include <doctest/doctest.h>
@@ -63,6 +64,7 @@ TEST_CASE("calibrate: the confined targets are checked before any run") {
     refused({"--target-mi-confinements", "5e6"}, "goes with --target-mi");
     refused({"--target-biaxial", "40e6"}, "go together");
     refused({"--fit-confined-friction"}, "needs a confined target");
+    refused({"--residual-confinement", "10e6"}, "goes with --target-residual-friction");
     std::filesystem::remove_all(dir);
 }
 
@@ -114,6 +116,32 @@ TEST_CASE("calibrate: the confined-friction step for phi2") {
     CHECK(next_confined_friction(5.0, -1.0, 0.0, 50.0, -2.0) == doctest::Approx(60.0));
     CHECK(next_confined_friction(5.0, -1.0, 0.0, 70.0, -0.4) == doctest::Approx(75.0));
     CHECK(next_confined_friction(30.0, -1.0, 0.0, 35.0, 0.5) == doctest::Approx(30.0));
+}
+
+TEST_CASE("calibrate: the broken joints' friction step toward the rubble's") {
+    // First step: the prior 1.4 degrees of rubble friction per degree; Lac du
+    // Bonnet's in-situ set at 5 degrees slid at 32.7 against Byerlee's 40.4.
+    CHECK(next_residual_friction(-1.0, 0.0, 5.0, 32.7, 40.4) == doctest::Approx(5.0 + 7.7 / 1.4));
+    // Then the secant of the last two: a synthetic rubble sliding at 30 + 1.7 (phi - 4)
+    // lands on the phi whose rubble is at the target.
+    auto rubble = [](double phi) { return 30.0 + 1.7 * (phi - 4.0); };
+    const double phi = next_residual_friction(5.0, rubble(5.0), 10.5, rubble(10.5), 40.4);
+    CHECK(rubble(phi) == doctest::Approx(40.4));
+    // A secant outside 0.3-5 (noise: the rubble's friction fell as phi rose) is not
+    // followed: the prior.
+    CHECK(next_residual_friction(5.0, 35.0, 10.0, 34.0, 40.4) == doctest::Approx(10.0 + 6.4 / 1.4));
+    // Steps within +/-10 degrees, phi within [0, 60].
+    CHECK(next_residual_friction(-1.0, 0.0, 5.0, 10.0, 40.4) == doctest::Approx(15.0));
+    CHECK(next_residual_friction(-1.0, 0.0, 3.0, 45.0, 40.4) == doctest::Approx(0.0));
+    CHECK(next_residual_friction(-1.0, 0.0, 55.0, 30.0, 40.4) == doctest::Approx(60.0));
+    // The calibrated phi: the converged iteration, else the one nearest the target.
+    std::vector<ResidualFrictionStep> steps(3);
+    steps[0].residual_friction = 5, steps[0].rubble_friction = 32.7;
+    steps[1].residual_friction = 12, steps[1].rubble_friction = 42.0;
+    steps[2].residual_friction = 9, steps[2].rubble_friction = 38.2;
+    CHECK(best_residual_step(steps, 40.4).residual_friction == 12.0);
+    steps[2].converged = true;
+    CHECK(best_residual_step(steps, 40.4).residual_friction == 9.0);
 }
 
 TEST_CASE("calibrate: the stiffness-ratio step for nu, lattice first and then the measured secant") {
