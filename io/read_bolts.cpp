@@ -34,10 +34,7 @@ BoltSetSpec::Ring read_ring(const Ctx& c, const toml::node& node, const Path& p)
 /// that belong to it.
 DowelSetSpec read_bolt_set(Ctx& c, const toml::table& t, const Path& p, Names& names, std::string_view type) {
     static constexpr auto all_keys = key_names(bolt_keys);
-    std::vector<std::string_view> keys;
-    for (const BoltKey& k : bolt_keys)
-        if (key_applies(k, type)) keys.push_back(k.key);
-    check_keys(c, t, p, keys, all_keys, "a " + std::string(type) + " set");
+    check_keys(c, t, p, keys_of_type(bolt_keys, type), all_keys, "a " + std::string(type) + " set");
     DowelSetSpec b;
     b.name = read_name(c, t, p, names);
     if (const toml::node* n = find(c, t, p, "bolts")) {
