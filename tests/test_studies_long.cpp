@@ -144,9 +144,13 @@ TEST_CASE("calibrate --target-residual-friction: Lac du Bonnet's broken joints f
     // Issue 48, item 2: the broken joints' friction fixed by the laboratory before
     // the field. The in-situ set's bonds (docs/calibration.md, "The residual
     // strength": at 5 degrees its rubble slid at 32.7, at 10 at 41.1, at 15 at
-    // 45.6 degrees), biaxial at sigma3 = 10 MPa to 2% strain, 2 seeds an
-    // iteration. Targets: within 1 degree of 40.4 in at most 5 iterations, and the
-    // set's rubble on fresh seeds within 2 degrees (the seeds' scatter).
+    // 45.6 degrees), biaxial at sigma3 = 10 MPa to 2% strain, 3 seeds an
+    // iteration as `bbm calibrate` runs it. Targets: within 1 degree of 40.4 in at
+    // most 5 iterations, and the set's rubble on 3 fresh seeds within 2 degrees.
+    // With 2 seeds (2026-11-29) the fit converged at 10.60 degrees (39.9) and the
+    // fresh seeds 2001-2002 slid at 43.5 (std 2.7): one seed's rubble scatters by
+    // 2-2.7 degrees, too much for 2 degrees on a mean of two. The command's own
+    // run on 3 seeds: 9.45 degrees, fresh seeds 39.9 (std 2.0; docs/calibration.md).
     CalibrationOptions o;
     o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
     o.base.material.density = 2650;
@@ -154,7 +158,7 @@ TEST_CASE("calibrate --target-residual-friction: Lac du Bonnet's broken joints f
     auto& j = o.base.joint;
     j.kn = 954.511e9, j.ks = 257.441e9, j.tensile = 15.1313e6, j.cohesion = 41.843e6;
     j.friction = 5, j.residual_friction = 5;
-    o.realizations = 2, o.threads = 2;
+    o.realizations = 3, o.threads = 2;
     const ResidualFrictionTarget target{40.4, 10e6};
     const auto steps = calibrate_residual_friction(j, target, o, [](const ResidualFrictionStep& s) {
         MESSAGE("broken joints " << s.residual_friction << " deg: rubble " << s.rubble_friction << " deg (std "
@@ -169,7 +173,7 @@ TEST_CASE("calibrate --target-residual-friction: Lac du Bonnet's broken joints f
     auto calibrated = j;
     calibrated.residual_friction = best.residual_friction;
     const auto fresh = measure_rubble_friction(calibrated, target, o, 2001);
-    MESSAGE("fresh seeds 2001-2002: rubble " << fresh.rubble_friction << " deg (std " << fresh.rubble_std << ")");
+    MESSAGE("fresh seeds 2001-2003: rubble " << fresh.rubble_friction << " deg (std " << fresh.rubble_std << ")");
     CHECK(fresh.unmeasured == 0);
     CHECK(std::abs(fresh.rubble_friction - 40.4) <= 2.0);
     test::record_check(test::Against::laboratory, "broken joints' friction calibrated on the rubble's, sigma3 10 MPa",
