@@ -104,7 +104,8 @@ struct StrengthSample {
 /// 0.055/° against 0.023/°), so each friction step threw the UCS off (134–345
 /// MPa against 213) and φ swung (25° → 35° → 43° → 33° → 43° → 41°). The targets
 /// are met in least squares, the UCS row weighted twice (its tolerance is half
-/// the envelope's); steps within ±0.7 in ln c and ±8° in φ, φ within 5–55°.
+/// the envelope's); steps within ±0.7 in ln c and ±8° in φ, φ within 5–55°, and
+/// when φ's step is cut so, ln c's is solved again for the φ step taken.
 std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
                                                  const std::vector<double>& sigma3,
                                                  const std::vector<double>& log_target);

@@ -104,6 +104,33 @@ TEST_CASE("calibrate: the cohesion-friction step finds a synthetic rock's c and 
     CHECK_THROWS_AS(next_cohesion_friction({}, sigma3, {0, 0, 0}), std::logic_error);
 }
 
+TEST_CASE("calibrate: a friction step cut at 8 degrees takes the cohesion step that goes with it") {
+    // Every strength low, the confined ones far more than the UCS (a Coulomb rock of
+    // c 50 MPa, phi 45 deg, started at c 60 MPa, phi 25 deg: UCS +25%, sigma1 at
+    // 71 MPa +59% short): the joint step wants phi up by far more than 8 degrees and
+    // ln c down to match. With phi cut to +8 the cohesion must not fall with it, or
+    // the UCS moves away from its target (Lac du Bonnet from the default bonds,
+    // 2026-11-29: UCS 190 -> 145 MPa against 213).
+    constexpr double deg = 3.14159265358979323846 / 180.0;
+    const std::vector<double> sigma3{35.5e6, 71e6};
+    auto strengths = [&](double c, double phi) {
+        const double n = (1 + std::sin(phi * deg)) / (1 - std::sin(phi * deg));
+        const double ucs = 2 * c * std::sqrt(n);
+        return std::vector<double>{std::log(ucs), std::log(ucs + n * sigma3[0]), std::log(ucs + n * sigma3[1])};
+    };
+    const auto target = strengths(50e6, 45.0);
+    const std::vector<StrengthSample> history{{std::log(60e6), 25.0, strengths(60e6, 25.0)}};
+    REQUIRE(target[0] > history[0].log_strength[0]);
+    const auto [log_c, phi] = next_cohesion_friction(history, sigma3, target);
+    CHECK(phi == doctest::Approx(33.0));
+    const auto after = strengths(std::exp(log_c), phi);
+    MESSAGE("c " << std::exp(log_c) / 1e6 << " MPa, phi " << phi << ": UCS " << std::exp(after[0]) / 1e6 << " MPa from "
+                 << std::exp(history[0].log_strength[0]) / 1e6 << " against " << std::exp(target[0]) / 1e6);
+    // The UCS closer to its target, every confined strength too.
+    for (std::size_t m = 0; m < 3; ++m)
+        CHECK(std::abs(after[m] - target[m]) < std::abs(history[0].log_strength[m] - target[m]));
+}
+
 TEST_CASE("calibrate: the confined-friction step for phi2") {
     // First step: the prior slope, 0.05 per degree; σ1 too low by e^−0.2 → +4°.
     CHECK(next_confined_friction(5.0, -1.0, 0.0, 55.0, -0.2) == doctest::Approx(59.0));
