@@ -240,73 +240,127 @@ std::optional<std::array<double, N>> solve_small(std::array<std::array<double, N
 }
 } // namespace
 
-std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
-                                                 const std::vector<double>& sigma3,
-                                                 const std::vector<double>& log_target) {
-    if (history.empty()) throw std::logic_error("next_cohesion_friction: no sample");
+namespace {
+/// The strength step of next_cohesion_friction (K = 2: ln c, φ) and next_bond_cap
+/// (K = 3: ln c, φ, φ2 above σ*): the unknowns after the step, in that order.
+template <int K>
+std::array<double, K> strength_step(const std::vector<StrengthSample>& history, const std::vector<double>& sigma3,
+                                    const std::vector<double>& log_target, double sigma_star) {
+    if (history.empty()) throw std::logic_error("strength step: no sample");
     constexpr double deg = std::numbers::pi / 180.0;
     const StrengthSample& last = history.back();
     const std::size_t measures = log_target.size();
     if (last.log_strength.size() != measures || sigma3.size() + 1 != measures)
-        throw std::logic_error("next_cohesion_friction: a UCS and one σ1 per confinement");
+        throw std::logic_error("strength step: a UCS and one σ1 per confinement");
+    auto coordinates = [](const StrengthSample& sample) {
+        std::array<double, K> x{sample.log_cohesion, sample.friction};
+        if constexpr (K == 3) x[2] = sample.confined_friction;
+        return x;
+    };
+    const std::array<double, K> at = coordinates(last);
     // Coulomb's slopes at the last sample: UCS = 2c√N, σ1 = UCS + N σ3,
-    // d ln √N/dφ = 1/cos φ, d ln N/dφ = 2/cos φ (per radian).
+    // d ln √N/dφ = 1/cos φ, d ln N/dφ = 2/cos φ (per radian). With a cap in two
+    // pieces, the friction's slope is shared between φ and φ2 by where the normal
+    // stress on the Coulomb failure plane, (σ1 + σ3)/2 − (σ1 − σ3)/2 sin φ, lies
+    // against σ*: a prior only, the measured planes take over.
     const double phi = last.friction * deg, n_phi = (1.0 + std::sin(phi)) / (1.0 - std::sin(phi));
     const double ucs = std::exp(last.log_strength[0]);
     constexpr double prior_c = 0.5, prior_phi = 3.0; // the prior rows' weights: ln c and degrees
-    // Each plane in coordinates centred on the last sample, (1, ln c − ln c_last,
-    // φ − φ_last): its intercept is the strength predicted there, and the
-    // normal equations stay well conditioned. Small systems solved by hand:
-    // Eigen here would put its template code in bbm beside gmsh's own copy, and
-    // the dynamic linker binds gmsh's calls to ours (an ASan build then frees
-    // gmsh's matrices with the wrong allocator).
-    std::vector<double> predicted(measures), slope_c(measures), slope_phi(measures);
+    // Each plane in coordinates centred on the last sample, (1, x − x_last): its
+    // intercept is the strength predicted there, and the normal equations stay well
+    // conditioned. Small systems solved by hand: Eigen here would put its template
+    // code in bbm beside gmsh's own copy, and the dynamic linker binds gmsh's calls
+    // to ours (an ASan build then frees gmsh's matrices with the wrong allocator).
+    std::vector<double> predicted(measures);
+    std::vector<std::array<double, K>> slope(measures);
     for (std::size_t m = 0; m < measures; ++m) {
         const double s3 = m == 0 ? 0.0 : sigma3[m - 1], s1 = std::exp(last.log_strength[m]);
-        const double b0 = ucs / s1, g0 = (ucs / std::cos(phi) + s3 * n_phi * 2.0 / std::cos(phi)) * deg / s1;
-        // Normal equations of the rows: the samples (1, dx, dφ) → ln s, then the
-        // two priors on the slopes.
-        std::array<std::array<double, 4>, 3> normal{};
-        auto add_row = [&normal](std::array<double, 3> row, double y) {
-            for (int r = 0; r < 3; ++r) {
-                for (int c = 0; c < 3; ++c) normal[r][c] += row[r] * row[c];
-                normal[r][3] += row[r] * y;
+        std::array<double, K> prior{ucs / s1, (ucs / std::cos(phi) + s3 * n_phi * 2.0 / std::cos(phi)) * deg / s1};
+        if constexpr (K == 3) {
+            const double normal_stress = 0.5 * (s1 + s3) - 0.5 * (s1 - s3) * std::sin(phi);
+            const double above = std::clamp(1.0 - sigma_star / normal_stress, 0.0, 1.0);
+            prior[2] = prior[1] * above, prior[1] *= 1.0 - above;
+        }
+        // Normal equations of the rows: the samples (1, x − x_last) → ln s, then a
+        // prior on each slope.
+        std::array<std::array<double, K + 2>, K + 1> normal{};
+        auto add_row = [&normal](const std::array<double, K + 1>& row, double y) {
+            for (int r = 0; r <= K; ++r) {
+                for (int c = 0; c <= K; ++c) normal[r][c] += row[r] * row[c];
+                normal[r][K + 1] += row[r] * y;
             }
         };
-        for (const auto& sample : history)
-            add_row({1.0, sample.log_cohesion - last.log_cohesion, sample.friction - last.friction},
-                    sample.log_strength[m]);
-        add_row({0.0, prior_c, 0.0}, prior_c * b0);
-        add_row({0.0, 0.0, prior_phi}, prior_phi * g0);
-        const auto fit = solve_small<3>(normal);
-        if (!fit) return {last.log_cohesion, last.friction};
-        predicted[m] = (*fit)[0], slope_c[m] = (*fit)[1], slope_phi[m] = (*fit)[2];
+        for (const auto& sample : history) {
+            const std::array<double, K> x = coordinates(sample);
+            std::array<double, K + 1> row{1.0};
+            for (int k = 0; k < K; ++k) row[k + 1] = x[k] - at[k];
+            add_row(row, sample.log_strength[m]);
+        }
+        for (int k = 0; k < K; ++k) {
+            std::array<double, K + 1> row{};
+            row[k + 1] = k == 0 ? prior_c : prior_phi;
+            add_row(row, row[k + 1] * prior[k]);
+        }
+        const auto fit = solve_small<K + 1>(normal);
+        if (!fit) return at;
+        predicted[m] = (*fit)[0];
+        for (int k = 0; k < K; ++k) slope[m][k] = (*fit)[k + 1];
     }
     // The step from the last sample to the targets in least squares (a step, so
     // that a direction the planes cannot see stays put), the UCS row twice as heavy.
-    std::array<std::array<double, 3>, 2> normal{};
+    std::array<std::array<double, K + 1>, K> normal{};
     for (std::size_t m = 0; m < measures; ++m) {
         const double w2 = m == 0 ? 4.0 : 1.0, miss = log_target[m] - predicted[m];
-        normal[0][0] += w2 * slope_c[m] * slope_c[m], normal[0][1] += w2 * slope_c[m] * slope_phi[m];
-        normal[1][0] += w2 * slope_phi[m] * slope_c[m], normal[1][1] += w2 * slope_phi[m] * slope_phi[m];
-        normal[0][2] += w2 * slope_c[m] * miss, normal[1][2] += w2 * slope_phi[m] * miss;
+        for (int r = 0; r < K; ++r) {
+            for (int c = 0; c < K; ++c) normal[r][c] += w2 * slope[m][r] * slope[m][c];
+            normal[r][K] += w2 * slope[m][r] * miss;
+        }
     }
-    const auto step = solve_small<2>(normal);
-    double log_c = last.log_cohesion, friction = last.friction;
-    if (step) {
-        friction = std::clamp(friction + std::clamp((*step)[1], -8.0, 8.0), 5.0, 55.0);
-        // When φ's step is cut short, ln c is solved again for the φ step taken: the
-        // joint solution's c step goes with its whole φ step, and alone it throws the
-        // UCS away from its target (Lac du Bonnet from the default bonds, every
-        // strength low: φ +8° of a wanted +34°, ln c −0.49, the UCS 190 → 145 MPa
-        // against 213).
-        const double friction_step = friction - last.friction;
-        double log_c_step = (*step)[0];
-        if (std::abs(friction_step - (*step)[1]) > 1e-9 && normal[0][0] > 0.0)
-            log_c_step = (normal[0][2] - normal[0][1] * friction_step) / normal[0][0];
-        log_c += std::clamp(log_c_step, -0.7, 0.7);
+    // The angles' steps within ±8° and their ranges (φ 5–55°, φ2 0–75°). An angle
+    // cut short is held at its cut step and the others solved again for it: the
+    // joint solution's other steps go with its whole step, and alone they throw the
+    // strengths away from their targets (Lac du Bonnet from the default bonds, every
+    // strength low: φ +8° of a wanted +34°, ln c −0.49, the UCS 190 → 145 MPa
+    // against 213).
+    const std::array<double, 3> lowest{0.0, 5.0, 0.0}, highest{0.0, 55.0, 75.0};
+    std::array<bool, K> held{};
+    std::array<double, K> step{};
+    for (int pass = 0; pass < K; ++pass) {
+        auto system = normal;
+        for (int k = 0; k < K; ++k)
+            if (held[k]) {
+                system[k].fill(0.0);
+                system[k][k] = 1.0, system[k][K] = step[k];
+            }
+        const auto solved = solve_small<K>(system);
+        if (!solved) return at;
+        step = *solved;
+        bool cut = false;
+        for (int k = 1; k < K; ++k) {
+            const double taken = std::clamp(at[k] + std::clamp(step[k], -8.0, 8.0), lowest[k], highest[k]) - at[k];
+            if (!held[k] && std::abs(taken - step[k]) > 1e-9) held[k] = cut = true;
+            step[k] = taken;
+        }
+        if (!cut) break;
     }
-    return {log_c, friction};
+    std::array<double, K> next = at;
+    next[0] += std::clamp(step[0], -0.7, 0.7);
+    for (int k = 1; k < K; ++k) next[k] += step[k];
+    return next;
+}
+} // namespace
+
+std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
+                                                 const std::vector<double>& sigma3,
+                                                 const std::vector<double>& log_target) {
+    const auto next = strength_step<2>(history, sigma3, log_target, 0.0);
+    return {next[0], next[1]};
+}
+
+BondCapStep next_bond_cap(const std::vector<StrengthSample>& history, const std::vector<double>& sigma3,
+                          const std::vector<double>& log_target, double sigma_star) {
+    const auto next = strength_step<3>(history, sigma3, log_target, sigma_star);
+    return {next[0], next[1], next[2]};
 }
 
 double next_confined_friction(double friction, double phi2_prev, double misfit_prev, double phi2, double misfit) {
@@ -341,6 +395,12 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
     std::vector<CalibrationIteration> out;
     JointPropertySpec j = calibration_start(t, o);
     double prev_phi2 = -1.0, prev_misfit = 0.0; // φ2 and its misfit at the previous iteration
+    if (o.fit_curvature) {
+        if (t.envelope.size() < 2) throw std::invalid_argument("a curvature calibration needs two confined targets");
+        if (o.fit_confined_friction) throw std::invalid_argument("fit_curvature fits the confined friction itself");
+        if (j.confined_friction < 0.0) j.confined_friction = j.friction;
+        if (!(j.confined_friction_from > 0.0)) j.confined_friction_from = t.ucs;
+    }
     if (o.fit_confined_friction) {
         if (t.envelope.empty()) throw std::invalid_argument("a confined-friction calibration needs a confined target");
         // Unless given: steepening from the normal stress of the UCS target (an
@@ -391,12 +451,20 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
             prev_phi2 = phi2, prev_misfit = misfit;
         } else if (with_phi) {
             const double loss = ucs_loss(heterogeneity_of(j));
-            StrengthSample sample{std::log(j.cohesion * loss), j.friction, {std::log(it.ucs)}};
+            StrengthSample sample{std::log(j.cohesion * loss), j.friction, {std::log(it.ucs)}, j.confined_friction};
             for (double s1 : it.confined) sample.log_strength.push_back(std::log(s1));
             strength_history.push_back(std::move(sample));
-            const auto [log_c, friction] = next_cohesion_friction(strength_history, sigma3, log_strength_target);
-            j.cohesion = std::exp(log_c) / loss;
-            j.friction = friction;
+            if (o.fit_curvature) {
+                const BondCapStep next =
+                    next_bond_cap(strength_history, sigma3, log_strength_target, j.confined_friction_from);
+                j.cohesion = std::exp(next.log_cohesion) / loss;
+                j.friction = next.friction;
+                j.confined_friction = next.confined_friction;
+            } else {
+                const auto [log_c, friction] = next_cohesion_friction(strength_history, sigma3, log_strength_target);
+                j.cohesion = std::exp(log_c) / loss;
+                j.friction = friction;
+            }
         } else {
             j.cohesion *= t.ucs / it.ucs;
         }

@@ -24,7 +24,8 @@
 // the strengths (ln UCS, ln σ1 at each σ3) as planes in (ln c, φ) fitted to
 // every iteration so far, solved for the targets. One friction angle sets one
 // slope: the curvature of a record's envelope is not fitted, and the misfit at
-// each σ3 is reported.
+// each σ3 is reported — unless fit_curvature fits a cap in two pieces, φ below a
+// normal stress σ* and φ2 above it (next_bond_cap).
 // Converged when every mean is within its tolerance; otherwise, after
 // max_iterations, the best set (the smallest largest misfit) is the result.
 // The means are over realizations, so the result carries their scatter: a new
@@ -82,6 +83,11 @@ struct CalibrationOptions {
     /// confined_friction_from; none: the UCS target), the friction φ held and the
     /// cohesion steered by the UCS alone.
     bool fit_confined_friction = false;
+    /// Calibrate the bonds' cap in two straight pieces, c and φ below σ* and φ2
+    /// above it, together on the UCS and at least two confined targets
+    /// (next_bond_cap): σ* held (the set's confined_friction_from; none: the UCS
+    /// target), φ2 starting at the set's (none: φ, a straight cap).
+    bool fit_curvature = false;
 };
 
 /// One iteration's strengths against the bonds' cohesion and friction.
@@ -91,6 +97,7 @@ struct StrengthSample {
     double log_cohesion = 0.0;
     double friction = 0.0;              ///< degrees
     std::vector<double> log_strength;   ///< ln UCS, then ln σ1 at each confinement
+    double confined_friction = -1.0;    ///< φ2 above σ*, degrees (next_bond_cap only)
 };
 
 /// The next (ln c, φ) for the strength targets (ln UCS, then ln σ1 at each of
@@ -109,6 +116,18 @@ struct StrengthSample {
 std::pair<double, double> next_cohesion_friction(const std::vector<StrengthSample>& history,
                                                  const std::vector<double>& sigma3,
                                                  const std::vector<double>& log_target);
+
+/// The next bonds' cap in two straight pieces (fit_curvature): ln c, φ below the
+/// normal stress σ* and φ2 above it (JointPropertySpec::confined_friction), by the
+/// planes of next_cohesion_friction in three unknowns. The prior slope of the
+/// friction is shared between φ and φ2 by the normal stress on the Coulomb failure
+/// plane at each target against σ*. φ2 steps within ±8°, within 0–75°: below φ the
+/// envelope bends down (concave, as rock's), above it up (S-shaped).
+struct BondCapStep {
+    double log_cohesion, friction, confined_friction;
+};
+BondCapStep next_bond_cap(const std::vector<StrengthSample>& history, const std::vector<double>& sigma3,
+                          const std::vector<double>& log_target, double sigma_star);
 
 /// The next confined friction φ2 (degrees) of a confined-friction calibration,
 /// σ* held: from the signed misfit m = mean over the confined targets of

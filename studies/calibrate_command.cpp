@@ -80,6 +80,12 @@ CalibrationOptions calibration_options(CalibrateCli& values) {
     if (o.fit_confined_friction && values.targets.envelope.empty())
         throw InputError("--fit-confined-friction", 0, "",
                          "needs a confined target (--target-biaxial, --target-record or --target-mi) for phi2");
+    o.fit_curvature = values.fit_curvature;
+    if (o.fit_curvature && values.targets.envelope.size() < 2)
+        throw InputError("--fit-curvature", 0, "",
+                         "needs two confined targets or more (--target-record or --target-mi) for phi and phi2");
+    if (o.fit_curvature && o.fit_confined_friction)
+        throw InputError("--fit-curvature", 0, "", "fits phi2 itself: leave out --fit-confined-friction");
     if (values.residual_confinement > 0.0 && !(values.residual_target > 0.0))
         throw InputError("--residual-confinement", 0, "", "goes with --target-residual-friction");
     if (values.residual_target > 0.0 && !(values.residual_confinement > 0.0))
@@ -110,6 +116,9 @@ void print_calibration_header(const CalibrateCli& values, const CalibrationOptio
         std::fprintf(stderr, o.fit_confined_friction
                                  ? " the confined friction phi2 calibrated (phi and sigma* held; sigma*, phi2 and the "
                                    "sigma1 at the end of each row)\n"
+                             : o.fit_curvature
+                                 ? " the cap in two pieces calibrated, phi below sigma* and phi2 above it (sigma* held; "
+                                   "sigma*, phi2, phi and the sigma1 at the end of each row)\n"
                                  : " the friction angle calibrated too (phi and the sigma1 at the end of each row)\n");
     }
     if (targets.ci_ratio > 0 && o.fit_ci)
@@ -141,7 +150,7 @@ void print_iteration(int k, const CalibrationIteration& it, const CalibrationOpt
         std::fprintf(stderr, " (m %s)",
                      it.joint.weibull_modulus > 0 ? fmt_number(it.joint.weibull_modulus).c_str() : "uniform");
     if (with_phi) {
-        if (o.fit_confined_friction)
+        if (o.fit_confined_friction || o.fit_curvature)
             std::fprintf(stderr, "   sigma* %.4g MPa phi2 %5.2f", it.joint.confined_friction_from / 1e6,
                          it.joint.confined_friction);
         std::fprintf(stderr, "   phi %5.2f  sigma1", it.joint.friction);
@@ -270,7 +279,8 @@ nlohmann::json calibration_record(const CalibrateCli& values, const CalibrationO
     return {{"targets", {{"E", targets.E}, {"nu", targets.nu}, {"ucs", targets.ucs},
                          {"tensile", targets.tensile}, {"envelope", targets.envelope},
                          {"ci_ratio", targets.ci_ratio}, {"fit_ci", o.fit_ci},
-                         {"fit_confined_friction", o.fit_confined_friction}}},
+                         {"fit_confined_friction", o.fit_confined_friction},
+                         {"fit_curvature", o.fit_curvature}}},
             {"pattern", values.lab.pattern},
             {"size", o.base.size},
             {"size_measure", values.lab.size_measure},
@@ -406,6 +416,11 @@ void add_calibrate_options(CLI::App* cmd, CalibrateCli& v, bool& quiet) {
                   "Calibrate the bonds' confined friction phi2 (docs/input.md, confined_friction) on the confined "
                   "targets, the friction and sigma* held (--confined-friction-from; default --target-ucs) and the "
                   "cohesion steered by the UCS alone (--confined-friction is the start; default 55)");
+    cmd->add_flag("--fit-curvature", v.fit_curvature,
+                  "Calibrate the bonds' cap in two straight pieces: the cohesion and friction phi below the normal "
+                  "stress sigma* (--confined-friction-from; default --target-ucs) and the confined friction phi2 "
+                  "above it, together on the UCS and two confined targets or more, so that the envelope bends as "
+                  "the record's (phi2 < phi: concave; --confined-friction is the start; default phi)");
     cmd->add_option("--target-residual-friction", v.residual_target,
                     "Optional: the friction angle of the rock's rubble in degrees, as the laboratory measures it "
                     "(the residual strength of a confined test: asin((sr - s3)/(sr + s3)); broken crystalline rock "

@@ -337,8 +337,11 @@ void add_specimen_options(CLI::App* sub, LabTestCli& c) {
                     "them (what bbm calibrate writes: joint_property.toml), or a whole model file (its bonded "
                     "region's pattern, bonds and material); the rock's flags given beside it override it")
         ->check(CLI::ExistingFile);
-    // After the command's flags are parsed: the file, then the flags given beside it.
-    sub->parse_complete_callback([sub, &c] { apply_rock_file(*sub, c); });
+    // After the command's flags are parsed, those of --config too: the file, then
+    // the flags given beside it. A final callback, not parse_complete_callback: with
+    // one, CLI11 (2.1) reads a --config file after it and never sets the
+    // command's flags from the file (fit-curvature = true was silently false).
+    sub->final_callback([sub, &c] { apply_rock_file(*sub, c); });
     sub->add_option("--pattern", c.pattern, "Inner-block pattern")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick"}))
         ->capture_default_str();

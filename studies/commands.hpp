@@ -108,6 +108,7 @@ struct CalibrateCli {
     int iterations = 6;
     bool fit_ci = false; ///< calibrate σci/UCS too (--fit-ci: by the bonds' strength heterogeneity)
     bool fit_confined_friction = false; ///< --fit-confined-friction: σ*, φ2 on the confined targets
+    bool fit_curvature = false;         ///< --fit-curvature: c, φ and φ2 above σ* together
     /// --target-residual-friction (degrees) and --residual-confinement (Pa): the
     /// broken joints' friction calibrated first, on the rubble's (residual_friction.hpp).
     double residual_target = 0.0, residual_confinement = 0.0;

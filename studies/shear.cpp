@@ -282,7 +282,7 @@ void add_shear_options(CLI::App* sub, ShearCli& v, bool& quiet) {
                     "The rock's bonds, material and block pattern from a file, as the lab tests' --rock (what bbm "
                     "calibrate writes); the rock's flags given beside it override it")
         ->check(CLI::ExistingFile);
-    sub->parse_complete_callback([sub, &c] { apply_rock_file(*sub, c); });
+    sub->final_callback([sub, &c] { apply_rock_file(*sub, c); }); // after --config: see commands.cpp
     sub->add_option("--pattern", c.pattern, "Inner-block pattern (single: each half one rigid block; persistent joints only)")
         ->check(CLI::IsMember({"voronoi", "trigon", "delaunay", "hexagonal", "brick", "single"}))
         ->capture_default_str();

@@ -30,6 +30,15 @@ execute_process(COMMAND ${BBM} --config ${DIR}/ucs.toml ucs --quiet --out ${DIR}
 if(NOT status EQUAL 2 OR NOT err MATCHES "ucs.toml" OR NOT err MATCHES "widht")
   message(FATAL_ERROR "a bad key in --config should give status 2 naming file and key, got ${status}: ${err}")
 endif()
+# A flag in a --config file is read as on the command line: fit-curvature with one
+# confined target is refused, naming the flag (it was once silently ignored).
+file(WRITE ${DIR}/curvature.toml "[calibrate]\ntarget-mi = 10\ntarget-mi-confinements = [5e6]\nfit-curvature = true\n")
+execute_process(COMMAND ${BBM} --check --config ${DIR}/curvature.toml calibrate --quiet --out ${DIR}/calibrate_out
+                RESULT_VARIABLE status ERROR_VARIABLE err OUTPUT_VARIABLE out)
+if(NOT status EQUAL 2 OR NOT err MATCHES "--fit-curvature")
+  message(FATAL_ERROR "fit-curvature = true in --config with one confined target should give status 2 naming "
+                      "--fit-curvature, got ${status}: ${err}")
+endif()
 # bbm shear: a bad combination of flags names the flag, exits 2 and keeps earlier output.
 execute_process(COMMAND ${BBM} shear --pattern single --persistence 0.5 --quiet --out ${DIR}/out
                 RESULT_VARIABLE status ERROR_VARIABLE err)

@@ -131,6 +131,59 @@ TEST_CASE("calibrate: a friction step cut at 8 degrees takes the cohesion step t
         CHECK(std::abs(after[m] - target[m]) < std::abs(history[0].log_strength[m] - target[m]));
 }
 
+TEST_CASE("calibrate: the cap in two pieces finds a synthetic rock's c, phi and phi2, concave and S-shaped") {
+    // A rock whose Mohr envelope is two straight pieces, c + sigma_n tan(phi) below
+    // sigma* and phi2 above it (the cohesion of the upper piece c + sigma* (tan phi -
+    // tan phi2)): its principal-stress strengths are the lower of the two Coulomb
+    // lines (phi2 < phi, concave) or the higher (phi2 > phi, S-shaped). The targets:
+    // its UCS and sigma1 at a sixth, a third and half of the UCS; the start: a straight
+    // cap, c 9 MPa, phi = phi2 = 25 deg. The step must reach every strength within
+    // 1% in at most 8 steps.
+    constexpr double deg = 3.14159265358979323846 / 180.0;
+    const double sigma_star = 20e6;
+    auto line = [](double c, double phi, double s3) {
+        const double n = (1 + std::sin(phi * deg)) / (1 - std::sin(phi * deg));
+        return 2 * c * std::sqrt(n) + n * s3;
+    };
+    struct Truth {
+        double c, phi, phi2;
+    };
+    for (const Truth truth : {Truth{8e6, 38.0, 22.0}, Truth{8e6, 30.0, 42.0}}) {
+        std::vector<double> sigma3{3.45e6, 6.9e6, 10.35e6};
+        auto strengths = [&](double c, double phi, double phi2) {
+            const double c2 = c + sigma_star * (std::tan(phi * deg) - std::tan(phi2 * deg));
+            std::vector<double> out;
+            for (double s3 : {0.0, sigma3[0], sigma3[1], sigma3[2]}) {
+                const double a = line(c, phi, s3), b = line(c2, phi2, s3);
+                out.push_back(std::log(phi2 < phi ? std::min(a, b) : std::max(a, b)));
+            }
+            return out;
+        };
+        const auto target = strengths(truth.c, truth.phi, truth.phi2);
+        std::vector<StrengthSample> history;
+        BondCapStep at{std::log(9e6), 25.0, 25.0};
+        int steps = 0;
+        double miss = 0;
+        for (; steps < 8; ++steps) {
+            history.push_back({at.log_cohesion, at.friction, strengths(std::exp(at.log_cohesion), at.friction,
+                                                                       at.confined_friction),
+                               at.confined_friction});
+            miss = 0;
+            for (std::size_t m = 0; m < 4; ++m) miss = std::max(miss, std::abs(history.back().log_strength[m] - target[m]));
+            if (miss < 0.01) break;
+            at = next_bond_cap(history, sigma3, target, sigma_star);
+            CHECK(at.friction >= 5.0);
+            CHECK(at.confined_friction >= 0.0);
+            CHECK(std::abs(at.confined_friction - history.back().confined_friction) <= 8.0 + 1e-9);
+        }
+        MESSAGE("truth phi " << truth.phi << ", phi2 " << truth.phi2 << ": c " << std::exp(at.log_cohesion) / 1e6
+                             << " MPa, phi " << at.friction << ", phi2 " << at.confined_friction << " after " << steps
+                             << " steps, largest miss " << miss);
+        CHECK(miss < 0.01);
+    }
+    CHECK_THROWS_AS(next_bond_cap({}, {1e6}, {0, 0}, 1e6), std::logic_error);
+}
+
 TEST_CASE("calibrate: the confined-friction step for phi2") {
     // First step: the prior slope, 0.05 per degree; σ1 too low by e^−0.2 → +4°.
     CHECK(next_confined_friction(5.0, -1.0, 0.0, 55.0, -0.2) == doctest::Approx(59.0));
