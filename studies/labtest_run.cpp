@@ -4,6 +4,7 @@
 
 #include "base/error.hpp"
 #include "core/solver.hpp"
+#include "studies/run_model.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -460,6 +461,9 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         }
         ratio_max = 0.0;
         if (progress) progress(p);
+        // Ctrl-C (or a scheduler's SIGTERM): a lab test has no checkpoint, so the
+        // command stops at once and writes nothing (apps/cli.cpp: exit status 130).
+        if (studies::stop_signal_received()) throw std::runtime_error("interrupted during a lab test");
         if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
         if (rules.stop_after(s, p, r)) break;
     }

@@ -39,6 +39,14 @@ if(NOT status EQUAL 2 OR NOT err MATCHES "--fit-curvature")
   message(FATAL_ERROR "fit-curvature = true in --config with one confined target should give status 2 naming "
                       "--fit-curvature, got ${status}: ${err}")
 endif()
+# Ctrl-C stops a lab test at once (it has no checkpoint): exit status 130, nothing written.
+file(REMOVE_RECURSE ${DIR}/interrupted)
+execute_process(COMMAND timeout --preserve-status -s INT 3 ${BBM} ucs --width 4 --height 8 --quiet --threads 1
+                        --out ${DIR}/interrupted
+                RESULT_VARIABLE status ERROR_VARIABLE err)
+if(NOT status EQUAL 130 OR NOT err MATCHES "interrupted" OR EXISTS ${DIR}/interrupted/summary.json)
+  message(FATAL_ERROR "SIGINT during bbm ucs should stop it with status 130 and no summary, got ${status}: ${err}")
+endif()
 # bbm shear: a bad combination of flags names the flag, exits 2 and keeps earlier output.
 execute_process(COMMAND ${BBM} shear --pattern single --persistence 0.5 --quiet --out ${DIR}/out
                 RESULT_VARIABLE status ERROR_VARIABLE err)
