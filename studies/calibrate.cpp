@@ -241,6 +241,55 @@ std::optional<std::array<double, N>> solve_small(std::array<std::array<double, N
 } // namespace
 
 namespace {
+/// The step of strength_step from the last sample `at` to the targets, in least
+/// squares on the strengths' planes (their predictions there and their slopes).
+template <int K>
+std::array<double, K> bounded_step(const std::vector<double>& predicted, const std::vector<std::array<double, K>>& slope,
+                                   const std::vector<double>& log_target, const std::array<double, K>& at) {
+    const std::size_t measures = log_target.size();
+    // The step from the last sample to the targets in least squares (a step, so
+    // that a direction the planes cannot see stays put), the UCS row twice as heavy.
+    std::array<std::array<double, K + 1>, K> normal{};
+    for (std::size_t m = 0; m < measures; ++m) {
+        const double w2 = m == 0 ? 4.0 : 1.0, miss = log_target[m] - predicted[m];
+        for (int r = 0; r < K; ++r) {
+            for (int c = 0; c < K; ++c) normal[r][c] += w2 * slope[m][r] * slope[m][c];
+            normal[r][K] += w2 * slope[m][r] * miss;
+        }
+    }
+    // The angles' steps within ±8° and their ranges (φ 5–55°, φ2 0–75°). An angle
+    // cut short is held at its cut step and the others solved again for it: the
+    // joint solution's other steps go with its whole step, and alone they throw the
+    // strengths away from their targets (Lac du Bonnet from the default bonds, every
+    // strength low: φ +8° of a wanted +34°, ln c −0.49, the UCS 190 → 145 MPa
+    // against 213).
+    const std::array<double, 3> lowest{0.0, 5.0, 0.0}, highest{0.0, 55.0, 75.0};
+    std::array<bool, K> held{};
+    std::array<double, K> step{};
+    for (int pass = 0; pass < K; ++pass) {
+        auto system = normal;
+        for (int k = 0; k < K; ++k)
+            if (held[k]) {
+                system[k].fill(0.0);
+                system[k][k] = 1.0, system[k][K] = step[k];
+            }
+        const auto solved = solve_small<K>(system);
+        if (!solved) return at;
+        step = *solved;
+        bool cut = false;
+        for (int k = 1; k < K; ++k) {
+            const double taken = std::clamp(at[k] + std::clamp(step[k], -8.0, 8.0), lowest[k], highest[k]) - at[k];
+            if (!held[k] && std::abs(taken - step[k]) > 1e-9) held[k] = cut = true;
+            step[k] = taken;
+        }
+        if (!cut) break;
+    }
+    std::array<double, K> next = at;
+    next[0] += std::clamp(step[0], -0.7, 0.7);
+    for (int k = 1; k < K; ++k) next[k] += step[k];
+    return next;
+}
+
 /// The strength step of next_cohesion_friction (K = 2: ln c, φ) and next_bond_cap
 /// (K = 3: ln c, φ, φ2 above σ*): the unknowns after the step, in that order.
 template <int K>
@@ -306,47 +355,7 @@ std::array<double, K> strength_step(const std::vector<StrengthSample>& history, 
         predicted[m] = (*fit)[0];
         for (int k = 0; k < K; ++k) slope[m][k] = (*fit)[k + 1];
     }
-    // The step from the last sample to the targets in least squares (a step, so
-    // that a direction the planes cannot see stays put), the UCS row twice as heavy.
-    std::array<std::array<double, K + 1>, K> normal{};
-    for (std::size_t m = 0; m < measures; ++m) {
-        const double w2 = m == 0 ? 4.0 : 1.0, miss = log_target[m] - predicted[m];
-        for (int r = 0; r < K; ++r) {
-            for (int c = 0; c < K; ++c) normal[r][c] += w2 * slope[m][r] * slope[m][c];
-            normal[r][K] += w2 * slope[m][r] * miss;
-        }
-    }
-    // The angles' steps within ±8° and their ranges (φ 5–55°, φ2 0–75°). An angle
-    // cut short is held at its cut step and the others solved again for it: the
-    // joint solution's other steps go with its whole step, and alone they throw the
-    // strengths away from their targets (Lac du Bonnet from the default bonds, every
-    // strength low: φ +8° of a wanted +34°, ln c −0.49, the UCS 190 → 145 MPa
-    // against 213).
-    const std::array<double, 3> lowest{0.0, 5.0, 0.0}, highest{0.0, 55.0, 75.0};
-    std::array<bool, K> held{};
-    std::array<double, K> step{};
-    for (int pass = 0; pass < K; ++pass) {
-        auto system = normal;
-        for (int k = 0; k < K; ++k)
-            if (held[k]) {
-                system[k].fill(0.0);
-                system[k][k] = 1.0, system[k][K] = step[k];
-            }
-        const auto solved = solve_small<K>(system);
-        if (!solved) return at;
-        step = *solved;
-        bool cut = false;
-        for (int k = 1; k < K; ++k) {
-            const double taken = std::clamp(at[k] + std::clamp(step[k], -8.0, 8.0), lowest[k], highest[k]) - at[k];
-            if (!held[k] && std::abs(taken - step[k]) > 1e-9) held[k] = cut = true;
-            step[k] = taken;
-        }
-        if (!cut) break;
-    }
-    std::array<double, K> next = at;
-    next[0] += std::clamp(step[0], -0.7, 0.7);
-    for (int k = 1; k < K; ++k) next[k] += step[k];
-    return next;
+    return bounded_step<K>(predicted, slope, log_target, at);
 }
 } // namespace
 
