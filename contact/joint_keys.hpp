@@ -57,8 +57,8 @@ inline constexpr JointKey joint_keys[] = {
      .absent = "brittle"},
     {.key = "shear_softening", .kind = KeyKind::curve, .meaning = "The same for the shear curve", .absent = "brittle"},
     {.key = "confined_friction", .bounds = below(0, 90, degrees),
-     .meaning = "A bond's friction angle φ2 above the normal stress confined_friction_from (an S-shaped envelope); "
-                "with confined_friction_from",
+     .meaning = "A bond's friction angle φ2 above the normal stress confined_friction_from (below friction: an "
+                "envelope flattening as rock's; above it: an S-shaped one); with confined_friction_from",
      .absent = "none", BBM_JOINT_FIELD(confined_friction)},
     {.key = "confined_friction_from", .bounds = above(0, pascals),
      .meaning = "The normal stress σ* above which confined_friction acts", .absent = "none",

@@ -24,12 +24,14 @@ struct JointPropertySpec {
     bool face_shear = false;
     double friction = 30.0;       ///< friction angle φ, degrees
     double residual_friction = -1; ///< φr after failure, degrees; < 0 = friction
-    /// A bonded joint's friction that steepens under high normal stress (an
-    /// S-shaped strength envelope of brittle rock: cohesion-controlled crack
-    /// initiation near an opening, a strength that climbs steeply with
-    /// confinement beyond it): above σn = `confined_friction_from` the bond's
-    /// Coulomb cap rises with tan `confined_friction` instead of tan φ.
-    /// Softening law only; broken joints keep φr. < 0 = none.
+    /// A bonded joint's friction above a normal stress: above σn =
+    /// `confined_friction_from` the bond's Coulomb cap rises with tan
+    /// `confined_friction` instead of tan φ. Flatter than φ, the envelope bends
+    /// down under confinement as rock's does (Hoek–Brown's concave curve; what
+    /// `bbm calibrate --fit-curvature` fits); steeper, it is S-shaped (brittle
+    /// rock's cohesion-controlled crack initiation near an opening, a strength
+    /// that climbs steeply with confinement beyond it). Softening law only;
+    /// broken joints keep φr. < 0 = none.
     double confined_friction = -1;           ///< φ2, degrees
     double confined_friction_from = 0.0;     ///< σ*, Pa (> 0 with confined_friction)
     double cohesion = 0.0;        ///< c, Pa (coulomb: brittle bond; softening: peak cohesion)
