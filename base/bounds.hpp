@@ -53,6 +53,7 @@ constexpr Bounds between(double lo, double hi, std::string_view unit) {
 constexpr std::string_view pascals = " Pa";
 constexpr std::string_view pascals_per_metre = " Pa/m";
 constexpr std::string_view metres = " m";
+constexpr std::string_view joules_per_square_metre = " J/m2";
 constexpr std::string_view degrees = " degrees";
 
 } // namespace bbm

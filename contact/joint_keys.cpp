@@ -39,6 +39,12 @@ std::optional<KeyProblem> check_joint_property(const JointPropertySpec& j) {
             if (!(value > 0))
                 return KeyProblem{key, "a softening law needs " + std::string(key) + " > 0 Pa, the peak the " + curve +
                                            " curve is normalised by; got " + shortest_text(value)};
+        for (const auto& [key, energy, curve, name] :
+             {std::tuple{"tension_fracture_energy", j.tension_fracture_energy, &j.tension_softening, "tension_softening"},
+              std::tuple{"shear_fracture_energy", j.shear_fracture_energy, &j.shear_softening, "shear_softening"}})
+            if (energy > 0.0 && curve->empty())
+                return KeyProblem{key, std::string("a fracture energy stretches a softening curve and needs ") + name +
+                                           " (a brittle bond dissipates nothing after its peak)"};
         if ((j.confined_friction >= 0.0) != (j.confined_friction_from > 0.0))
             return KeyProblem{j.confined_friction >= 0.0 ? "confined_friction" : "confined_friction_from",
                               "confined_friction (the steeper friction angle, degrees) and confined_friction_from "

@@ -56,6 +56,14 @@ inline constexpr JointKey joint_keys[] = {
                 "displacement at peak, increasing; β the stress over the peak, the last 0",
      .absent = "brittle"},
     {.key = "shear_softening", .kind = KeyKind::curve, .meaning = "The same for the shear curve", .absent = "brittle"},
+    {.key = "tension_fracture_energy", .bounds = above(0, joules_per_square_metre),
+     .meaning = "The energy G_I to break a bond in tension, the area under its tension curve: the curve's plastic "
+                "displacements are stretched, its shape kept, to dissipate it whatever kn and σt are (softening "
+                "lengths held as block size and calibration change kn); needs tension_softening",
+     .absent = "none: the curve's α are multiples of σt/kn", BBM_JOINT_FIELD(tension_fracture_energy)},
+    {.key = "shear_fracture_energy", .bounds = above(0, joules_per_square_metre),
+     .meaning = "The same in shear, G_II, at zero normal stress; needs shear_softening",
+     .absent = "none: the curve's α are multiples of c/ks", BBM_JOINT_FIELD(shear_fracture_energy)},
     {.key = "confined_friction", .bounds = below(0, 90, degrees),
      .meaning = "A bond's friction angle φ2 above the normal stress confined_friction_from (below friction: an "
                 "envelope flattening as rock's; above it: an S-shaped one); with confined_friction_from",

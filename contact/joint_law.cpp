@@ -37,7 +37,21 @@ BondFriction::BondFriction(const JointPropertySpec& p) : tan_phi(tan_deg(p.frict
     }
 }
 
-SofteningCurve::SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0) {
+double SofteningCurve::normalised_energy(const std::vector<std::pair<double, double>>& points) {
+    double area = 0.0, up = 0.0, s = 1.0;
+    for (const auto& [alpha, beta] : points) {
+        area += 0.5 * (s + beta) * (alpha - beta - up);
+        up = alpha - beta, s = beta;
+    }
+    return area;
+}
+
+SofteningCurve::SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0, double peak,
+                               double fracture_energy) {
+    // A fracture energy fixes the area: the unit of the plastic displacements is
+    // then G / (peak · normalised area) instead of u0 (the key checks keep the
+    // curve non-empty, so the area is > 0).
+    if (fracture_energy > 0.0 && !points.empty()) u0 = fracture_energy / (peak * normalised_energy(points));
     for (const auto& [alpha, beta] : points) {
         up_.push_back((alpha - beta) * u0);
         s_.push_back(beta);
@@ -107,8 +121,9 @@ void CoulombLaw::update_inelastic(JointHistory& h, double dus) const {
 
 SofteningLaw::SofteningLaw(const JointPropertySpec& p)
     : kn(p.kn), ks(p.ks), tan_phi(tan_deg(p.friction)), tan_phi_r(tan_deg(residual(p))),
-      cohesion(p.cohesion), tensile(p.tensile), friction(p), tension(p.tension_softening, p.tensile / p.kn),
-      shear(p.shear_softening, p.cohesion / p.ks) {}
+      cohesion(p.cohesion), tensile(p.tensile), friction(p),
+      tension(p.tension_softening, p.tensile / p.kn, p.tensile, p.tension_fracture_energy),
+      shear(p.shear_softening, p.cohesion / p.ks, p.cohesion, p.shear_fracture_energy) {}
 
 void SofteningLaw::update_inelastic(JointHistory& h, double dus) const {
     if (!h.bonded) {

@@ -47,8 +47,14 @@ namespace bbm::contact {
 class SofteningCurve {
 public:
     SofteningCurve() = default;
-    /// points (α, β) as in SPEC §4, u0 the elastic displacement at peak.
-    SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0);
+    /// points (α, β) as in SPEC §4, u0 the elastic displacement at peak. With a
+    /// fracture energy (> 0, J/m²) the plastic displacements are stretched so the
+    /// area under peak·S(up) is that energy; `peak` is then the strength.
+    SofteningCurve(const std::vector<std::pair<double, double>>& points, double u0, double peak = 0.0,
+                   double fracture_energy = -1.0);
+    /// The area under S over up / u0 of the normalised points: the fracture energy
+    /// over peak·u0 (1.6 for the paper's tension curve, 0.925 for its shear curve).
+    static double normalised_energy(const std::vector<std::pair<double, double>>& points);
     double operator()(double up) const;
     /// Smallest δ >= 0 with  excess − k δ <= peak·min(S(up + δ), other)  (the
     /// return of a trial stress `excess` above the cap, stiffness k). `other` is
@@ -142,10 +148,10 @@ struct CoulombLaw {
 
 struct SofteningLaw {
     static constexpr std::string_view name = "softening";
-    static constexpr std::array<std::string_view, 16> keys{
+    static constexpr std::array<std::string_view, 18> keys{
         "name",     "law",    "kn",  "ks", "face_shear", "friction", "residual_friction", "cohesion", "tensile",
         "weibull_modulus", "strength_classes", "strength_seed", "tension_softening", "shear_softening",
-        "confined_friction", "confined_friction_from"};
+        "tension_fracture_energy", "shear_fracture_energy", "confined_friction", "confined_friction_from"};
     double kn, ks, tan_phi, tan_phi_r, cohesion, tensile;
     BondFriction friction; ///< the bonded cap's frictional term, confined friction included
     SofteningCurve tension, shear;

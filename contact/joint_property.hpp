@@ -48,6 +48,15 @@ struct JointPropertySpec {
     /// in increasing α, the last with β = 0. Empty = brittle (drops to 0 at once).
     std::vector<std::pair<double, double>> tension_softening;
     std::vector<std::pair<double, double>> shear_softening;
+    /// Fracture energies (J/m²): the work to break a bond in pure tension and in
+    /// pure shear, the areas under its curves. Given, the curve's plastic
+    /// displacements are stretched (its shape kept) to dissipate that energy
+    /// whatever kn, ks and the strengths are: the softening displacements are
+    /// then lengths of the rock, not multiples of σt/kn, and do not shrink as
+    /// calibration at a finer block size stiffens the joints (docs/theory.md §4.2).
+    /// ≤ 0 = none: the curve's α are multiples of σt/kn and c/ks (SPEC §4).
+    double tension_fracture_energy = -1.0;
+    double shear_fracture_energy = -1.0;
     /// Heterogeneity of the strengths (grain boundaries of unequal strength, as
     /// grain-based models of granite have): with a Weibull modulus m > 0 each joint
     /// of the set gets its tensile strength and cohesion times a factor drawn from

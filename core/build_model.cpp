@@ -103,6 +103,10 @@ public:
         JointPropertySpec p = base;
         p.tensile *= f;
         p.cohesion *= f;
+        // As without fracture energies (σt·u0 ∝ f²): the set's energy is its mean
+        // class's, and a class's scales with its strength squared.
+        for (double* energy : {&p.tension_fracture_energy, &p.shear_fracture_energy})
+            if (*energy > 0.0) *energy *= f * f;
         p.weibull_modulus = 0.0;
         p.name += " (strength class " + std::to_string(k + 1) + " of " + std::to_string(classes) + ")";
         return class_sets_[{prop, k}] = derive(std::move(p));

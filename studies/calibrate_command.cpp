@@ -236,6 +236,10 @@ std::string calibrated_set_toml(const CalibrateCli& values, const CalibrationOpt
                                               "\nconfined_friction_from = " + shortest_text(j.confined_friction_from)
                                         : std::string()) +
             "\ntension_softening = " + pts(j.tension_softening) + "\nshear_softening = " + pts(j.shear_softening) + "\n";
+    // Held fracture energies: the curves above stretch to them at this set's kn and strengths.
+    for (const auto& [key, energy] : {std::pair{"tension_fracture_energy", j.tension_fracture_energy},
+                                      std::pair{"shear_fracture_energy", j.shear_fracture_energy}})
+        if (energy > 0.0) toml += std::string(key) + " = " + shortest_text(energy) + "\n";
     // The set's heterogeneity is part of it: without these lines the file would
     // describe a uniform rock the calibration never measured.
     if (j.weibull_modulus > 0.0)

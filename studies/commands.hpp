@@ -40,7 +40,8 @@ extern const char* const max_elements_help;
 /// --shear-softening as b1,a1,a2; its seed is the specimen's).
 inline constexpr std::string_view labtest_joint_keys[] = {
     "kn", "ks", "tensile", "cohesion", "friction", "residual_friction", "confined_friction",
-    "confined_friction_from", "weibull_modulus", "strength_classes"};
+    "confined_friction_from", "tension_fracture_energy", "shear_fracture_energy", "weibull_modulus",
+    "strength_classes"};
 
 /// The [[material]] keys (core/material_keys.hpp) the lab tests take as flags.
 inline constexpr std::string_view labtest_material_keys[] = {"density", "deformable_fraction", "young", "poisson"};

@@ -906,6 +906,18 @@ TEST_CASE("joint property mistakes") {
                      "confined_friction = 45\n"),
                 "confined_friction", "joint_property[0].confined_friction",
                 "key 'confined_friction' does not apply to a coulomb joint property");
+    // A fracture energy stretches a curve: it needs one.
+    {
+        const auto read = parse_model(
+            with(std::string(bond) + "tension_softening = [[1.7, 0.5], [4.0, 0.0]]\ntension_fracture_energy = 250\n"),
+            "t.toml");
+        CHECK(read.analysis.joint_properties[0].tension_fracture_energy == 250.0);
+        CHECK(read.analysis.joint_properties[0].shear_fracture_energy < 0.0);
+    }
+    check_error(with(std::string(bond) + "shear_fracture_energy = 900 # no curve\n"), "# no curve",
+                "joint_property[0].shear_fracture_energy", "needs shear_softening");
+    check_error(with(std::string(bond) + "tension_fracture_energy = 0 # zero\n"), "# zero",
+                "joint_property[0].tension_fracture_energy", "must be > 0 J/m2, got 0");
     // A softening law needs both peaks; a curve only belongs to a softening law.
     std::string no_peak = with(bond);
     no_peak.replace(no_peak.find("tensile = 5e5"), 13, "tensile = 0  ");

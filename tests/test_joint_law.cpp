@@ -76,6 +76,46 @@ TEST_CASE("softening law, shear at sigma_n = 0: curve points and G_II") {
     CHECK(work == doctest::Approx(gii).epsilon(0.01));
 }
 
+TEST_CASE("softening law with fracture energies: the same G_I and G_II at any stiffness and strength") {
+    // The paper's curves' areas in units of peak·u0 (SPEC §4): 1.6 and 0.925.
+    CHECK(SofteningCurve::normalised_energy({{1.7, 0.5}, {4.0, 0.0}}) == doctest::Approx(1.6).epsilon(1e-12));
+    CHECK(SofteningCurve::normalised_energy({{1.3, 0.5}, {2.1, 0.0}}) == doctest::Approx(0.925).epsilon(1e-12));
+    const double gi = 300.0, gii = 4000.0;
+    for (const double stiffer : {1.0, 2.5})       // a finer block size calibrates stiffer joints
+        for (const double stronger : {1.0, 1.3}) { // and may move the peaks
+            INFO("stiffness x" << stiffer << ", strengths x" << stronger);
+            auto p = paper_bond();
+            p.kn *= stiffer, p.ks *= stiffer, p.tensile *= stronger, p.cohesion *= stronger;
+            p.tension_fracture_energy = gi, p.shear_fracture_energy = gii;
+            const SofteningLaw law(p);
+            // Tension: pulled until broken; the peak is still σt at σt/kn, the
+            // curve ends (zero stress) at the plastic displacement 4.0 · G_I / (1.6 σt).
+            JointHistory h;
+            const double end = 4.0 * gi / (1.6 * p.tensile), du = end / 20000;
+            double work = 0.0, prev = 0.0, peak = 0.0;
+            while (h.bonded) {
+                law.update(h, du, 0.0);
+                work += 0.5 * (prev - h.sn) * du;
+                prev = -h.sn;
+                peak = std::max(peak, -h.sn);
+            }
+            CHECK(peak == doctest::Approx(p.tensile).epsilon(1e-3));
+            CHECK(h.un == doctest::Approx(end).epsilon(1e-3));
+            CHECK(work == doctest::Approx(gi).epsilon(0.005));
+            CHECK(h.dissipated == doctest::Approx(gi).epsilon(0.005));
+            // Shear at σn = 0.
+            JointHistory s;
+            const double ds = 2.1 * gii / (0.925 * p.cohesion) / 20000;
+            work = prev = 0.0;
+            while (s.bonded) {
+                law.update(s, 0.0, ds);
+                work += 0.5 * (prev + s.tau) * ds;
+                prev = s.tau;
+            }
+            CHECK(work == doctest::Approx(gii).epsilon(0.005));
+        }
+}
+
 TEST_CASE("softening law, shear at sigma_n = 5 MPa: peak c + sn tan phi, residual sn tan phi") {
     const auto p = paper_bond();
     const SofteningLaw law(p);
