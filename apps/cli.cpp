@@ -284,13 +284,12 @@ int run_cli(int argc, char** argv) {
     } catch (const NumericalError& e) {
         if (studies::Ranks::root()) std::fprintf(stderr, "bbm: stopped: %s\n", e.what());
         return 3;
+    } catch (const Interrupted& e) {
+        // A lab test, calibration, envelope or shear test stopped by SIGINT/SIGTERM
+        // (`bbm run` writes a checkpoint and returns 130 itself).
+        std::fprintf(stderr, "bbm: interrupted: stopped without writing output (%s)\n", e.what());
+        return 130;
     } catch (const std::exception& e) {
-        if (studies::stop_signal_received()) {
-            // A lab test, calibration, envelope or shear test stopped by SIGINT/SIGTERM
-            // (`bbm run` writes a checkpoint and returns 130 itself).
-            std::fprintf(stderr, "bbm: interrupted: stopped without writing output (%s)\n", e.what());
-            return 130;
-        }
         std::fprintf(stderr, "bbm: error%s: %s\n",
                      studies::Ranks::size() > 1 ? (" on rank " + std::to_string(studies::Ranks::rank())).c_str() : "",
                      e.what());

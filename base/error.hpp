@@ -53,6 +53,14 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// A study stopped by SIGINT, SIGTERM or SIGUSR1 (a lab test, calibration, envelope,
+/// shear test, or a sweep's run not yet started): bbm exits with status 130 and
+/// writes nothing for it (`bbm run` checkpoints instead and returns 130 itself).
+class Interrupted : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 /// The implicit elastic system has no unique solution: a block, node or group can
 /// move without resistance (no joints or broken ones, no support). A caller that
 /// has another way on (a lab test loading explicitly) catches this type alone.

@@ -463,7 +463,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         if (progress) progress(p);
         // Ctrl-C (or a scheduler's SIGTERM): a lab test has no checkpoint, so the
         // command stops at once and writes nothing (apps/cli.cpp: exit status 130).
-        if (studies::stop_signal_received()) throw std::runtime_error("interrupted during a lab test");
+        if (studies::stop_signal_received()) throw Interrupted("interrupted during a lab test");
         if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
         if (rules.stop_after(s, p, r)) break;
     }

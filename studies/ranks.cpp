@@ -24,7 +24,7 @@ bool started = false;
 int this_rank = 0, rank_count = 1;
 
 /// How a run ended, to raise the same error on every rank.
-enum class Outcome : std::uint8_t { ok, input_error, numerical_error, other_error };
+enum class Outcome : std::uint8_t { ok, input_error, numerical_error, interrupted, other_error };
 
 struct RunResult {
     Outcome outcome = Outcome::ok;
@@ -47,6 +47,7 @@ std::string join_fields(const InputError& e) {
         throw InputError(f[0], std::atoi(f[1].c_str()), f[2], r.text.substr(start));
     }
     if (r.outcome == Outcome::numerical_error) throw NumericalError(r.text);
+    if (r.outcome == Outcome::interrupted) throw Interrupted(r.text);
     throw std::runtime_error(r.text);
 }
 
@@ -137,6 +138,8 @@ std::vector<std::string> run_spread(int n, int threads, const std::function<std:
                 r = {Outcome::input_error, join_fields(e)};
             } catch (const NumericalError& e) {
                 r = {Outcome::numerical_error, e.what()};
+            } catch (const Interrupted& e) {
+                r = {Outcome::interrupted, e.what()};
             } catch (const std::exception& e) {
                 r = {Outcome::other_error, e.what()};
             }

@@ -248,7 +248,7 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
         const double t = target(p.dilation) / w;
         if (t > 0) r.normal_stress_error = std::max(r.normal_stress_error, std::abs(p.normal_stress - t) / t);
         if (progress) progress(p);
-        if (studies::stop_signal_received()) throw std::runtime_error("interrupted during a shear test"); // as a lab test's
+        if (studies::stop_signal_received()) throw Interrupted("interrupted during a shear test"); // as a lab test's
         if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
     }
     shear_figures(r, peak);

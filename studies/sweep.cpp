@@ -159,7 +159,7 @@ std::string run_one(const SweepOptions& o, const SweepRun& r, bool quiet) {
     // Interrupted (Ctrl-C, a scheduler's signal): the runs under way stop with a
     // checkpoint, no further run starts; `bbm sweep --resume` runs the rest.
     if (stop_signal_received())
-        throw std::runtime_error("not started: the sweep was interrupted (bbm sweep --resume runs it)");
+        throw Interrupted("not started: the sweep was interrupted (bbm sweep --resume runs it)");
     const fs::path dir = o.out / r.dir;
     if (o.resume && fs::exists(dir / "summary.json") && read_text(dir / "model.toml") == r.text) {
         const auto s = nlohmann::json::parse(read_text(dir / "summary.json"), nullptr, false);
