@@ -48,17 +48,22 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
     an.boundaries.push_back(top);
     Solver s(blocks, an);
     s.solve_elastic();
-    const auto& b = s.blocks();
     double y_lo = 0, y_hi = 0, x_left = 0, x_right = 0;
     int n_lo = 0, n_hi = 0, n_left = 0, n_right = 0;
     const double h = o.height, w = o.width, d = o.size;
-    for (int i = 0; i < b.count(); ++i) {
-        const Vec2 c = b.centroid0[i], u = b.centroid[i] - b.centroid0[i];
+    // Displacements sampled at the rigid blocks' centroids and the deformable
+    // blocks' nodes (a deformable block's centroid does not move).
+    const auto sample = [&](Vec2 c, Vec2 u) {
         if (std::abs(c.y - 0.3 * h) < d) y_lo += u.y, ++n_lo;
         if (std::abs(c.y - 0.7 * h) < d) y_hi += u.y, ++n_hi;
         if (c.y > 0.3 * h && c.y < 0.7 * h && c.x < d) x_left += u.x, ++n_left;
         if (c.y > 0.3 * h && c.y < 0.7 * h && c.x > w - d) x_right += u.x, ++n_right;
-    }
+    };
+    const auto& b = s.blocks();
+    for (int i = 0; i < b.count(); ++i)
+        if (!b.deformable[i]) sample(b.centroid0[i], b.centroid[i] - b.centroid0[i]);
+    const auto& nodes = s.nodes();
+    for (int i = 0; i < nodes.count(); ++i) sample(nodes.position0[i], nodes.position[i] - nodes.position0[i]);
     const double axial = (y_hi / n_hi - y_lo / n_lo) / (0.4 * h);
     const double lateral = (x_right / n_right - x_left / n_left) / w;
     return {-1e6 / axial, -lateral / axial};
@@ -108,6 +113,8 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     // Runs k: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests at
     // each confinement; shared among the threads and ranks.
     const int runs = (2 + int(confinements.size())) * n;
+    // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
+    const bool one_at_a_time = o.base.material.deformable_fraction > 0.0;
     // Each run travels (between ranks under mpirun) as the five numbers used here.
     struct Measured {
         double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0;
@@ -117,7 +124,7 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
         LabTestOptions lo = o.base;
         lo.joint = joint;
         lo.seed = first_seed + std::uint64_t(k % n);
-        lo.threads = 1;
+        lo.threads = one_at_a_time ? o.threads : 1;
         if (k < n) {
             lo.kind = LabTestOptions::Kind::ucs;
         } else if (k < 2 * n) {
@@ -138,7 +145,7 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     };
     // Runs over ranks and threads; every rank gets every result.
     std::vector<Measured> measured(static_cast<std::size_t>(runs));
-    const auto texts = studies::run_spread(runs, o.threads, run);
+    const auto texts = studies::run_spread(runs, one_at_a_time ? 1 : o.threads, run);
     for (int k = 0; k < runs; ++k) {
         Measured& m = measured[std::size_t(k)];
         if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf %d", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation,
