@@ -666,8 +666,12 @@ int run_model(const RunOptions& opt) {
     if (opt.profile) summary["profile"] = report_profile(solver->profile(), solver->contacts().size());
     FailurePlotOptions fo = failure_plot_options(model, blocks, *solver, model_path);
     fo.shade_pressure = opt.shade_pressure;
-    if (!health.empty()) summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
-    else draw_pictures(*solver, output, opt, fo);
+    if (!health.empty()) {
+        summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
+        output.flush_history();    // its rows so far: how the stage went wrong
+    } else {
+        draw_pictures(*solver, output, opt, fo);
+    }
     write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");
     if (!health.empty()) {
         std::fprintf(stderr, "\nbbm: stopped: %s\nThe output of the last good step is kept in %s.\n", health.c_str(),

@@ -114,3 +114,11 @@ endif()
 if(NOT err MATCHES "solver.timestep")
   message(FATAL_ERROR "the message should say what to change: ${err}")
 endif()
+# Its history so far is kept: the rows of the stage that went wrong (written only
+# at a stage's end before 2026-11-30, so a run stopped inside its first long
+# stage kept none).
+file(STRINGS ${DIR}/unstable/history.csv rows)
+list(LENGTH rows n)
+if(n LESS 5)
+  message(FATAL_ERROR "the stopped run's history.csv should keep its rows so far: ${n} lines")
+endif()
