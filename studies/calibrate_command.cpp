@@ -245,6 +245,15 @@ std::string calibrated_set_toml(const CalibrateCli& values, const CalibrationOpt
     if (j.weibull_modulus > 0.0)
         toml += "weibull_modulus = " + shortest_text(j.weibull_modulus) +
                 "\nstrength_classes = " + std::to_string(j.strength_classes) + "\n";
+    // Bonds calibrated with deformable blocks hold only with them: kn and ks are the
+    // rock's, split by the blocks' share f (SPEC §6). The material travels with them.
+    const MaterialSpec& m = o.base.material;
+    if (m.deformable_fraction > 0.0)
+        toml += "\n# The blocks the bonds were calibrated with (a region with a mesh of " +
+                fmt_number(o.base.mesh_size > 0.0 ? o.base.mesh_size : 0.5 * o.base.size) +
+                " m triangles):\n[[material]]\nname = \"calibrated\"\ndensity = " + shortest_text(m.density) +
+                "\nyoung = " + shortest_text(m.young) + "\npoisson = " + shortest_text(m.poisson) +
+                "\ndeformable_fraction = " + shortest_text(m.deformable_fraction) + "\n";
     return toml;
 }
 
