@@ -265,7 +265,6 @@ TEST_CASE("calibrate: the heterogeneity step for sigma_ci/UCS") {
     CHECK(next_heterogeneity(0.8, 0.40, 0.9, 0.38, 0.10) == 1.0);
 }
 
-
 TEST_CASE("calibrate: the elastic measure of deformable blocks puts the blocks' and the bonds' compliances in series") {
     // Rigid blocks on bonds kn, ks give the modulus E_r. With the deformation split
     // (SPEC §6), blocks of E0 / f on bonds kn / (1 − f), ks / (1 − f), the specimen's
