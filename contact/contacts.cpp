@@ -191,7 +191,8 @@ void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_ra
             const int A = c.vertex_block[i], B = c.edge_block[i];
             const Vec2 x = b.vertex[c.vertex_id[i]];
             const ContactFrame fr = contact_frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]],
-                                                  b.inv_edge_length[c.edge_id[i]], c.history[i].bonded, corner_radius);
+                                                  b.inv_edge_length[c.edge_id[i]], c.history[i].bonded, corner_radius,
+                                                  b.corner, c.edge_id[i], c.edge_end[i]);
             const Vec2 vr = vertex_velocity(b, A, c.vertex_id[i], x) - edge_velocity(b, B, c.edge_id[i], c.edge_end[i], fr.s, x);
             sum += c.length[i] * dot(vr, fr.t) * dt;
             length += c.length[i];
@@ -241,7 +242,9 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
         const int A = va[i], B = eb[i];
         const Vec2 x = vertex[vid[i]];
         JointHistory& h = hist[i];
-        const auto [n, t, s] = contact_frame(x, vertex[e0[i]], vertex[e1[i]], inv_edge[e0[i]], h.bonded, corner_radius);
+        // Rigid blocks: every vertex is a corner (null: no load in the loop).
+        const auto [n, t, s] = contact_frame(x, vertex[e0[i]], vertex[e1[i]], inv_edge[e0[i]], h.bonded, corner_radius,
+                                             Mixed ? b.corner : nullptr, e0[i], e1[i]);
         const BodyState& bA = body[A];
         const BodyState& bB = body[B];
         const Vec2 ra = x - bA.centroid, rb = x - bB.centroid;

@@ -16,7 +16,11 @@
 // the vertex — which turns continuously from one edge's normal to the next's; the
 // contact passes to the neighbouring edge, with its history, once the vertex is
 // past the corner by more than the detection tolerance and projects onto that
-// edge. A bonded contact keeps its edge and the edge's normal: an intact joint
+// edge. Only corners are rounded: a node along a deformable block's face is none
+// (BlockView::corner), the edge's line goes on past it, and on a deformable block
+// the contact passes to the next edge as soon as it is beyond the end, its normal
+// displacement taken from the new edge (docs/theory.md §3.3–3.4). A bonded contact
+// keeps its edge and the edge's normal: an intact joint
 // moves by elastic amounts only, and its contacts sit exactly on edge ends, where
 // rounding noise must not turn the normal of a loaded bond (that would add a
 // spurious geometric stiffness F/r).
@@ -66,6 +70,11 @@ struct BlockView {
     const std::uint8_t* deformable; ///< per block
     const int* vertex_node;         ///< per vertex: its node, −1 on rigid blocks
     const Vec2* node_velocity;      ///< per node
+    /// Per vertex: 1 where the boundary turns at it (a corner, which an unbonded
+    /// contact past the end of an edge meets rounded), 0 where a deformable block's
+    /// boundary runs on straight or bends inwards (a node along a face: past it the
+    /// edge's line goes on, and the contact passes to the next edge at once).
+    const std::uint8_t* corner;
 };
 
 /// Velocity of the material point of block `blk` at `x`, which is its vertex `v`
@@ -189,18 +198,24 @@ inline Vec2 tangent_of(Vec2 n) { return {-n.y, n.x}; }
 /// The frame of a contact whose vertex x lies against the edge p → q (1/|q − p| =
 /// inv_len): normal n (the edge's outward normal), tangent t, and the vertex's
 /// parameter s along the edge. An unbonded contact beyond an end of its edge takes
-/// the normal of the rounded corner. The step loop, the face pass and
-/// contact_kinematics all read the frame from here.
+/// the normal of the rounded corner if that end is a corner (`corner`, per vertex,
+/// of the ends p_id and q_id; null: every vertex is one, as on rigid blocks). The
+/// step loop, the face pass and contact_kinematics all read the frame from here.
 struct ContactFrame {
     Vec2 n, t;
     double s;
 };
-inline ContactFrame contact_frame(Vec2 x, Vec2 p, Vec2 q, double inv_len, bool bonded, double corner_radius) {
+inline ContactFrame contact_frame(Vec2 x, Vec2 p, Vec2 q, double inv_len, bool bonded, double corner_radius,
+                                  const std::uint8_t* corner = nullptr, int p_id = 0, int q_id = 0) {
     ContactFrame f;
     f.t = inv_len * (q - p);
     f.n = Vec2{f.t.y, -f.t.x}; // outward normal of a counter-clockwise polygon's edge
     f.s = dot(x - p, f.t) * inv_len;
     if (!bonded && (f.s < 0.0 || f.s > 1.0)) [[unlikely]] {
+        // A node along a deformable block's face is no corner: rounded, the gap
+        // past it would grow as the square of the distance while the vertex slides
+        // on along the face (and into the next edge, unseen).
+        if (corner && !corner[f.s < 0.0 ? p_id : q_id]) return f;
         const Vec2 r = x - ((f.s < 0.0 ? p : q) - corner_radius * f.n);
         const double rl = norm(r);
         if (rl > 0.0) f.n = r / rl, f.t = Vec2{-f.n.y, f.n.x};
@@ -211,7 +226,8 @@ inline ContactFrame contact_frame(Vec2 x, Vec2 p, Vec2 q, double inv_len, bool b
 /// Normal of contact i from the current geometry (used outside the step loop).
 inline void contact_kinematics(Contacts& c, int i, const BlockView& b, double corner_radius) {
     c.normal[i] = contact_frame(b.vertex[c.vertex_id[i]], b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]],
-                                b.inv_edge_length[c.edge_id[i]], c.history[i].bonded, corner_radius)
+                                b.inv_edge_length[c.edge_id[i]], c.history[i].bonded, corner_radius, b.corner,
+                                c.edge_id[i], c.edge_end[i])
                       .n;
 }
 

@@ -239,12 +239,13 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
         }
         const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
         double gap = frame(x, b.vertex[best], b.vertex[e1]).gap;
-        if (s_on < 0.0 || s_on > 1.0) {
+        if ((s_on < 0.0 || s_on > 1.0) && b.corner[s_on < 0.0 ? best : e1]) {
             // Past the end of the edge the contact's surface is the rounded corner
             // (contact_kinematics), not the edge's line: a vertex beside the corner
             // but inside that line is not in overlap. Measured against the line it
             // would start compressed by up to the tolerance — at kn, hundreds of MPa
             // on a fresh vertex-vertex contact (docs/calibration.md, After the peak).
+            // Past a node along a deformable face, the line goes on (contact_frame).
             const Vec2 centre = (s_on < 0.0 ? b.vertex[best] : b.vertex[e1]) - in.corner_radius * n;
             const Vec2 r = x - centre;
             const double rl = norm(r);
@@ -273,7 +274,7 @@ void Detector::start_pass(const Contacts& c, const DetectionInput& in) {
         team_.resize(std::max(1, omp_get_num_threads()));
         for (auto& t : team_) {
             t.candidates.clear();
-            t.dropped = t.dropped_tensile = t.dropped_shear = t.transferred = 0;
+            t.dropped = t.dropped_tensile = t.dropped_shear = t.transferred = t.transferred_on_nodes = 0;
         }
         stale_ = !grid_valid_;
         left_box_ = false;
@@ -298,7 +299,14 @@ void Detector::transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadSc
             const Vec2 x = b.vertex[c.vertex_id[i]];
             EdgeFrame f = frame(x, b.vertex[c.edge_id[i]], b.vertex[c.edge_end[i]]);
             const double len = 1.0 / b.inv_edge_length[c.edge_id[i]];
-            if (std::max(-f.s, f.s - 1.0) * len > tol) {
+            // Past a rigid block's corner the contact rides the rounding until it is
+            // past by the tolerance. A deformable block's boundary is a chain of
+            // short edges whose nodes are mostly no corners: a vertex that kept to
+            // the first edge while it slid on would be measured against the wrong
+            // line, and could pass into the block unresisted (blocks overlap in the
+            // crushed notch of deformable blocks, docs/notes). It passes on at once.
+            const bool chain = b.deformable[B];
+            if (std::max(-f.s, f.s - 1.0) * len > (chain ? 0.0 : tol)) {
                 const bool back = f.s < 0.0;
                 const int e0 = back ? prev_vertex(b.first, B, c.edge_id[i]) : c.edge_end[i];
                 const int e1 = back ? c.edge_id[i] : next_vertex(b.first, B, c.edge_end[i]);
@@ -306,6 +314,15 @@ void Detector::transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadSc
                 if (g.s >= 0.0 && g.s <= 1.0 && g.gap > -tol) {
                     c.edge_id[i] = e0;
                     c.edge_end[i] = e1;
+                    if (chain) {
+                        // Its normal displacement from the new edge's geometry, as a
+                        // contact born there would have it (add_candidates): the
+                        // rounding or the old line it was measured on is left behind.
+                        const Vec2 vr = vertex_velocity(b, A, c.vertex_id[i], x) - edge_velocity(b, B, e0, e1, g.s, x);
+                        const Vec2 n = b.inv_edge_length[e0] * (b.vertex[e1] - b.vertex[e0]);
+                        c.history[i].un = g.gap - dot(vr, Vec2{n.y, -n.x}) * in.dt;
+                        ++mine.transferred_on_nodes;
+                    }
                     f = g;
                     ++mine.transferred;
                 }
@@ -404,11 +421,13 @@ void Detector::accept_candidates(Contacts& c, const DetectionInput& in) {
 #pragma omp single
     {
         DetectionResult res;
+        int on_nodes = 0;
         // The threads' runs of active blocks follow each other in block order.
         candidates_.clear();
         for (auto& t : team_) {
             candidates_.insert(candidates_.end(), t.candidates.begin(), t.candidates.end());
             res.transferred += t.transferred;
+            on_nodes += t.transferred_on_nodes;
             res.removed += t.dropped;
             res.removed_tensile += t.dropped_tensile;
             res.removed_shear += t.dropped_shear;
@@ -444,6 +463,7 @@ void Detector::accept_candidates(Contacts& c, const DetectionInput& in) {
             std::fill(drop_.begin(), drop_.end(), 0);
         }
         result_ = res;
+        transferred_on_nodes_ = on_nodes;
     }
 }
 

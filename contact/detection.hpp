@@ -112,6 +112,9 @@ public:
     void invalidate() { grid_valid_ = false; }
     /// How many times the broad-phase grid has been built (for statistics).
     long grid_builds() const { return grid_builds_; }
+    /// Of the last pass's transfers, those onto another edge of a deformable block:
+    /// they change which nodes a contact loads, so the index is stale after them too.
+    int transferred_on_nodes() const { return transferred_on_nodes_; }
 
 private:
     /// A run of at most 16 consecutive vertices of a block and the edges they start.
@@ -161,13 +164,14 @@ private:
     struct alignas(64) ThreadScratch {
         std::vector<Candidate> candidates;
         std::vector<int> near;
-        int dropped = 0, dropped_tensile = 0, dropped_shear = 0, transferred = 0;
+        int dropped = 0, dropped_tensile = 0, dropped_shear = 0, transferred = 0, transferred_on_nodes = 0;
     };
     std::vector<ThreadScratch> team_;
     std::vector<Candidate> candidates_;
     std::vector<int> order_, accepted_;
     bool stale_ = false, left_box_ = false; ///< this pass: grid invalid, a piece left its box
     DetectionResult result_;
+    int transferred_on_nodes_ = 0;
 };
 
 } // namespace bbm::contact

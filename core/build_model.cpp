@@ -221,6 +221,19 @@ void Solver::build_bodies(const meshing::BlockAssembly& a, const AnalysisSpec& a
     b_.removed.assign(nb, 0);
     b_.deformable = a.deformable.size() == std::size_t(nb) ? a.deformable : std::vector<std::uint8_t>(nb, 0);
     b_.vertex_node = a.vertex_node.size() == a.points.size() ? a.vertex_node : std::vector<int>(a.points.size(), -1);
+    // Corners: where a deformable block's boundary turns outwards by more than
+    // 10° (a polygon's corner, not one of the nodes its mesh put along a face);
+    // every vertex of a rigid block.
+    b_.corner.assign(a.points.size(), 1);
+    const double corner_turn = std::sin(10.0 * M_PI / 180.0);
+    for (int i = 0; i < nb; ++i) {
+        if (!b_.deformable[i]) continue;
+        for (std::uint32_t v = a.first[i]; v < a.first[i + 1]; ++v) {
+            const Vec2 prev = a.points[v == a.first[i] ? a.first[i + 1] - 1 : v - 1];
+            const Vec2 in = a.points[v] - prev, out = a.points[contact::next_vertex(a.first.data(), i, int(v))] - a.points[v];
+            b_.corner[v] = cross(in, out) > corner_turn * norm(in) * norm(out);
+        }
+    }
 
     // FE nodes and zones of deformable blocks: lumped mass ρA/3 per zone corner.
     n_.position = n_.position0 = a.nodes;

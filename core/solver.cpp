@@ -162,7 +162,8 @@ contact::BlockView Solver::view() const {
     return {body_.data(),
             b_.centroid.data(),        b_.velocity.data(),   b_.omega.data(),
             b_.vertex.data(),          b_.first.data(),      b_.inv_edge_length.data(),
-            b_.deformable.data(),      b_.vertex_node.data(), n_.velocity.data()};
+            b_.deformable.data(),      b_.vertex_node.data(), n_.velocity.data(),
+            b_.corner.data()};
 }
 
 void Solver::place_rigid_block(int i) {
@@ -657,7 +658,12 @@ void Solver::detection_pass() {
         detection_totals_.transferred += r.transferred;
         detection_totals_.removed_tensile += r.removed_tensile;
         detection_totals_.removed_shear += r.removed_shear;
-        if (r.created > 0 || r.removed > 0) {
+        // A contact passed to another edge of a deformable block loads that edge's
+        // nodes: the per-node index (and the faces of face_shear) must follow it,
+        // or its force would go on to the nodes it left, and a resumed run, which
+        // builds the index afresh, would part from the uninterrupted one.
+        const bool moved_on_nodes = detector_.transferred_on_nodes() > 0;
+        if (r.created > 0 || r.removed > 0 || moved_on_nodes) {
             // New contacts are appended; once they are more than a sixteenth of all,
             // renumber the contacts by block again (the loop's locality) — rarely
             // enough that the renumbering costs little.

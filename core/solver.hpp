@@ -207,6 +207,9 @@ public:
         std::vector<double> inv_edge_length; ///< per vertex: 1 / length of the edge it starts
         std::vector<std::uint32_t> first;
         std::vector<int> vertex_node; ///< per vertex: its FE node, −1 on rigid blocks
+        /// Per vertex: 1 at a corner of its block (every vertex of a rigid block),
+        /// 0 at a node along a deformable block's face (contact::BlockView::corner).
+        std::vector<std::uint8_t> corner;
         int count() const { return static_cast<int>(centroid.size()); }
     };
     /// FE nodes of deformable blocks.

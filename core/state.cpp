@@ -147,6 +147,7 @@ void Solver::for_each_body_field(Self& s, Visit& v) {
     v({"blocks.deformable", G::blocks, R}, b.deformable), v({"blocks.region", G::blocks, R}, b.region);
     v({"blocks.material", G::blocks, R}, b.material), v({"blocks.first", G::blocks, R}, b.first);
     v({"blocks.vertex", G::vertices, R}, b.vertex), v({"blocks.vertex_node", G::vertices, R}, b.vertex_node);
+    v({"blocks.corner", G::vertices, R}, b.corner);
     v({"blocks.force", G::blocks, R}, b.force), v({"blocks.moment", G::blocks, R}, b.moment);
     // FE nodes and zones.
     v({"nodes.position", G::nodes, E}, n.position), v({"nodes.velocity", G::nodes, E}, n.velocity);
