@@ -334,6 +334,14 @@ TEST_CASE("fem: a deformable block slides down a deformable plane at g (sin θ �
     // overshoots. The bound sits between rocking (tens of µm) and sinking (mm).
     CHECK(deepest < 10.0 * sigma_n / kn);
     CHECK(deepest_base < 5.0 * sigma_n / kn);
+    test::record_check(test::Against::closed_form,
+                       "a deformable block sliding down a deformable plane, its nodes passing the plane's",
+                       "a = g (sin θ − cos θ tan φ) = " + test::figure(expected, 4) + " m/s²; no node sinks in",
+                       "within 1%; deepest node under 10 σn/kn",
+                       test::figure(a, 4) + " m/s² (" + test::percent(a, expected) + "), deepest node " +
+                           test::figure(deepest * 1e6, 2) + " µm = " + test::figure(deepest / (sigma_n / kn), 2) +
+                           " σn/kn",
+                       std::abs(a / expected - 1.0) <= 0.01 && deepest < 10.0 * sigma_n / kn);
 }
 
 TEST_CASE("fem: a P-wave travels down a deformable column at the P-wave speed within 2%") {
