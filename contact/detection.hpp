@@ -104,7 +104,8 @@ class Detector {
 public:
     /// One pass (steps 1–4 above). Needs `c`'s index (Contacts::rebuild_index) to
     /// be current; leaves it stale if contacts were created or removed (the
-    /// result says so), for the caller to rebuild once. Called by every thread of
+    /// result says so) or passed to another edge of a deformable block
+    /// (transferred_on_nodes), for the caller to rebuild once. Called by every thread of
     /// an OpenMP team (all get the result), or outside one: the same contacts in
     /// the same order on any number of threads.
     DetectionResult update(Contacts& c, const DetectionInput& in);
