@@ -31,6 +31,7 @@ enum class KeyKind {
     segments, ///< an array of segments [[[x1, y1], [x2, y2]], ...] (bolts' heads and toes)
     numbers, ///< an array of numbers (a list of angles)
     table,   ///< an inline table of its own keys (a ring of bolts)
+    rows,    ///< an array of rows of numbers [[a, b, c], ...] (a path through a stage)
 };
 
 template <class Spec>
@@ -72,6 +73,7 @@ inline std::string key_value_text(KeyKind kind, const Bounds& b) {
     case KeyKind::names: return "array of names";
     case KeyKind::segments: return "[[[x1, y1], [x2, y2]], ...]" + std::string(b.unit);
     case KeyKind::table: return "table";
+    case KeyKind::rows: return "[[a, b, c], ...]";
     case KeyKind::numbers: return "array of numbers" + (b.text().empty() ? std::string(b.unit) : " " + b.text());
     case KeyKind::integer: return "whole number " + b.text();
     case KeyKind::number: break;

@@ -16,6 +16,7 @@
 #include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
 
+#include <array>
 #include <optional>
 #include <string>
 #include <utility>
@@ -139,6 +140,12 @@ struct StageSpec {
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
     double keep = 0.0;                 ///< excavate: fraction of the support kept for good (a support pressure)
     double pressure = 0.0;             ///< excavate: Pa on the new boundary, normal to it, for good; pressurise: target
+    /// excavate: the support's path instead of a linear relaxation, rows [t, k_mean,
+    /// k_deviator] from t = 0 to t = 1 over relax_steps: the fractions of the
+    /// in-situ support's mean and deviatoric parts left at t (the last row's for
+    /// good). A tunnel face's three-dimensional stress path in a plane section
+    /// (examples/field/face_path.py; docs/theory.md §9.2).
+    std::vector<std::array<double, 3>> support_path;
     std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
 };
 

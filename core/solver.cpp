@@ -290,7 +290,8 @@ void Solver::initialize_stress(const StressFieldSpec& field) {
     }
 }
 
-void Solver::excavate(const std::vector<std::string>& regions, long relax_steps, double keep, double pressure) {
+void Solver::excavate(const std::vector<std::string>& regions, long relax_steps, double keep, double pressure,
+                      const SupportPath& path) {
     for (int i = 0; i < b_.count(); ++i)
         if (selected(regions, region_names_[b_.region[i]]) && !regions.empty()) b_.removed[i] = 1;
     refresh_normals();
@@ -300,6 +301,13 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
     relax_block_force_.assign(relaxing ? b_.count() : 0, {});
     relax_block_moment_.assign(relaxing ? b_.count() : 0, 0.0);
     relax_node_force_.assign(relaxing ? n_.count() : 0, {});
+    const bool along_path = relaxing && !path.rows.empty();
+    relax_path_.clear();
+    if (along_path)
+        for (const auto& row : path.rows) relax_path_.insert(relax_path_.end(), row.begin(), row.end());
+    relax_deviator_block_force_.assign(along_path ? b_.count() : 0, {});
+    relax_deviator_block_moment_.assign(along_path ? b_.count() : 0, 0.0);
+    relax_deviator_node_force_.assign(along_path ? n_.count() : 0, {});
     pressure_block_force_.assign(pressure > 0.0 ? b_.count() : 0, {});
     pressure_block_moment_.assign(pressure > 0.0 ? b_.count() : 0, 0.0);
     pressure_node_force_.assign(pressure > 0.0 ? n_.count() : 0, {});
@@ -332,6 +340,15 @@ void Solver::excavate(const std::vector<std::string>& regions, long relax_steps,
         if (relaxing)
             add_to_kept(i, x, sign * contact::contact_force(c_, i), relax_block_force_, relax_block_moment_,
                         relax_node_force_);
+        // The support's deviatoric part: the in-situ deviator's traction on the kept
+        // side (its outward normal is -n on A, n on B) over the contact's length.
+        if (along_path) {
+            const auto s = stress_at(path.in_situ, x.y);
+            const double mean = 0.5 * (s[0] + s[1]);
+            const Vec2 deviator_traction = traction({s[0] - mean, s[1] - mean, s[2]}, c_.normal[i]);
+            add_to_kept(i, x, -sign * c_.length[i] * deviator_traction, relax_deviator_block_force_,
+                        relax_deviator_block_moment_, relax_deviator_node_force_);
+        }
         // The pressure pushes the kept side away from the removed one: along the
         // contact's normal (B's outward normal, towards A) on A, against it on B,
         // over the contact's length.
@@ -457,10 +474,9 @@ void Solver::gather_stage() {
     const bool ties = !tie_reaction_.empty();
     const Vec2 g = settings_.gravity;
     // The support of the excavated rock: relaxed linearly to the fraction kept (a
-    // fictitious support pressure, the convergence–confinement method's 1 − λ).
-    const double relax = relax_left_ > 0 ? relax_keep_ + (1.0 - relax_keep_) * double(relax_left_) / double(relax_total_ + 1)
-                         : relax_block_force_.empty() && relax_node_force_.empty() ? 0.0
-                                                                                    : relax_keep_;
+    // fictitious support pressure, the convergence–confinement method's 1 − λ), or
+    // its mean and deviator each along a path (a face going by, theory.md §6.5).
+    const auto [relax, relax_deviator] = relaxation_factors();
     const bool pressure = !pressure_block_force_.empty();
     // 1 as excavated (x 1.0 is exact: the same bits as without a scale).
     const double pressure_scale = pressure_scale_.empty() ? 1.0 : pressure_scale_[0];
@@ -474,7 +490,9 @@ void Solver::gather_stage() {
         if (!b_.deformable[i]) contact::block_contact_force(c_, i, f, m); // deformable: through its nodes
         f += b_.applied[i] + b_.real_mass[i] * g;
         m += b_.applied_moment[i];
-        if (relax > 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
+        if (relax != 0.0) f += relax * relax_block_force_[i], m += relax * relax_block_moment_[i];
+        if (relax_deviator != 0.0)
+            f += relax_deviator * relax_deviator_block_force_[i], m += relax_deviator * relax_deviator_block_moment_[i];
         if (pressure) f += pressure_scale * pressure_block_force_[i], m += pressure_scale * pressure_block_moment_[i];
         if (ties)
             for (int t = tie_block_first_[i]; t < tie_block_first_[i + 1]; ++t) {
@@ -487,7 +505,8 @@ void Solver::gather_stage() {
 #pragma omp for schedule(static)
     for (int k = 0; k < nn; ++k) {
         Vec2 f = contact::node_contact_force(c_, k) + fem::node_zone_force(z_, k) + n_.applied[k] + n_.real_mass[k] * g;
-        if (relax > 0.0) f += relax * relax_node_force_[k];
+        if (relax != 0.0) f += relax * relax_node_force_[k];
+        if (relax_deviator != 0.0) f += relax_deviator * relax_deviator_node_force_[k];
         if (pressure) f += pressure_scale * pressure_node_force_[k];
         if (ties)
             for (int t = tie_node_first_[k]; t < tie_node_first_[k + 1]; ++t) {
@@ -498,11 +517,34 @@ void Solver::gather_stage() {
     }
 }
 
+std::pair<double, double> Solver::relaxation_factors() const {
+    if (relax_block_force_.empty() && relax_node_force_.empty()) return {0.0, 0.0};
+    if (relax_path_.empty())
+        return {relax_left_ > 0 ? relax_keep_ + (1.0 - relax_keep_) * double(relax_left_) / double(relax_total_ + 1)
+                                : relax_keep_,
+                0.0};
+    // Along the path: at t = k / (N + 1) on the k-th step of N (the linear
+    // relaxation's factor is 1 − t), then at its last row.
+    const double t = relax_left_ > 0 ? 1.0 - double(relax_left_) / double(relax_total_ + 1) : 1.0;
+    std::size_t r = 3;
+    while (r + 3 < relax_path_.size() && relax_path_[r] < t) r += 3;
+    const double t0 = relax_path_[r - 3], t1 = relax_path_[r], w = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    const double k_mean = (1.0 - w) * relax_path_[r - 2] + w * relax_path_[r + 1];
+    const double k_deviator = (1.0 - w) * relax_path_[r - 1] + w * relax_path_[r + 2];
+    return {k_mean, k_deviator - k_mean};
+}
+
 void Solver::release_relaxation() {
-    if (relax_left_ > 0 && --relax_left_ == 0 && relax_keep_ == 0.0) {
+    const std::size_t rows = relax_path_.size();
+    const bool kept = relax_keep_ != 0.0 || (rows > 0 && (relax_path_[rows - 2] != 0.0 || relax_path_[rows - 1] != 0.0));
+    if (relax_left_ > 0 && --relax_left_ == 0 && !kept) {
         relax_block_force_.clear();
         relax_block_moment_.clear();
         relax_node_force_.clear();
+        relax_path_.clear();
+        relax_deviator_block_force_.clear();
+        relax_deviator_block_moment_.clear();
+        relax_deviator_node_force_.clear();
     }
 }
 

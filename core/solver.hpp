@@ -81,6 +81,14 @@ struct StepProfile {
     void lap(Stage stage);
 };
 
+/// An excavation's support along a path (StageSpec::support_path): rows [t,
+/// k_mean, k_deviator] over the relaxation's steps, and the in-situ stress whose
+/// deviator splits each support force into its mean and deviatoric parts.
+struct SupportPath {
+    std::vector<std::array<double, 3>> rows;
+    StressFieldSpec in_situ;
+};
+
 class Solver {
 public:
     /// Builds the model (core/build_model.cpp): blocks, FE nodes and zones,
@@ -96,9 +104,11 @@ public:
     /// relaxed linearly over relax_steps steps to the fraction `keep` of them, which
     /// stays (a support pressure: the convergence–confinement method's 1 − λ).
     /// `pressure` (Pa) pushes on the new boundary, normal to it, from now on and for
-    /// good (a support pressure in Pa); a later excavate replaces both.
+    /// good (a support pressure in Pa); a later excavate replaces both. A support
+    /// path instead relaxes the support's mean and deviatoric parts each along its
+    /// own curve (a tunnel face going by; theory.md §6.5).
     void excavate(const std::vector<std::string>& regions, long relax_steps, double keep = 0.0,
-                  double pressure = 0.0);
+                  double pressure = 0.0, const SupportPath& path = {});
     /// The latest opening's pressure is now `pressure` (Pa): the push on its wall
     /// scaled from the excavation's `excavation_pressure`, which must be > 0 (it
     /// gave the push its direction and extent), and, with water in the joints,
@@ -315,6 +325,9 @@ private:
     /// Boundary reactions (boundary_force) from the forces of the last evaluation.
     void sum_boundary_forces();
     void release_relaxation();
+    /// The support's factors now: on the whole in-situ support, and on its
+    /// deviatoric part besides (k_mean and k_deviator − k_mean along a path).
+    std::pair<double, double> relaxation_factors() const;
     /// The one list of the state (core/state.cpp): visit(FieldInfo, field&) per field.
     template <class Self, class Visit>
     static void for_each_field(Self& self, Visit&& visit);
@@ -401,6 +414,11 @@ private:
     std::vector<double> relax_block_moment_;
     long relax_total_ = 0, relax_left_ = 0;
     double relax_keep_ = 0.0; ///< fraction of the excavated rock's support kept for good
+    /// With a support path: its rows flattened (t, k_mean, k_deviator, ...), and the
+    /// deviatoric part of the support forces above (empty without one).
+    std::vector<double> relax_path_;
+    std::vector<Vec2> relax_deviator_block_force_, relax_deviator_node_force_;
+    std::vector<double> relax_deviator_block_moment_;
     /// A constant support pressure on the excavated boundary, as forces per block
     /// and per node (empty when none).
     std::vector<Vec2> pressure_block_force_, pressure_node_force_;

@@ -61,6 +61,13 @@ inline constexpr StageKey stage_keys[] = {
                 "pressure, (1 − λ) × the in-situ support in the convergence–confinement method; a later excavate "
                 "replaces it",
      .absent = "0"},
+    {.key = "support_path", .kind = KeyKind::rows, .only = "excavate",
+     .meaning = "The support's path as a tunnel face goes by, instead of a linear relaxation: rows [t, k_mean, "
+                "k_deviator], t from 0 to 1 (increasing) over relax_steps, the fractions of the in-situ support's "
+                "mean and deviatoric parts left at t, interpolated linearly; the last row's stay for good. "
+                "examples/field/face_path.py computes it from the elastic three-dimensional solution (theory.md "
+                "§6.5); needs relax_steps ≥ 1, an initialize stage before it, and no keep",
+     .absent = "a linear relaxation"},
     {.key = "pressure", .bounds = at_least(0, " Pa"), .only = "excavate, pressurise",
      .meaning = "excavate: a constant pressure on the new boundary, normal to it, from this stage on (a later "
                 "excavate replaces it); with [flow] also the water's pressure in the opening, held at its wall's "

@@ -33,6 +33,15 @@ std::pair<double, double> opening_pressures_before(const std::vector<StageSpec>&
     return {now, excavated};
 }
 
+/// An excavate stage's support path with the in-situ stress of the latest
+/// initialize stage before it (the reader requires one).
+SupportPath support_path_of(const std::vector<StageSpec>& stages, int index) {
+    SupportPath path{stages[index].support_path, {}};
+    for (int k = 0; k < index; ++k)
+        if (stages[k].kind == StageSpec::Kind::initialize) path.in_situ = stages[k].stress;
+    return path;
+}
+
 } // namespace
 
 std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs,
@@ -92,7 +101,9 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
             obs.stage_started(s, st);
             switch (st.kind) {
             case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
-            case StageSpec::Kind::excavate: s.excavate(st.regions, st.relax_steps, st.keep, st.pressure); break;
+            case StageSpec::Kind::excavate:
+                s.excavate(st.regions, st.relax_steps, st.keep, st.pressure, support_path_of(stages, index));
+                break;
             case StageSpec::Kind::elastic: r.method = s.solve_elastic().method; break;
             case StageSpec::Kind::install: s.install_supports(st.supports); break;
             case StageSpec::Kind::pressurise:

@@ -38,9 +38,9 @@ namespace {
 // constant support pressure (excavate's `pressure`); 6 the same fields with a
 // hash of the bolts' and liners' kinematics; 7 the state hash over every saved
 // field (the state-field list); 8 the dowels' fields (core/dowels.hpp); 9 the
-// opening's pressure scale (a pressurise stage).
+// opening's pressure scale (a pressurise stage); A an excavation's support path.
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = '9';
+constexpr std::uint64_t format = 'A';
 constexpr std::uint64_t magic = magic_base | format;
 
 template <class T>
@@ -202,6 +202,10 @@ void Solver::for_each_run_field(Self& s, Visit& v) {
     v({"relax.node_force", G::nodes, E}, s.relax_node_force_);
     v({"relax.total_steps", G::other, E}, s.relax_total_), v({"relax.steps_left", G::other, E}, s.relax_left_);
     v({"relax.keep", G::other, E}, s.relax_keep_);
+    v({"relax.path", G::other, E}, s.relax_path_);
+    v({"relax.deviator_block_force", G::blocks, E}, s.relax_deviator_block_force_);
+    v({"relax.deviator_block_moment", G::blocks, E}, s.relax_deviator_block_moment_);
+    v({"relax.deviator_node_force", G::nodes, E}, s.relax_deviator_node_force_);
     v({"pressure.block_force", G::blocks, E}, s.pressure_block_force_);
     v({"pressure.block_moment", G::blocks, E}, s.pressure_block_moment_);
     v({"pressure.node_force", G::nodes, E}, s.pressure_node_force_);

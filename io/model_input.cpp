@@ -523,9 +523,14 @@ void read_stages(Ctx& c, const toml::table& doc, std::vector<StageSpec>& out, co
                  const Names& supports) {
     Names stages{"stage", "stages", "stage", {}, {}};
     double opening_pressure = -1.0; // the latest excavate stage's pressure (-1: none yet)
+    bool initialized = false;
     read_tables(c, doc, "stage", [&](const toml::table& t, const Path& p, std::size_t i) {
         out.push_back(read_stage(c, t, p, i, stages, regions, supports));
         const StageSpec& st = out.back();
+        if (st.kind == StageSpec::Kind::initialize) initialized = true;
+        if (!st.support_path.empty() && !initialized)
+            c.fail(*find(c, t, p, "support_path"), p.key("support_path"),
+                   "needs an initialize stage before it: the in-situ stress whose mean and deviator it relaxes");
         if (st.kind == StageSpec::Kind::excavate) opening_pressure = st.pressure;
         if (st.kind == StageSpec::Kind::pressurise && !(opening_pressure > 0.0))
             c.fail(*find(c, t, p, "type"), p.key("type"),

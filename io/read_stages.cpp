@@ -41,6 +41,41 @@ HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& nam
     return h;
 }
 
+namespace {
+
+/// An excavate stage's support_path: rows [t, k_mean, k_deviator], t from 0 to 1.
+std::vector<std::array<double, 3>> read_support_path(Ctx& c, const toml::table& t, const Path& p) {
+    std::vector<std::array<double, 3>> rows;
+    const toml::node* n = find(c, t, p, "support_path");
+    if (!n) return rows;
+    const Path kp = p.key("support_path");
+    const toml::array& a = to_array(c, *n, kp, "an array of rows [t, k_mean, k_deviator]");
+    // A fraction of the support beyond [-1, 2] is no stress path of an elastic rock.
+    const Range fraction{.lo = -1, .hi = 2, .unit = ""};
+    for_each_element(c, a, kp, [&](const toml::node& e, const Path& ep) {
+        const auto* row = e.as_array();
+        if (!row || row->size() != 3)
+            c.fail(e, ep,
+                   "expected a row [t, k_mean, k_deviator] of 3 numbers, got " +
+                       (row ? "an array of " + std::to_string(row->size()) : describe(e)));
+        const double at = checked_number(c, (*row)[0], ep.at(0), Range{.lo = 0, .hi = 1, .unit = ""});
+        if (rows.empty() && at != 0)
+            c.fail((*row)[0], ep.at(0), "the first row must be at t = 0 (the excavation), got " + fmt(at));
+        if (!rows.empty() && !(at > rows.back()[0]))
+            c.fail((*row)[0], ep.at(0),
+                   "t must increase from row to row, got " + fmt(at) + " after " + fmt(rows.back()[0]));
+        rows.push_back({at, checked_number(c, (*row)[1], ep.at(1), fraction),
+                        checked_number(c, (*row)[2], ep.at(2), fraction)});
+    });
+    if (rows.size() < 2 || rows.back()[0] != 1)
+        c.fail(*n, kp,
+               "needs at least two rows, from t = 0 to t = 1 (the end of relax_steps), got " +
+                   (rows.empty() ? std::string("none") : "the last at t = " + fmt(rows.back()[0])));
+    return rows;
+}
+
+} // namespace
+
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
                      const Names& regions, const Names& supports) {
     static constexpr auto all_keys = key_names(stage_keys);
@@ -83,6 +118,15 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         if (s.steps > s.relax_steps)
             c.fail(*find(c, t, p, "steps"), p.key("steps"),
                    "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));
+        s.support_path = read_support_path(c, t, p);
+        if (!s.support_path.empty()) {
+            const toml::node& n = *find(c, t, p, "support_path");
+            if (s.relax_steps < 1)
+                c.fail(n, p.key("support_path"), "needs relax_steps >= 1: the steps the path is run over");
+            if (find(c, t, p, "keep"))
+                c.fail(*find(c, t, p, "keep"), p.key("keep"),
+                       "cannot go with support_path: the path's last row is the support kept");
+        }
         break;
     case Kind::cycle:
         // A cycle runs at least one step.

@@ -1101,6 +1101,36 @@ TEST_CASE("excavate: a support kept as a fraction or as a pressure, and their mi
                 "stage[0].pressure", "");
 }
 
+TEST_CASE("excavate: a support path, and its mistakes") {
+    const std::string initialize = "[[stage]]\ntype = \"initialize\"\nsxx = -2e6\n\n";
+    const std::string excavate = "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\nrelax_steps = 100\n";
+    const auto mf = parse_model(with(initialize + excavate + "support_path = [[0, 1, 1], [0.4, 0.6, 0.9], [1, 0, 0]]\n"),
+                                "t.toml");
+    const auto& path = mf.analysis.stages[1].support_path;
+    REQUIRE(path.size() == 3);
+    CHECK(path[1] == std::array<double, 3>{0.4, 0.6, 0.9});
+    auto fails = [&](const std::string& rows, const std::string& at, const std::string& path_key,
+                     const std::string& message) {
+        check_error(with(initialize + excavate + "support_path = " + rows + "\n"), at, path_key, message);
+    };
+    fails("[[0.1, 1, 1], [1, 0, 0]]", "support_path", "stage[1].support_path[0][0]",
+          "the first row must be at t = 0 (the excavation), got 0.1");
+    fails("[[0, 1, 1], [0.5, 0.5, 0.5], [0.5, 0, 0], [1, 0, 0]]", "support_path", "stage[1].support_path[2][0]",
+          "t must increase from row to row, got 0.5 after 0.5");
+    fails("[[0, 1, 1], [0.5, 0.5, 0.5]]", "support_path", "stage[1].support_path",
+          "needs at least two rows, from t = 0 to t = 1 (the end of relax_steps), got the last at t = 0.5");
+    fails("[[0, 1, 1], [1, 0]]", "support_path", "stage[1].support_path[1]",
+          "expected a row [t, k_mean, k_deviator] of 3 numbers, got an array of 2");
+    fails("[[0, 1, 1], [1, 3, 0]]", "support_path", "stage[1].support_path[1][1]", "must be in [-1, 2], got 3");
+    check_error(with(excavate + "support_path = [[0, 1, 1], [1, 0, 0]]\n"), "support_path", "stage[0].support_path",
+                "needs an initialize stage before it: the in-situ stress whose mean and deviator it relaxes");
+    check_error(with(initialize + "[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\n"
+                                  "support_path = [[0, 1, 1], [1, 0, 0]]\n"),
+                "support_path", "stage[1].support_path", "needs relax_steps >= 1: the steps the path is run over");
+    check_error(with(initialize + excavate + "keep = 0.2\nsupport_path = [[0, 1, 1], [1, 0, 0]]\n"), "keep",
+                "stage[1].keep", "cannot go with support_path: the path's last row is the support kept");
+}
+
 TEST_CASE("bolts: a set, its installation, and its mistakes") {
     const std::string set = "[[bolt]]\nname = \"rebar\"\nbolts = [[[0.0, 0.0], [2.0, 0.0]]]\n"
                             "diameter = 0.025\nyield_force = 200e3\nbond_stiffness = 1e9\nspacing = 1.5\n";

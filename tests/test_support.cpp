@@ -353,6 +353,32 @@ double wall_convergence(const Solver& s) {
     return sum / count;
 }
 
+/// A checkpoint taken `before` steps after the model's first two stages (the
+/// in-situ stress and the excavation) resumes `after` steps on to the same bits.
+void check_resumes_exactly(const Built& m, int before, int after) {
+    Solver one(m.blocks, m.file.analysis), again(m.blocks, m.file.analysis);
+    Quiet quiet;
+    run_stages(one, {m.file.analysis.stages.begin(), m.file.analysis.stages.begin() + 2}, quiet);
+    for (int k = 0; k < before; ++k) one.step();
+    std::ostringstream saved;
+    one.save_state(saved);
+    for (int k = 0; k < after; ++k) one.step();
+    std::istringstream in(saved.str());
+    again.load_state(in);
+    while (again.steps() < one.steps()) again.step();
+    CHECK(again.state_hash() == one.state_hash());
+}
+
+/// The inward displacement of each of the ground's nodes on the wall, in node order.
+std::vector<double> wall_inward(const Solver& s) {
+    const auto& n = s.nodes();
+    std::vector<double> u;
+    for (int i = 0; i < n.count(); ++i)
+        if (std::abs(norm(n.position0[i]) - 1.0) < 1e-6) u.push_back(-dot(n.position[i] - n.position0[i], n.position0[i]));
+    REQUIRE(u.size() > 10);
+    return u;
+}
+
 } // namespace
 
 TEST_CASE("a liner in elastic ground: the pressure where the ground reaction and support characteristic meet") {
@@ -619,6 +645,52 @@ TEST_CASE("a lined opening resumes exactly from a checkpoint, and runs to the sa
     CHECK(two->state_hash() == one->state_hash());
 }
 
+TEST_CASE("a support path: the in-situ support's mean and deviator relax each along its own curve") {
+    // Elastic ground under sxx = -10, syy = -4 MPa: mean 7 MPa, deviator 3 MPa. Its
+    // convergence is the sum of the mean's (uniform) and the deviator's (cos 2 theta),
+    // so a path that keeps all of the mean's support leaves the deviator's
+    // convergence, and one that keeps the deviator's leaves the mean's: that of
+    // the ground under sxx = syy = -7 MPa.
+    auto run = [](double sxx, double syy, const std::string& path) {
+        LinedCase c;
+        c.lined = false, c.sxx = sxx, c.syy = syy;
+        std::string text = lined_opening(c);
+        if (!path.empty()) text.insert(text.find("steps = 0\n"), "support_path = " + path + "\n");
+        const auto m = build(text);
+        auto s = std::make_unique<Solver>(m.blocks, m.file.analysis);
+        Quiet quiet;
+        CHECK(run_stages(*s, m.file.analysis.stages, quiet).back().converged);
+        return wall_inward(*s);
+    };
+    const auto both = run(-10e6, -4e6, ""), mean = run(-7e6, -7e6, "");
+    const auto mean_kept = run(-10e6, -4e6, "[[0, 1, 1], [0.3, 1, 0.5], [1, 1, 0]]");
+    const auto deviator_kept = run(-10e6, -4e6, "[[0, 1, 1], [0.7, 0.2, 1], [1, 0, 1]]");
+    const auto linear = run(-10e6, -4e6, "[[0, 1, 1], [1, 0, 0]]");
+    double largest = 0.0, off_mean = 0.0, off_deviator = 0.0, off_linear = 0.0, spread = 0.0;
+    for (std::size_t k = 0; k < both.size(); ++k) {
+        largest = std::max(largest, std::abs(both[k]));
+        off_mean = std::max(off_mean, std::abs(deviator_kept[k] - mean[k]));
+        off_deviator = std::max(off_deviator, std::abs(mean_kept[k] - (both[k] - mean[k])));
+        off_linear = std::max(off_linear, std::abs(linear[k] - both[k]));
+        spread = std::max(spread, std::abs(mean_kept[k]));
+    }
+    MESSAGE("largest convergence " << largest * 1e3 << " mm; deviator's " << spread * 1e3 << " mm; off by "
+                                   << off_mean * 1e3 << " (mean), " << off_deviator * 1e3 << " (deviator), "
+                                   << off_linear * 1e3 << " mm (linear path)");
+    CHECK(spread > 0.2 * largest); // the deviator's share is no small part
+    CHECK(off_mean < 0.01 * largest);
+    CHECK(off_deviator < 0.01 * largest);
+    CHECK(off_linear < 1e-6 * largest);
+
+    // A checkpoint taken part-way along the path resumes to the same bits, past
+    // the path's end too (its last row stays).
+    LinedCase c;
+    c.lined = false, c.sxx = -10e6, c.syy = -4e6;
+    std::string text = lined_opening(c);
+    text.insert(text.find("steps = 0\n"), "support_path = [[0, 1, 1], [0.3, 1, 0.5], [1, 0.5, 0]]\n");
+    check_resumes_exactly(build(text), 700, 1500);
+}
+
 TEST_CASE("a support pressure: keeping a fraction of the excavated rock's support scales the elastic convergence") {
     // Linear elastic ground: keeping 40% of the in-situ support on the wall (the
     // convergence–confinement method's fictitious pressure (1 − λ) p0 with λ = 0.6)
@@ -652,15 +724,5 @@ TEST_CASE("a support pressure: keeping a fraction of the excavated rock's suppor
     CHECK(u_pressed == doctest::Approx(0.6 * u_free).epsilon(2e-3));
 
     // It resumes exactly from a checkpoint.
-    Solver one(pressed.blocks, pressed.file.analysis), again(pressed.blocks, pressed.file.analysis);
-    Quiet quiet;
-    run_stages(one, {pressed.file.analysis.stages.begin(), pressed.file.analysis.stages.begin() + 2}, quiet);
-    for (int k = 0; k < 300; ++k) one.step();
-    std::ostringstream saved;
-    one.save_state(saved);
-    for (int k = 0; k < 300; ++k) one.step();
-    std::istringstream in(saved.str());
-    again.load_state(in);
-    while (again.steps() < one.steps()) again.step();
-    CHECK(again.state_hash() == one.state_hash());
+    check_resumes_exactly(pressed, 300, 300);
 }
