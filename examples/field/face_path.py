@@ -137,6 +137,8 @@ def main():
                          "Mine-by's)")
     ap.add_argument("--fine", action="store_true", help="a mesh 1.5 times as fine each way (the convergence check; about 10 minutes, 6 GB)")
     ap.add_argument("--coarse", action="store_true", help="a mesh about half as fine each way (a quick look)")
+    ap.add_argument("--check", action="store_true",
+                    help="exit with status 1 if a check misses its tolerance (the test suite runs --coarse --check)")
     ap.add_argument("--table", type=float, nargs="+",
                     default=[6, 4, 3, 2, 1.5, 1, 0.75, 0.5, 0.25, 0.1, -0.1, -0.25, -0.5, -0.75, -1, -1.5, -2, -3, -4, -5],
                     help="distances ahead of the face, in radii, of the table's rows (negative: behind)")
@@ -247,11 +249,16 @@ def main():
         prof.append((z, mx[0] + my[0], mx[1] - my[1], mz[0]))
     prof = np.array(prof)
     far = prof[np.argmin(np.abs(prof[:, 0] + L / 2))]
-    # Excavation-induced displacement (tension positive: unloading a tensile stress
-    # moves the wall inwards, u < 0 for p = +1; a / 2G for a unit mean).
-    print(f"\nplane strain far behind (z = {far[0]:.1f} a): mean mode {far[1] * 2 * G:.4f} x a/2G (closed form 1); "
-          f"deviator mode {far[2] * 2 * G:.4f} x a/2G (closed form 3 - 4 nu = {3 - 4 * nu:.4f}); "
-          f"szz's {far[3] * 2 * G:+.4f} (0)")
+    # Excavation-induced displacement (tension positive: unloading a tensile in-situ
+    # stress moves the wall outwards): a unit mean, a / 2G in infinite rock; held at
+    # r = R, the thick-walled cylinder's (1 - a²/R²) / (1 + a²/R² / (1 - 2 nu)).
+    bounded = (1 - R**-2) / (1 + R**-2 / (1 - 2 * nu))
+    print(f"\nplane strain far behind (z = {far[0]:.1f} a): mean mode {far[1] * 2 * G:.4f} x a/2G (closed form, held "
+          f"at {R:g} a: {bounded:.4f}); deviator mode {far[2] * 2 * G:.4f} x a/2G (Kirsch in infinite rock: 3 - 4 nu = "
+          f"{3 - 4 * nu:.4f}); szz's {far[3] * 2 * G:+.4f} (0)")
+    checks = [("the mean's plane-strain wall displacement within 2% of the closed form",
+               abs(far[1] * 2 * G / bounded - 1) < 0.02),
+              ("the deviator's within 6% of Kirsch's", abs(far[2] * 2 * G / (3 - 4 * nu) - 1) < 0.06)]
 
     # Hoop stress at the wall far behind the face, from the first ring's elements,
     # extrapolated to r = a, against Kirsch: s_tt = p2 - 2 q2 cos 2 theta per unit (sxx = 1: 1 - 2 cos 2 theta).
@@ -280,10 +287,12 @@ def main():
     err = np.abs(rows[:, 1] - rows[:, 2]).max()
     print(f"hoop stress at the wall far behind, unit sxx: at 0 deg {rows[0, 1]:+.3f} (Kirsch -1), at 90 deg "
           f"{rows[-1, 1]:+.3f} (3); largest difference over the wall {err:.3f} (of 3)")
+    checks.append(("Kirsch's hoop stress within 5% of 3 all round the wall", err < 0.15))
 
     # The longitudinal profile of the mean mode for szz = p against V&D 2009.
     u_inf_p, u_inf_q = far[1], far[2]
     print("\nd/a (ahead +)   mean p: u/u_inf  [V&D 2009]   szz: u/u_inf(p)   deviator: u/u_inf")
+    ldp_off = 0.0
     for d in [3, 2, 1, 0.5, 0, -0.5, -1, -2, -3, -4]:
         row = prof[np.argmin(np.abs(prof[:, 0] - d))]  # ahead of the face: z > 0
         x = -d
@@ -291,6 +300,9 @@ def main():
             1 - (1 - (1 / 3) * math.exp(-0.15)) * math.exp(-3 * x / 2)
         print(f"{d:+6.2f}          {(row[1] + row[3]) / u_inf_p:7.3f}   [{vd:.3f}]      {row[3] / u_inf_p:+7.3f}"
               f"          {row[2] / u_inf_q:7.3f}")
+        if d in (1, 2):
+            ldp_off = max(ldp_off, abs((row[1] + row[3]) / u_inf_p - vd))
+    checks.append(("the hydrostatic profile 1 and 2 radii ahead of the face within 0.03 of V&D 2009's", ldp_off < 0.03))
 
     # The stress path at the wall where the notch forms: across the largest in-plane
     # stress (in its principal axes, theta' = 90 degrees: the plane x = 0), by slice,
@@ -377,6 +389,12 @@ def main():
         d0, d1 = table[0][0], table[-1][0]
         print("support_path = [" + ", ".join(f"[{(d0 - d) / (d0 - d1):.4g}, {k0:.4f}, {k2:.4f}]" for d, k0, k2 in table)
               + "]")
+    print()
+    for what, ok in checks:
+        print(("ok      " if ok else "MISSED  ") + what)
+    if args.check and not all(ok for _, ok in checks):
+        return 1
+    return 0
 
 
 if __name__ == "__main__":
