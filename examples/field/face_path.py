@@ -21,10 +21,11 @@ the deviator's, k0(d) = 1 - u0(d)/u0(-inf) and k2(d) = 1 - u2(d)/u2(-inf)
 the in-plane and out-of-plane stresses at the wall ahead of the face for a given
 in-situ tensor (by default the Mine-by's): how much they rise and turn.
 
-Checks printed: the plane-strain wall displacement of the mean (p a / 2G) and
-Kirsch's hoop stress far behind the face, and the mean mode's longitudinal
-displacement profile against Vlachopoulos & Diederichs (2009), whose closed form
-fits axisymmetric elastic models (u at the face 0.29 of the final one).
+Checks (printed; --check makes a miss the exit status): far behind the face, the
+plane-strain wall displacement of the mean against the thick-walled cylinder's
+closed form and of the deviator against Kirsch's, and Kirsch's hoop stress; ahead
+of it, the hydrostatic longitudinal displacement profile against Vlachopoulos &
+Diederichs (2009), whose closed form fits axisymmetric elastic models.
 
 Needs numpy and scipy (Debian: python3-numpy, python3-scipy). About 2 minutes.
 Run: python3 examples/field/face_path.py [--szz-over-p 1.29] [--fine]
@@ -260,8 +261,8 @@ def main():
                abs(far[1] * 2 * G / bounded - 1) < 0.02),
               ("the deviator's within 6% of Kirsch's", abs(far[2] * 2 * G / (3 - 4 * nu) - 1) < 0.06)]
 
-    # Hoop stress at the wall far behind the face, from the first ring's elements,
-    # extrapolated to r = a, against Kirsch: s_tt = p2 - 2 q2 cos 2 theta per unit (sxx = 1: 1 - 2 cos 2 theta).
+    # Hoop stress at the wall far behind the face, from the first two rings'
+    # elements extrapolated to r = a, against Kirsch's for a unit sxx: 1 - 2 cos 2 theta.
     centres = X.mean(axis=1)
     cr = np.hypot(centres[:, 0], centres[:, 1])
     B_centre = b_matrices(X, [(0, 0, 0)])[0][:, 0]
