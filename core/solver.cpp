@@ -476,7 +476,10 @@ void Solver::gather_stage() {
     // The support of the excavated rock: relaxed linearly to the fraction kept (a
     // fictitious support pressure, the convergence–confinement method's 1 − λ), or
     // its mean and deviator each along a path (a face going by, theory.md §6.5).
-    const auto [relax, relax_deviator] = relaxation_factors();
+    // (Plain variables, not a structured binding: clang 14 cannot use one inside
+    // the OpenMP loop below.)
+    const std::pair<double, double> factors = relaxation_factors();
+    const double relax = factors.first, relax_deviator = factors.second;
     const bool pressure = !pressure_block_force_.empty();
     // 1 as excavated (x 1.0 is exact: the same bits as without a scale).
     const double pressure_scale = pressure_scale_.empty() ? 1.0 : pressure_scale_[0];
