@@ -241,6 +241,11 @@ int run_cli(int argc, char** argv) {
         std::ostringstream discard;
         const int code = studies::Ranks::root() ? app.exit(e) : app.exit(e, discard, discard);
         return code == 0 ? 0 : 2;
+    } catch (const InputError& e) {
+        // A file read while parsing (a lab test's --rock, in its command's final
+        // callback) names its own file, line and key.
+        if (studies::Ranks::root()) std::fprintf(stderr, "bbm: error: %s\n", e.what());
+        return 2;
     }
     try {
         if (*run) {

@@ -30,6 +30,17 @@ execute_process(COMMAND ${BBM} --config ${DIR}/ucs.toml ucs --quiet --out ${DIR}
 if(NOT status EQUAL 2 OR NOT err MATCHES "ucs.toml" OR NOT err MATCHES "widht")
   message(FATAL_ERROR "a bad key in --config should give status 2 naming file and key, got ${status}: ${err}")
 endif()
+# A rock file (--rock) with a misspelt key: status 2 naming file, line and key, for
+# every command that reads one (it once aborted: the file is read while parsing).
+file(WRITE ${DIR}/rock.toml "[[joint_property]]\nname = \"rock\"\nlaw = \"softening\"\nkn = 1e11\nks = 4e10\nfrictoin = 30\n")
+foreach(command ucs envelope calibrate shear)
+  execute_process(COMMAND ${BBM} ${command} --rock ${DIR}/rock.toml --quiet --out ${DIR}/out
+                  RESULT_VARIABLE status ERROR_VARIABLE err OUTPUT_VARIABLE out)
+  if(NOT status EQUAL 2 OR NOT err MATCHES "rock.toml:6: joint_property\\[0\\]\\.frictoin")
+    message(FATAL_ERROR "bbm ${command} --rock with a misspelt key should give status 2 naming file:line: key, "
+                        "got ${status}: ${err}")
+  endif()
+endforeach()
 # A flag in a --config file is read as on the command line: fit-curvature with one
 # confined target is refused, naming the flag (it was once silently ignored).
 file(WRITE ${DIR}/curvature.toml "[calibrate]\ntarget-mi = 10\ntarget-mi-confinements = [5e6]\nfit-curvature = true\n")
