@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <fstream>
 #include <mutex>
+#include <numeric>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -341,8 +342,21 @@ struct EnvelopeRunner {
 
     void operator()(const std::vector<Job>& jobs) {
         const int side_by_side = one_at_a_time ? 1 : std::max(1, std::min(int(jobs.size()), available));
-        const auto texts = run_spread(int(jobs.size()), side_by_side, [&](int k) {
-            const Job& job = jobs[k];
+        // Handed out longest first, so that no thread is left with a long test while
+        // the other idles: confined tests take more steps the higher their
+        // confinement, a tension test a fraction of a compression test's. Results
+        // come back in list order whatever order they ran in.
+        std::vector<int> order(jobs.size());
+        std::iota(order.begin(), order.end(), 0);
+        auto expected_cost = [&](const Job& job) {
+            return job.kind == LabTestOptions::Kind::biaxial ? 2.0 + job.confinement
+                   : job.kind == LabTestOptions::Kind::ucs   ? 1.0
+                                                             : 0.0;
+        };
+        std::stable_sort(order.begin(), order.end(),
+                         [&](int a, int b) { return expected_cost(jobs[a]) > expected_cost(jobs[b]); });
+        const auto texts_by_turn = run_spread(int(jobs.size()), side_by_side, [&](int turn) {
+            const Job& job = jobs[order[turn]];
             LabTestOptions o = job.kind == tension_kind ? tension.o : compression.o;
             o.kind = job.kind;
             o.confinement = job.confinement;
@@ -376,6 +390,8 @@ struct EnvelopeRunner {
             }
             return labtest_record_text(result);
         });
+        std::vector<std::string> texts(jobs.size());
+        for (std::size_t turn = 0; turn < jobs.size(); ++turn) texts[order[turn]] = texts_by_turn[turn];
         for (std::size_t k = 0; k < jobs.size(); ++k)
             runs.push_back({test_name(jobs[k].kind), jobs[k].confinement, c.o.seed + std::uint64_t(jobs[k].realization),
                             labtest_from_record_text(texts[k])});
@@ -514,20 +530,26 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
                      c.pattern.c_str(), c.o.size, c.o.width, c.o.height, n, n > 1 ? "s" : "", available,
                      available > 1 ? "s" : "");
     // Uniaxial compression and tension first: the default confinements follow the UCS.
+    // Confinements given: every test in one list, none waiting for the UCS.
     std::vector<Job> first;
     for (int k = 0; k < n; ++k) first.push_back({LabTestOptions::Kind::ucs, 0.0, k});
     for (int k = 0; k < n; ++k) first.push_back({tension_kind, 0.0, k});
+    const bool given = !e.confinements.empty();
+    if (given)
+        for (double s3 : confinements_to_test(e.confinements, {}))
+            for (int k = 0; k < n; ++k) first.push_back({LabTestOptions::Kind::biaxial, s3, k});
     run_jobs(first);
     std::vector<double> ucs, strength_t;
     for (const auto& r : runs)
-        (r.test == "ucs" ? ucs : strength_t)
-            .push_back(r.test == "ucs" ? r.result.peak_stress
-                                       : (brazilian ? r.result.tensile_strength : r.result.peak_stress));
+        if (r.test == "ucs") ucs.push_back(r.result.peak_stress);
+        else if (r.test != "biaxial") strength_t.push_back(brazilian ? r.result.tensile_strength : r.result.peak_stress);
     const std::vector<double> confinements = confinements_to_test(e.confinements, ucs);
-    std::vector<Job> second;
-    for (double s3 : confinements)
-        for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});
-    run_jobs(second);
+    if (!given) {
+        std::vector<Job> second;
+        for (double s3 : confinements)
+            for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});
+        run_jobs(second);
+    }
 
     const nlohmann::json levels = envelope_levels(runs, confinements);
     const auto [per_run, csv] = envelope_runs_table(runs);

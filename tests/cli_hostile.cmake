@@ -156,8 +156,22 @@ if(NOT kept STREQUAL "not a directory\n")
   message(FATAL_ERROR "the file given as --out was changed")
 endif()
 
-# --check: a valid model and valid options pass (status 0) and write nothing.
-foreach(command "run;${MODEL}" "mesh;${MODEL}" "ucs;--pattern;trigon" "calibrate;--target-E;20e9")
+# --check: a valid model and valid options pass (status 0) and write nothing; so do
+# the shipped laboratory files (examples/lab/: calibration options, and a calibrated
+# set read as a rock).
+get_filename_component(EXAMPLES ${MODEL} DIRECTORY)
+# One command a list item, its arguments joined by "|".
+set(checked_commands "run|${MODEL}" "mesh|${MODEL}" "ucs|--pattern|trigon" "calibrate|--target-E|20e9"
+    "envelope|--rock|${EXAMPLES}/lab/paper_rock_hoek_brown_set.toml")
+file(GLOB lab_files ${EXAMPLES}/lab/*.toml)
+foreach(lab_file ${lab_files})
+  file(READ ${lab_file} lab_text)
+  if(lab_text MATCHES "\\[calibrate\\]")
+    list(APPEND checked_commands "--config|${lab_file}|calibrate")
+  endif()
+endforeach()
+foreach(joined IN LISTS checked_commands)
+  string(REPLACE "|" ";" command "${joined}")
   execute_process(COMMAND ${BBM} --check ${command} --quiet --out ${DIR}/checked
                   RESULT_VARIABLE status ERROR_VARIABLE err TIMEOUT 120)
   if(NOT status EQUAL 0 OR EXISTS ${DIR}/checked)

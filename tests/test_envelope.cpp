@@ -137,6 +137,17 @@ TEST_CASE("envelope of a small Voronoi specimen: strength rises with confinement
     CHECK(b5 > b2);
     CHECK(study.summary_json.find("\"hoek_brown\"") != std::string::npos);
     CHECK(study.summary_json.find("\"mohr_coulomb\"") != std::string::npos);
+    // Run longest first (the biaxials), reported in the list's order, each test's
+    // strength in its own statistics: the tension's mean is the tension run's.
+    CHECK(runs[0].test == "ucs");
+    CHECK(runs[1].test == "tension");
+    CHECK(runs[2].confinement == 2e6);
+    CHECK(runs[3].confinement == 5e6);
+    const auto summary = nlohmann::json::parse(study.summary_json);
+    CHECK(summary["ucs"]["n"] == 1);
+    CHECK(summary["ucs"]["mean"].get<double>() == ucs);
+    CHECK(summary["tension"]["strength"]["n"] == 1);
+    CHECK(summary["tension"]["strength"]["mean"].get<double>() == t);
 }
 
 // ---- The rock of a model file as a specimen (bbm compare --envelope) ----
