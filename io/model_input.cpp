@@ -498,12 +498,27 @@ void check_deformable_materials(const Ctx& c, const ModelFile& mf) {
     const AnalysisSpec& an = mf.analysis;
     const auto& rs = mf.geometry.regions;
     for (std::size_t i = 0; i < rs.size(); ++i) {
-        if (!rs[i].mesh.enabled) continue;
         const MaterialSpec* m = nullptr;
         for (const auto& [region, material] : an.region_material)
             if (region == rs[i].name)
                 m = &*std::ranges::find(an.materials, material, &MaterialSpec::name);
         if (an.region_material.empty() && !an.materials.empty()) m = &an.materials.front();
+        if (!rs[i].mesh.enabled) {
+            // Rigid blocks take none of the deformation: a share given to them would
+            // stiffen the region's joints by 1 / (1 - f) and nothing else.
+            if (m && m->deformable_fraction > 0.0) {
+                const auto& lines = mf.source.key_line[i];
+                const bool named = lines.contains("material");
+                c.fail(named ? lines.at("material") : mf.source.region_line[i],
+                       {"region[" + std::to_string(i) + "]" + (named ? ".material" : ""), ""},
+                       "region " + quoted(rs[i].name) + " has rigid blocks (no mesh) but its material " +
+                           quoted(m->name) + " gives deformable blocks a share of the deformation "
+                           "(deformable_fraction " + fmt(m->deformable_fraction) + "), which would stiffen "
+                           "its joints by 1 / (1 - f): give the region a mesh, or it a material without "
+                           "deformable_fraction");
+            }
+            continue;
+        }
         const Path p{"region[" + std::to_string(i) + "].mesh", ""};
         const int at = mf.source.key_line[i].at("mesh");
         const std::string head =

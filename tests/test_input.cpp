@@ -1341,6 +1341,17 @@ TEST_CASE("mesh and elasticity mistakes") {
     check_error(meshed("{ size = 0.1 }", b + "material = \"rock\"\n" + std::string(rock)), "mesh",
                 "region[0].mesh", "region 'a' is deformable (has a mesh) but has no material");
 
+    // Rigid blocks take no share of the deformation: a material that gives deformable
+    // blocks one would only stiffen the region's joints (it once did, silently).
+    const std::string split = "\n[[material]]\nname = \"split\"\nyoung = 1e10\ndeformable_fraction = 0.9\n";
+    check_error(std::string(one_region) + "material = \"split\"\n" + split, "material = \"split\"",
+                "region[0].material",
+                "region 'a' has rigid blocks (no mesh) but its material 'split' gives deformable blocks a "
+                "share of the deformation (deformable_fraction 0.9)");
+    check_error(std::string(one_region) + split, "[[region]]", "region[0]",
+                "region 'a' has rigid blocks (no mesh) but its material 'split'");
+    CHECK(parse_model(meshed("{ size = 0.1 }", split), "t.toml").geometry.regions[0].mesh.enabled);
+
     check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\npoisson = 0.5\n"), "poisson",
                 "material[0].poisson", "must be in [0, 0.5), got 0.5");
     check_error(with("[[material]]\nname = \"rock\"\nyoung = 1e10\npoisson = -0.1\n"), "poisson",
