@@ -193,6 +193,11 @@ inline int next_vertex(const std::uint32_t* first, int block, int v) {
     return (v + 1 == int(first[block + 1])) ? int(first[block]) : v + 1;
 }
 
+/// Global id of the vertex before `v` around its block.
+inline int prev_vertex(const std::uint32_t* first, int block, int v) {
+    return v == int(first[block]) ? int(first[block + 1]) - 1 : v - 1;
+}
+
 inline Vec2 tangent_of(Vec2 n) { return {-n.y, n.x}; }
 
 /// The frame of a contact whose vertex x lies against the edge p → q (1/|q − p| =

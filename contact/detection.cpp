@@ -20,10 +20,6 @@ EdgeFrame frame(Vec2 x, Vec2 p, Vec2 q) {
     return {dot(x - p, d) / l2, cross(d, x - p) / -l};
 }
 
-int prev_vertex(const std::uint32_t* first, int block, int v) {
-    return v == int(first[block]) ? int(first[block + 1]) - 1 : v - 1;
-}
-
 } // namespace
 
 std::vector<Junction> find_junctions(const std::vector<Vec2>& vertex, const std::vector<std::uint32_t>& first,

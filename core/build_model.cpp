@@ -229,7 +229,7 @@ void Solver::build_bodies(const meshing::BlockAssembly& a, const AnalysisSpec& a
     for (int i = 0; i < nb; ++i) {
         if (!b_.deformable[i]) continue;
         for (std::uint32_t v = a.first[i]; v < a.first[i + 1]; ++v) {
-            const Vec2 prev = a.points[v == a.first[i] ? a.first[i + 1] - 1 : v - 1];
+            const Vec2 prev = a.points[contact::prev_vertex(a.first.data(), i, int(v))];
             const Vec2 in = a.points[v] - prev, out = a.points[contact::next_vertex(a.first.data(), i, int(v))] - a.points[v];
             b_.corner[v] = cross(in, out) > corner_turn * norm(in) * norm(out);
         }
