@@ -490,6 +490,72 @@ std::vector<double> confinements_to_test(const std::vector<double>& given, const
     return confinements;
 }
 
+/// The biaxial tests at these confinements, `realizations` seeds each.
+std::vector<Job> biaxial_jobs(const std::vector<double>& confinements, int realizations) {
+    std::vector<Job> jobs;
+    for (double s3 : confinements)
+        for (int k = 0; k < realizations; ++k) jobs.push_back({LabTestOptions::Kind::biaxial, s3, k});
+    return jobs;
+}
+
+/// Runs every test of the envelope into the runner's list, in list order: the UCS
+/// and tension tests, then the biaxials. The default confinements follow the
+/// measured UCS, so its tests come first; confinements given go in one list with
+/// them, none waiting for the UCS. Returns the confinements tested.
+std::vector<double> run_envelope_tests(const EnvelopeOptions& e, EnvelopeRunner& run_jobs,
+                                       LabTestOptions::Kind tension_kind) {
+    const int n = e.lab.realizations;
+    std::vector<Job> first;
+    for (int k = 0; k < n; ++k) first.push_back({LabTestOptions::Kind::ucs, 0.0, k});
+    for (int k = 0; k < n; ++k) first.push_back({tension_kind, 0.0, k});
+    const bool given = !e.confinements.empty();
+    if (given) {
+        const auto jobs = biaxial_jobs(confinements_to_test(e.confinements, {}), n);
+        first.insert(first.end(), jobs.begin(), jobs.end());
+    }
+    run_jobs(first);
+    std::vector<double> ucs;
+    for (const auto& r : run_jobs.runs)
+        if (r.test == "ucs") ucs.push_back(r.result.peak_stress);
+    const std::vector<double> confinements = confinements_to_test(e.confinements, ucs);
+    if (!given) run_jobs(biaxial_jobs(confinements, n));
+    return confinements;
+}
+
+/// envelope.json: the specimen, the UCS and tension statistics, each level and
+/// run, the fits and the records to draw beside them.
+nlohmann::json envelope_summary(const EnvelopeOptions& e, const std::vector<EnvelopeRun>& runs,
+                                const nlohmann::json& per_run, const std::vector<double>& confinements,
+                                const std::vector<std::pair<double, double>>& record) {
+    const LabTestCli& c = e.lab;
+    const bool brazilian = e.tension_test == "brazilian";
+    std::vector<double> ucs, strength_t;
+    for (const auto& r : runs)
+        if (r.test == "ucs") ucs.push_back(r.result.peak_stress);
+        else if (r.test != "biaxial") strength_t.push_back(brazilian ? r.result.tensile_strength : r.result.peak_stress);
+    const auto ucs_stats = stats(ucs), t_stats = stats(strength_t);
+    const double t_over_c = ucs_stats["mean"].get<double>() > 0
+                                ? t_stats["mean"].get<double>() / ucs_stats["mean"].get<double>() : 0.0;
+    nlohmann::json summary{
+        {"specimen", {{"pattern", c.pattern}, {"size", c.o.size}, {"width", c.o.width}, {"height", c.o.height},
+                      {"deformable_fraction", c.o.material.deformable_fraction}, {"weibull_modulus", c.o.joint.weibull_modulus},
+                      {"seed", c.o.seed}, {"realizations", c.realizations}}},
+        {"ucs", ucs_stats},
+        {"tension", {{"test", brazilian ? "brazilian" : "direct"}, {"strength", t_stats}, {"over_ucs", t_over_c}}},
+        {"confinements", confinements},
+        {"levels", envelope_levels(runs, confinements)},
+        {"runs", per_run}};
+    if (!e.model.empty()) summary["specimen"]["model"] = e.model;
+    add_fits(summary);
+    if (e.target_sigma_ci > 0.0) summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
+    if (!record.empty()) {
+        nlohmann::json pairs = nlohmann::json::array();
+        for (const auto& [a, b] : record) pairs.push_back({a, b});
+        summary["target_record"] = {{"file", e.target_record}, {"pairs", pairs}};
+    }
+    return summary;
+}
+
 } // namespace
 
 int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
@@ -529,50 +595,9 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         std::fprintf(stderr, "bbm envelope: %s blocks of %.3g m, %g m x %g m, %d realization%s of each test on %d thread%s\n",
                      c.pattern.c_str(), c.o.size, c.o.width, c.o.height, n, n > 1 ? "s" : "", available,
                      available > 1 ? "s" : "");
-    // Uniaxial compression and tension first: the default confinements follow the UCS.
-    // Confinements given: every test in one list, none waiting for the UCS.
-    std::vector<Job> first;
-    for (int k = 0; k < n; ++k) first.push_back({LabTestOptions::Kind::ucs, 0.0, k});
-    for (int k = 0; k < n; ++k) first.push_back({tension_kind, 0.0, k});
-    const bool given = !e.confinements.empty();
-    if (given)
-        for (double s3 : confinements_to_test(e.confinements, {}))
-            for (int k = 0; k < n; ++k) first.push_back({LabTestOptions::Kind::biaxial, s3, k});
-    run_jobs(first);
-    std::vector<double> ucs, strength_t;
-    for (const auto& r : runs)
-        if (r.test == "ucs") ucs.push_back(r.result.peak_stress);
-        else if (r.test != "biaxial") strength_t.push_back(brazilian ? r.result.tensile_strength : r.result.peak_stress);
-    const std::vector<double> confinements = confinements_to_test(e.confinements, ucs);
-    if (!given) {
-        std::vector<Job> second;
-        for (double s3 : confinements)
-            for (int k = 0; k < n; ++k) second.push_back({LabTestOptions::Kind::biaxial, s3, k});
-        run_jobs(second);
-    }
-
-    const nlohmann::json levels = envelope_levels(runs, confinements);
+    const std::vector<double> confinements = run_envelope_tests(e, run_jobs, tension_kind);
     const auto [per_run, csv] = envelope_runs_table(runs);
-    const auto ucs_stats = stats(ucs), t_stats = stats(strength_t);
-    const double t_over_c = ucs_stats["mean"].get<double>() > 0
-                                ? t_stats["mean"].get<double>() / ucs_stats["mean"].get<double>() : 0.0;
-    nlohmann::json summary{
-        {"specimen", {{"pattern", c.pattern}, {"size", c.o.size}, {"width", c.o.width}, {"height", c.o.height},
-                      {"deformable_fraction", c.o.material.deformable_fraction}, {"weibull_modulus", c.o.joint.weibull_modulus},
-                      {"seed", c.o.seed}, {"realizations", n}}},
-        {"ucs", ucs_stats},
-        {"tension", {{"test", brazilian ? "brazilian" : "direct"}, {"strength", t_stats}, {"over_ucs", t_over_c}}},
-        {"confinements", confinements},
-        {"levels", levels},
-        {"runs", per_run}};
-    if (!e.model.empty()) summary["specimen"]["model"] = e.model;
-    add_fits(summary);
-    if (e.target_sigma_ci > 0.0) summary["target_hoek_brown"] = {{"sigma_ci", e.target_sigma_ci}, {"mi", e.target_mi}};
-    if (!record.empty()) {
-        nlohmann::json pairs = nlohmann::json::array();
-        for (const auto& [a, b] : record) pairs.push_back({a, b});
-        summary["target_record"] = {{"file", e.target_record}, {"pairs", pairs}};
-    }
+    const nlohmann::json summary = envelope_summary(e, runs, per_run, confinements, record);
 
     if (c.write_files && Ranks::root()) {
         io::write_text_atomically(out / "envelope.json", summary.dump(2) + "\n");
@@ -580,9 +605,11 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         draw_envelope(summary, out / "envelope.png");
     }
     if (!quiet) {
-        std::fprintf(stderr, "UCS %.2f +- %.2f MPa; %s tension %.2f MPa (T/UCS %.3f)\n", ucs_stats["mean"].get<double>() / 1e6,
-                     ucs_stats["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
-                     t_stats["mean"].get<double>() / 1e6, t_over_c);
+        const auto& ucs = summary["ucs"];
+        const auto& t = summary["tension"];
+        std::fprintf(stderr, "UCS %.2f +- %.2f MPa; %s tension %.2f MPa (T/UCS %.3f)\n", ucs["mean"].get<double>() / 1e6,
+                     ucs["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
+                     t["strength"]["mean"].get<double>() / 1e6, t["over_ucs"].get<double>());
         print_fits(summary);
         warn_about_envelope_runs(runs, c);
         if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
