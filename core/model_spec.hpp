@@ -144,7 +144,7 @@ struct StageSpec {
     /// k_deviator] from t = 0 to t = 1 over relax_steps: the fractions of the
     /// in-situ support's mean and deviatoric parts left at t (the last row's for
     /// good). A tunnel face's three-dimensional stress path in a plane section
-    /// (examples/field/face_path.py; docs/theory.md §9.2).
+    /// (examples/field/face_path.py; docs/theory.md §6.5).
     std::vector<std::array<double, 3>> support_path;
     std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
 };
