@@ -135,7 +135,7 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
             lo.kind = LabTestOptions::Kind::biaxial;
             const std::size_t c = std::size_t(k / n - 2);
             lo.confinement = confinements[c];
-            lo.stop.post_peak_strain = envelope_post_peak_strain; // as bbm envelope: a confined peak is final once failed
+            as_envelope_confined_test(lo); // as bbm envelope: a confined peak is final once failed
         }
         const LabTestResult r = run_labtest(lo);
         char text[128];

@@ -366,8 +366,9 @@ struct EnvelopeRunner {
             // stops 0.02% strain later, not at --max-strain (rigid trigon blocks keep
             // most of their strength under confinement and would run to 1% strain).
             // Once failed, its peak is final (run_labtest): a longer tail only draws
-            // more of the curve (1e-3 gave the same peaks, σci and σcd, 25% slower).
-            if (o.stop.post_peak_strain <= 0.0) o.stop.post_peak_strain = envelope_post_peak_strain;
+            // more of the curve (1e-3 gave the same peaks, σci and σcd, 25% slower),
+            // and that tail runs at the servo's fastest speed.
+            if (job.kind == LabTestOptions::Kind::biaxial) as_envelope_confined_test(o);
             o.threads = side_by_side == 1 ? available : 1;
             LabTestResult result;
             try {

@@ -416,3 +416,41 @@ TEST_CASE("the residual strength: the mean stress over the curve's last 0.2% of 
     CHECK(early.residual_stress == 0.0);
     CHECK(early.residual_friction_angle == 0.0);
 }
+
+TEST_CASE("the envelope's confined test: its tail past the failure runs at the servo's fastest speed, the peak the same to the last digit" * validation) {
+    // studies/labtest.hpp, as_envelope_confined_test: bbm envelope and calibrate
+    // stop a biaxial test 2e-4 of strain past its failure, and run that tail at
+    // --servo-max instead of the post-failure half speed. Nothing before the
+    // failure may change: the same steps up to it, so the same peak, first stall,
+    // sigma_ci, E and nu, bit for bit; the tail takes fewer steps.
+    auto o = LabTestOptions::paper_ucs();
+    o.kind = LabTestOptions::Kind::biaxial;
+    o.width = 2.0, o.height = 4.0, o.seed = 1, o.confinement = 2e6, o.frame_every = 0;
+    o.stop.post_peak_strain = envelope_post_peak_strain;
+    auto envelope = o;
+    as_envelope_confined_test(envelope);
+    CHECK(envelope.servo.post_peak_factor == o.servo.max_factor);
+    CHECK(envelope.stop.post_peak_strain == envelope_post_peak_strain);
+    // A faster post-failure speed given is kept, and a window given is kept.
+    auto given = o;
+    given.servo.post_peak_factor = 3.0, given.stop.post_peak_strain = 1e-3;
+    as_envelope_confined_test(given);
+    CHECK(given.servo.post_peak_factor == 3.0);
+    CHECK(given.stop.post_peak_strain == 1e-3);
+
+    LabTestResult slow, fast;
+    std::thread other([&] { slow = run_labtest(o); });
+    fast = run_labtest(envelope);
+    other.join();
+    MESSAGE("peak " << slow.peak_stress / 1e6 << " MPa at strain " << slow.strain_at_peak << "; steps " << slow.steps
+                    << " (half speed after failure) against " << fast.steps);
+    REQUIRE(slow.peak_passed);
+    CHECK(fast.peak_stress == slow.peak_stress);
+    CHECK(fast.strain_at_peak == slow.strain_at_peak);
+    CHECK(fast.first_stall_stress == slow.first_stall_stress);
+    CHECK(fast.crack_initiation_stress == slow.crack_initiation_stress);
+    CHECK(fast.E == slow.E);
+    CHECK(fast.nu == slow.nu);
+    CHECK(fast.reloads == slow.reloads);
+    CHECK(fast.steps < slow.steps);
+}
