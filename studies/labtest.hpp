@@ -265,10 +265,10 @@ std::vector<meshing::SegmentSpec> joint_set_traces(const LabTestOptions& o);
 /// or post_peak_factor if faster) instead of post_peak_factor's half speed. Before
 /// the failure nothing changes: on four rocks (the paper's Hoek-Brown set, its
 /// default joints, Lac du Bonnet's in-situ set with and without the confined
-/// friction; 26 biaxial tests, 2026-11-30) the peaks, first stalls, sigma_ci,
-/// sigma_cd, E and nu are the same to the last digit, with 5,120 steps fewer a test
-/// (docs/performance.md). A climb back above the dropped peak within the window
-/// (LabTestResult::reloads) is still loading on; none of those tests had one.
+/// friction; 28 biaxial tests, 2026-11-30) the peaks, first stalls, sigma_ci,
+/// sigma_cd, E and nu are the same to the last digit, most tests 5,120 steps
+/// shorter (docs/performance.md). A climb back above the dropped peak within the
+/// window (LabTestResult::reloads) is still loading on; none of those tests had one.
 inline void as_envelope_confined_test(LabTestOptions& o) {
     if (o.stop.post_peak_strain <= 0.0) o.stop.post_peak_strain = envelope_post_peak_strain;
     if (o.servo.post_peak_factor < o.servo.max_factor) o.servo.post_peak_factor = o.servo.max_factor;
