@@ -211,7 +211,7 @@ int main(int argc, char** argv) {
             AnalysisSpec analysis = sc.analysis;
             analysis.solver.threads = threads;
             Solver s(sc.blocks, analysis);
-            const long steps = std::max(100L, long(1e8 / s.contacts().size()));
+            const long steps = std::max(100L, long(1e8 / contacts(s.world()).size()));
             for (int k = 0; k < 20; ++k) s.step(); // warm-up
             std::vector<double> secs;
             for (int rep = 0; rep < 3; ++rep) {
@@ -220,10 +220,10 @@ int main(int argc, char** argv) {
                 secs.push_back(seconds_since(t0));
             }
             std::sort(secs.begin(), secs.end());
-            const double median = secs[1], updates = double(s.contacts().size()) * double(steps) / median;
+            const double median = secs[1], updates = double(contacts(s.world()).size()) * double(steps) / median;
             if (threads == 1) one_thread = updates;
-            const auto m = s.memory();
-            const int nb = s.blocks().count(), nc = s.contacts().size();
+            const auto m = memory(s.world());
+            const int nb = s.world().bodies.count(), nc = contacts(s.world()).size();
             const double per_block = double(m.blocks + m.vertices + m.other) / nb, per_contact = double(m.contacts) / nc;
             std::printf("%8d %9d %7d %7ld %10.1f %12.4g %9.2f %9.2f %11.0f %9.0f\n", nb, nc, threads, steps,
                         steps / median, updates, 1e9 / updates, updates / one_thread, per_block, per_contact);

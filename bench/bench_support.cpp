@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
         Quiet quiet;
         run_stages(s, before, quiet);
         std::ostringstream o;
-        s.save_state(o);
+        save_state(s.world(), o);
         state = o.str();
     }
     const long steps = 2000;
@@ -67,13 +67,14 @@ int main(int argc, char** argv) {
                 an.solver.threads = threads;
                 Solver s(blocks, an);
                 std::istringstream in(state);
-                s.load_state(in);
-                if (bolted) s.install_supports(sets);
+                load_state(s.world(), in);
+                if (bolted) install_supports(s.world(), sets);
                 const auto t0 = clock_type::now();
                 for (long k = 0; k < steps; ++k) s.step();
                 times[bolted].push_back(std::chrono::duration<double>(clock_type::now() - t0).count() / steps);
-                nodes[bolted] = s.bolts().node_count();
-                cracks[bolted] = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
+                nodes[bolted] = support_state<Bolts>(s.world().supports).node_count();
+                cracks[bolted] = bbm::cracks(s.world(), contact::JointState::broken_tension) +
+                                 bbm::cracks(s.world(), contact::JointState::broken_shear);
             }
         double median[2];
         for (int bolted : {0, 1}) {

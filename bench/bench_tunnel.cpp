@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <omp.h>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -27,6 +28,24 @@ using namespace bbm;
 using clock_type = std::chrono::steady_clock;
 
 namespace {
+
+/// Wall seconds of `passes` contact passes alone (the contact loop: kinematics,
+/// laws, forces) on `threads` threads, over a copy of the contacts in their
+/// present state; the model is not changed.
+double time_contact_passes(const World& w, long passes, int threads) {
+    contact::Contacts copy = w.contacts;
+    const auto view = block_view(w);
+    const auto t0 = std::chrono::steady_clock::now();
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+        const auto [first, last] = contact::contact_share(copy, omp_get_thread_num(), omp_get_num_threads());
+        for (long k = 0; k < passes; ++k) {
+            contact::contact_pass(copy, w.properties.laws, view, w.clock.dt, w.detection.corner_radius, first, last);
+#pragma omp barrier
+        }
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 double seconds_since(clock_type::time_point t0) {
     return std::chrono::duration<double>(clock_type::now() - t0).count();
 }
@@ -57,7 +76,7 @@ int main(int argc, char** argv) {
         scene.analysis.solver.threads = threads;
         Solver s(blocks, scene.analysis);
         int rigid = 0;
-        for (int i = 0; i < s.blocks().count(); ++i) rigid += !s.blocks().deformable[i];
+        for (int i = 0; i < s.world().bodies.count(); ++i) rigid += !s.world().blocks.deformable[i];
         for (int k = 0; k < 20; ++k) s.step(); // warm up
         const long steps = scene.analysis.stages[0].steps;
         double best = 1e30;
@@ -67,19 +86,20 @@ int main(int argc, char** argv) {
             best = std::min(best, seconds_since(t0));
         }
         // The zone kernel alone, on a copy of the model's zones and nodes.
-        fem::Zones z = s.zones();
-        std::vector<std::uint8_t> keep(s.blocks().count(), 0);
+        fem::Zones z = s.world().zones;
+        std::vector<std::uint8_t> keep(s.world().bodies.count(), 0);
         const long kernel_steps = 300;
         t0 = clock_type::now();
         for (long k = 0; k < kernel_steps; ++k)
-            fem::zone_pass(z, s.nodes().position.data(), s.nodes().velocity.data(), 1.0, keep.data());
+            fem::zone_pass(z, s.world().nodes.position.data(), s.world().nodes.velocity.data(), 1.0, keep.data(), 0,
+                           fem::zone_items(z));
         const double kernel_s = seconds_since(t0);
-        const double cups = double(s.contacts().size()) * steps / best, zups = double(s.zones().size()) * steps / best;
+        const double cups = double(contacts(s.world()).size()) * steps / best, zups = double(s.world().zones.size()) * steps / best;
         const double kernel = double(z.size()) * kernel_steps / kernel_s;
-        std::printf("%7d %8d %8d %9d %7ld %9.3f %9.0f %13.3g %13.3g %13.3g\n", threads, rigid, s.zones().size(),
-                    s.contacts().size(), steps, best, steps / best, cups, zups, kernel);
-        hybrid.push_back({{"threads", threads}, {"rigid_blocks", rigid}, {"zones", s.zones().size()},
-                          {"nodes", s.nodes().count()}, {"contacts", s.contacts().size()}, {"steps", steps},
+        std::printf("%7d %8d %8d %9d %7ld %9.3f %9.0f %13.3g %13.3g %13.3g\n", threads, rigid, s.world().zones.size(),
+                    contacts(s.world()).size(), steps, best, steps / best, cups, zups, kernel);
+        hybrid.push_back({{"threads", threads}, {"rigid_blocks", rigid}, {"zones", s.world().zones.size()},
+                          {"nodes", s.world().nodes.count()}, {"contacts", contacts(s.world()).size()}, {"steps", steps},
                           {"best_seconds", best}, {"steps_per_second", steps / best},
                           {"contact_updates_per_second", cups}, {"zone_updates_per_second", zups},
                           {"zone_kernel_updates_per_second", kernel}});
@@ -104,10 +124,10 @@ int main(int argc, char** argv) {
                     r.seconds, r.ratio);
         stages.push_back({{"name", r.name}, {"steps", r.steps}, {"seconds", r.seconds}, {"ratio", r.ratio}});
     }
-    std::printf("  total %.2f s, %ld steps, %d contacts, %d zones, peak memory %.0f MB\n", total, s.steps(),
-                s.contacts().size(), s.zones().size(), peak_mb());
+    std::printf("  total %.2f s, %ld steps, %d contacts, %d zones, peak memory %.0f MB\n", total, s.world().clock.steps,
+                contacts(s.world()).size(), s.world().zones.size(), peak_mb());
     result["tunnel_voronoi"] = {{"threads", 2}, {"setup_seconds", setup}, {"total_seconds", total},
-                                {"steps", s.steps()}, {"contacts", s.contacts().size()}, {"zones", s.zones().size()},
+                                {"steps", s.world().clock.steps}, {"contacts", contacts(s.world()).size()}, {"zones", s.world().zones.size()},
                                 {"stages", stages}};
 
     // 3. The contact loop's cost per contact, model against model.
@@ -129,17 +149,17 @@ int main(int argc, char** argv) {
         const auto mb = meshing::generate_blocks(model.geometry);
         Solver run(mb, model.analysis);
         run_stages(run, model.analysis.stages, q);
-        const int nc = run.contacts().size();
-        const long broken = run.cracks(contact::JointState::broken_tension) + run.cracks(contact::JointState::broken_shear);
+        const int nc = contacts(run.world()).size();
+        const long broken = cracks(run.world(), contact::JointState::broken_tension) + cracks(run.world(), contact::JointState::broken_shear);
         const long passes = std::max(50L, long(3e7 / std::max(1, nc)));
         for (int threads : {1, 2}) {
             double best = 1e30;
-            for (int rep = 0; rep < 3; ++rep) best = std::min(best, run.time_contact_passes(passes, threads));
+            for (int rep = 0; rep < 3; ++rep) best = std::min(best, time_contact_passes(run.world(), passes, threads));
             const double ns = best / (double(passes) * nc) * 1e9;
             if (&m == &cost_models[0]) paper_ns[threads] = ns;
-            std::printf("%-16s %8d %9d %8ld %7d %10.2f %9.3f\n", m.name, run.blocks().count(), nc, broken, threads, ns,
+            std::printf("%-16s %8d %9d %8ld %7d %10.2f %9.3f\n", m.name, run.world().bodies.count(), nc, broken, threads, ns,
                         ns / paper_ns[threads]);
-            costs.push_back({{"model", m.name}, {"file", m.file}, {"blocks", run.blocks().count()}, {"contacts", nc},
+            costs.push_back({{"model", m.name}, {"file", m.file}, {"blocks", run.world().bodies.count()}, {"contacts", nc},
                              {"broken_joints", broken}, {"threads", threads}, {"passes", passes},
                              {"ns_per_contact_update", ns}, {"relative_to_paper_tunnel", ns / paper_ns[threads]}});
         }

@@ -29,7 +29,7 @@ struct StopAt : StageObserver {
     explicit StopAt(long n) : stop_at(n) {}
     void at(const Solver& s, const StageCursor& c) override {
         cursor = c;
-        stop = s.steps() >= stop_at;
+        stop = s.world().clock.steps >= stop_at;
     }
     bool stop_requested() override { return stop; }
 };
@@ -43,26 +43,24 @@ long first_difference(const V& a, const V& b) {
 }
 
 void report(const Solver& a, const Solver& b) {
-    const auto &ca = a.contacts(), &cb = b.contacts();
+    const auto &ca = contacts(a.world()), &cb = contacts(b.world());
     std::printf("  contacts %d vs %d; dt %.17g vs %.17g; created %d/%d removed %d/%d transferred %d/%d\n", ca.size(),
-                cb.size(), a.timestep(), b.timestep(), a.detection_totals().created, b.detection_totals().created,
-                a.detection_totals().removed, b.detection_totals().removed, a.detection_totals().transferred,
-                b.detection_totals().transferred);
+                cb.size(), a.world().clock.dt, b.world().clock.dt, a.world().detection.totals.created, b.world().detection.totals.created,
+                a.world().detection.totals.removed, b.world().detection.totals.removed, a.world().detection.totals.transferred,
+                b.world().detection.totals.transferred);
     std::printf("  first difference: vertex_id %ld edge_id %ld length %ld property %ld history %ld\n",
                 first_difference(ca.vertex_id, cb.vertex_id), first_difference(ca.edge_id, cb.edge_id),
                 first_difference(ca.length, cb.length), first_difference(ca.property, cb.property),
                 first_difference(ca.history, cb.history));
-    std::printf("  blocks: centroid %ld velocity %ld theta %ld omega %ld mass %ld inertia %ld vertex %ld\n",
-                first_difference(a.blocks().centroid, b.blocks().centroid),
-                first_difference(a.blocks().velocity, b.blocks().velocity),
-                first_difference(a.blocks().theta, b.blocks().theta), first_difference(a.blocks().omega, b.blocks().omega),
-                first_difference(a.blocks().mass, b.blocks().mass),
-                first_difference(a.blocks().inertia, b.blocks().inertia),
-                first_difference(a.blocks().vertex, b.blocks().vertex));
+    const World &wa = a.world(), &wb = b.world();
+    std::printf("  blocks: state %ld mass %ld inertia %ld vertex %ld\n",
+                first_difference(wa.bodies.state, wb.bodies.state), first_difference(wa.bodies.mass, wb.bodies.mass),
+                first_difference(wa.bodies.inertia, wb.bodies.inertia),
+                first_difference(wa.vertices.position, wb.vertices.position));
     std::printf("  nodes: position %ld velocity %ld mass %ld; zones: stress %ld\n",
-                first_difference(a.nodes().position, b.nodes().position),
-                first_difference(a.nodes().velocity, b.nodes().velocity), first_difference(a.nodes().mass, b.nodes().mass),
-                first_difference(a.zones().stress, b.zones().stress));
+                first_difference(wa.nodes.position, wb.nodes.position),
+                first_difference(wa.nodes.velocity, wb.nodes.velocity), first_difference(wa.nodes.mass, wb.nodes.mass),
+                first_difference(wa.zones.stress, wb.zones.stress));
 }
 
 } // namespace
@@ -75,7 +73,7 @@ struct Record : StageObserver {
     explicit Record(long n) : last(n) {}
     void at(const Solver& s, const StageCursor& c) override {
         cursor = c;
-        if (c.step > 0) hashes.push_back({s.steps(), s.state_hash()});
+        if (c.step > 0) hashes.push_back({s.world().clock.steps, state_hash(s.world())});
     }
     bool stop_requested() override { return last > 0 && !hashes.empty() && hashes.back().first >= last; }
 };
@@ -97,10 +95,10 @@ int main(int argc, char** argv) {
         StopAt at(stop);
         run_stages(*whole, file.analysis.stages, at);
         std::stringstream checkpoint;
-        whole->save_state(checkpoint);
+        save_state(whole->world(), checkpoint);
         file.analysis.solver.threads = threads_after;
         auto* resumed = new Solver(blocks, file.analysis);
-        resumed->load_state(checkpoint);
+        load_state(resumed->world(), checkpoint);
         Record a(until), b(until);
         run_stages(*whole, file.analysis.stages, a, at.cursor);
         run_stages(*resumed, file.analysis.stages, b, at.cursor);
@@ -111,17 +109,17 @@ int main(int argc, char** argv) {
     const auto [ha, hb] = run(last, whole, resumed);
     std::printf("stopped at step %ld; continued to %ld (whole) and %ld (resumed); contacts created by the end: %d\n", stop,
                 ha.empty() ? stop : ha.back().first, hb.empty() ? stop : hb.back().first,
-                whole->detection_totals().created);
+                whole->world().detection.totals.created);
     long first = -1;
     for (std::size_t k = 0; k < std::min(ha.size(), hb.size()) && first < 0; ++k)
         if (ha[k] != hb[k]) first = ha[k].first;
     if (first < 0 && ha.size() == hb.size()) {
-        std::printf("identical at every step (final hash %llu)\n", (unsigned long long)whole->state_hash());
+        std::printf("identical at every step (final hash %llu)\n", (unsigned long long)state_hash(whole->world()));
         return 0;
     }
     std::printf("first different state after step %ld; at the end: cracks %d/%d vs %d/%d\n", first,
-                whole->cracks(contact::JointState::broken_tension), whole->cracks(contact::JointState::broken_shear),
-                resumed->cracks(contact::JointState::broken_tension), resumed->cracks(contact::JointState::broken_shear));
+                cracks(whole->world(), contact::JointState::broken_tension), cracks(whole->world(), contact::JointState::broken_shear),
+                cracks(resumed->world(), contact::JointState::broken_tension), cracks(resumed->world(), contact::JointState::broken_shear));
     delete whole, delete resumed;
     if (first < 0) return 1;
     run(first, whole, resumed);

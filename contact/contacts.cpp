@@ -1,7 +1,5 @@
 #include "contact/contacts.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <numeric>
 #include <tuple>
@@ -11,128 +9,137 @@
 
 namespace bbm::contact {
 
-void Contacts::add(int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h) {
-    edge_end.push_back(end);
-    vertex_block.push_back(a);
-    vertex_id.push_back(vertex);
-    edge_block.push_back(b);
-    edge_id.push_back(edge);
-    length.push_back(l);
-    property.push_back(prop);
-    history.push_back(h);
-    normal.push_back({});
-    if (flow_on) flow_link.push_back({-1, -1, -1}), fluid_pressure.push_back(0.0);
+void add_contact(Contacts& c, int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h) {
+    c.edge_end.push_back(end);
+    c.vertex_block.push_back(a);
+    c.vertex_id.push_back(vertex);
+    c.edge_block.push_back(b);
+    c.edge_id.push_back(edge);
+    c.length.push_back(l);
+    c.property.push_back(prop);
+    c.history.push_back(h);
+    c.normal.push_back({});
+    if (c.flow_on) c.flow_link.push_back({-1, -1, -1}), c.fluid_pressure.push_back(0.0);
 }
 
-void Contacts::remove_if_flagged(const std::vector<std::uint8_t>& remove) {
+void remove_flagged_contacts(Contacts& c, const std::vector<std::uint8_t>& remove) {
     int out = 0;
-    for (int i = 0; i < size(); ++i) {
+    for (int i = 0; i < c.size(); ++i) {
         if (remove[i]) continue;
-        vertex_block[out] = vertex_block[i];
-        vertex_id[out] = vertex_id[i];
-        edge_block[out] = edge_block[i];
-        edge_id[out] = edge_id[i];
-        edge_end[out] = edge_end[i];
-        length[out] = length[i];
-        property[out] = property[i];
-        history[out] = history[i];
-        normal[out] = normal[i];
-        if (flow_on) flow_link[out] = flow_link[i], fluid_pressure[out] = fluid_pressure[i];
+        c.vertex_block[out] = c.vertex_block[i];
+        c.vertex_id[out] = c.vertex_id[i];
+        c.edge_block[out] = c.edge_block[i];
+        c.edge_id[out] = c.edge_id[i];
+        c.edge_end[out] = c.edge_end[i];
+        c.length[out] = c.length[i];
+        c.property[out] = c.property[i];
+        c.history[out] = c.history[i];
+        c.normal[out] = c.normal[i];
+        if (c.flow_on) c.flow_link[out] = c.flow_link[i], c.fluid_pressure[out] = c.fluid_pressure[i];
         ++out;
     }
-    if (flow_on) flow_link.resize(out), fluid_pressure.resize(out);
-    for (auto* v : {&vertex_block, &vertex_id, &edge_block, &edge_id, &edge_end, &property}) v->resize(out);
-    length.resize(out);
-    history.resize(out);
-    normal.resize(out);
+    if (c.flow_on) c.flow_link.resize(out), c.fluid_pressure.resize(out);
+    for (auto* v : {&c.vertex_block, &c.vertex_id, &c.edge_block, &c.edge_id, &c.edge_end, &c.property}) v->resize(out);
+    c.length.resize(out);
+    c.history.resize(out);
+    c.normal.resize(out);
 }
 
-bool Contacts::sort_by_blocks() {
-    const int n = size();
+bool sort_contacts_by_blocks(Contacts& c) {
+    const int n = c.size();
     auto key = [&](int i) {
-        const int a = vertex_block[i], b = edge_block[i];
-        return std::tuple{std::min(a, b), std::max(a, b), vertex_id[i], edge_id[i]};
+        const int a = c.vertex_block[i], b = c.edge_block[i];
+        return std::tuple{std::min(a, b), std::max(a, b), c.vertex_id[i], c.edge_id[i]};
     };
     bool sorted = true;
     for (int i = 1; i < n && sorted; ++i) sorted = !(key(i) < key(i - 1));
     if (sorted) return false;
-    fill_.resize(n);
-    std::iota(fill_.begin(), fill_.end(), 0);
-    std::sort(fill_.begin(), fill_.end(), [&](int i, int j) { return key(i) < key(j); });
+    c.fill.resize(n);
+    std::iota(c.fill.begin(), c.fill.end(), 0);
+    std::sort(c.fill.begin(), c.fill.end(), [&](int i, int j) { return key(i) < key(j); });
     // Apply the permutation in place, cycle by cycle (new position k takes the
-    // contact at fill_[k]); a visited cycle is marked by negating its entries.
+    // contact at c.fill[k]); a visited cycle is marked by negating its entries.
     for (int start = 0; start < n; ++start) {
-        if (fill_[start] < 0 || fill_[start] == start) continue;
+        if (c.fill[start] < 0 || c.fill[start] == start) continue;
         auto rotate_cycle = [&](auto& v) {
             auto held = v[start];
             int k = start;
-            while (fill_[k] != start) {
-                v[k] = v[fill_[k]];
-                k = fill_[k];
+            while (c.fill[k] != start) {
+                v[k] = v[c.fill[k]];
+                k = c.fill[k];
             }
             v[k] = held;
         };
-        rotate_cycle(vertex_block), rotate_cycle(vertex_id), rotate_cycle(edge_block), rotate_cycle(edge_id);
-        rotate_cycle(edge_end), rotate_cycle(length), rotate_cycle(property), rotate_cycle(history);
-        rotate_cycle(normal);
-        if (flow_on) rotate_cycle(flow_link), rotate_cycle(fluid_pressure);
-        for (int k = start; fill_[k] >= 0;) {
-            const int next = fill_[k];
-            fill_[k] = -1 - next;
+        rotate_cycle(c.vertex_block), rotate_cycle(c.vertex_id), rotate_cycle(c.edge_block), rotate_cycle(c.edge_id);
+        rotate_cycle(c.edge_end), rotate_cycle(c.length), rotate_cycle(c.property), rotate_cycle(c.history);
+        rotate_cycle(c.normal);
+        if (c.flow_on) rotate_cycle(c.flow_link), rotate_cycle(c.fluid_pressure);
+        for (int k = start; c.fill[k] >= 0;) {
+            const int next = c.fill[k];
+            c.fill[k] = -1 - next;
             k = next;
         }
     }
     return true;
 }
 
-void Contacts::rebuild_index(int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
-                             const int* vertex_node) {
-    const int n = size();
+void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
+                           const int* vertex_node) {
+    const int n = c.size();
     auto is_deformable = [&](int blk) { return deformable && deformable[blk]; };
-    batches.resize(2 * property_sets);
-    for (auto& batch : batches) batch.clear();
-    for (int i = 0; i < n; ++i) {
-        const bool mixed = is_deformable(vertex_block[i]) || is_deformable(edge_block[i]);
-        batches[2 * property[i] + (mixed ? 1 : 0)].push_back(i);
+    // Batches by counting sort: each contact's batch, the sizes, then the fill
+    // in contact order.
+    const int batches = 2 * property_sets;
+    c.batch_first.assign(batches + 1, 0);
+    auto batch_of = [&](int i) {
+        const bool mixed = is_deformable(c.vertex_block[i]) || is_deformable(c.edge_block[i]);
+        return 2 * c.property[i] + (mixed ? 1 : 0);
+    };
+    for (int i = 0; i < n; ++i) ++c.batch_first[batch_of(i) + 1];
+    for (int k = 0; k < batches; ++k) c.batch_first[k + 1] += c.batch_first[k];
+    c.batch_contact.resize(n);
+    c.fill.assign(c.batch_first.begin(), c.batch_first.end() - 1);
+    for (int i = 0; i < n; ++i) c.batch_contact[c.fill[batch_of(i)]++] = i;
+    c.work.clear();
+    for (int k = 0; k < batches; ++k) {
+        const int size = c.batch_first[k + 1] - c.batch_first[k];
+        for (int begin = 0; begin < size; begin += Contacts::work_item_size)
+            c.work.push_back({k, begin, std::min(size, begin + Contacts::work_item_size)});
     }
-    work.clear();
-    for (int k = 0; k < int(batches.size()); ++k)
-        for (int begin = 0; begin < int(batches[k].size()); begin += work_item_size)
-            work.push_back({k, begin, std::min(int(batches[k].size()), begin + work_item_size)});
-    work_cost_before.resize(work.size() + 1);
+    c.work_cost_before.resize(c.work.size() + 1);
     double cost = 0.0;
-    for (std::size_t w = 0; w < work.size(); ++w) {
-        work_cost_before[w] = cost;
-        cost += double(work[w].end - work[w].begin) * (work[w].batch % 2 ? mixed_contact_cost : 1.0);
+    for (std::size_t w = 0; w < c.work.size(); ++w) {
+        c.work_cost_before[w] = cost;
+        cost += double(c.work[w].end - c.work[w].begin) * (c.work[w].batch % 2 ? Contacts::mixed_contact_cost : 1.0);
     }
-    work_cost_before[work.size()] = cost;
-    force.resize(n);
-    partial_sum.resize(work.size());
+    c.work_cost_before[c.work.size()] = cost;
+    c.force.resize(n);
+    c.partial_sum.resize(c.work.size());
 
     // Per-block and per-node lists in contact order: count, prefix sum, fill
-    // (`fill_` is kept between calls: this runs inside steps that change contacts).
-    block_first.assign(blocks + 1, 0);
-    node_first.assign(nodes + 1, 0);
+    // (`c.fill` is kept between calls: this runs inside steps that change contacts).
+    c.block_first.assign(blocks + 1, 0);
+    c.node_first.assign(nodes + 1, 0);
     for (int i = 0; i < n; ++i) {
-        ++block_first[vertex_block[i] + 1], ++block_first[edge_block[i] + 1];
-        if (is_deformable(vertex_block[i])) ++node_first[vertex_node[vertex_id[i]] + 1];
-        if (is_deformable(edge_block[i])) ++node_first[vertex_node[edge_id[i]] + 1], ++node_first[vertex_node[edge_end[i]] + 1];
+        ++c.block_first[c.vertex_block[i] + 1], ++c.block_first[c.edge_block[i] + 1];
+        if (is_deformable(c.vertex_block[i])) ++c.node_first[vertex_node[c.vertex_id[i]] + 1];
+        if (is_deformable(c.edge_block[i])) ++c.node_first[vertex_node[c.edge_id[i]] + 1], ++c.node_first[vertex_node[c.edge_end[i]] + 1];
     }
-    for (int k = 0; k < blocks; ++k) block_first[k + 1] += block_first[k];
-    for (int k = 0; k < nodes; ++k) node_first[k + 1] += node_first[k];
-    block_entry.resize(block_first[blocks]);
-    node_entry.resize(node_first[nodes]);
-    fill_.assign(block_first.begin(), block_first.end() - 1);
+    for (int k = 0; k < blocks; ++k) c.block_first[k + 1] += c.block_first[k];
+    for (int k = 0; k < nodes; ++k) c.node_first[k + 1] += c.node_first[k];
+    c.block_entry.resize(c.block_first[blocks]);
+    c.node_entry.resize(c.node_first[nodes]);
+    c.fill.assign(c.block_first.begin(), c.block_first.end() - 1);
     for (int i = 0; i < n; ++i) {
-        block_entry[fill_[vertex_block[i]]++] = 2 * i;
-        block_entry[fill_[edge_block[i]]++] = 2 * i + 1;
+        c.block_entry[c.fill[c.vertex_block[i]]++] = 2 * i;
+        c.block_entry[c.fill[c.edge_block[i]]++] = 2 * i + 1;
     }
-    fill_.assign(node_first.begin(), node_first.end() - 1);
+    c.fill.assign(c.node_first.begin(), c.node_first.end() - 1);
     for (int i = 0; i < n; ++i) {
-        if (is_deformable(vertex_block[i])) node_entry[fill_[vertex_node[vertex_id[i]]]++] = 4 * i;
-        if (is_deformable(edge_block[i])) {
-            node_entry[fill_[vertex_node[edge_id[i]]]++] = 4 * i + 1;
-            node_entry[fill_[vertex_node[edge_end[i]]]++] = 4 * i + 2;
+        if (is_deformable(c.vertex_block[i])) c.node_entry[c.fill[vertex_node[c.vertex_id[i]]]++] = 4 * i;
+        if (is_deformable(c.edge_block[i])) {
+            c.node_entry[c.fill[vertex_node[c.edge_id[i]]]++] = 4 * i + 1;
+            c.node_entry[c.fill[vertex_node[c.edge_end[i]]]++] = 4 * i + 2;
         }
     }
 }
@@ -181,10 +188,8 @@ void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::
     c.face_du_s.assign(c.face_first.size() - 1, 0.0);
 }
 
-void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_radius) {
-    const int faces = int(c.face_du_s.size());
-#pragma omp for schedule(static) nowait
-    for (int f = 0; f < faces; ++f) {
+void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_radius, int first, int last) {
+    for (int f = first; f < last; ++f) {
         double sum = 0.0, length = 0.0;
         for (int e = c.face_first[f]; e < c.face_first[f + 1]; ++e) {
             const int i = c.face_entry[e];
@@ -293,17 +298,11 @@ std::pair<int, int> team_share(const std::vector<double>& cost_before, int threa
 }
 
 void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                  double corner_radius) {
-    // Each thread of the team takes a contiguous run of work items of equal
-    // estimated cost (work_cost_before), the same run every step while the contacts
-    // do not change, so its contacts' histories and forces stay in that core's cache
-    // (dynamic handing-out moved them between cores every step; paired runs of the
-    // trigon tunnel on 2 threads: 8% less wall time, median of 8). No barrier at
-    // the end, like an `omp for nowait`; outside a team one thread takes all.
-    const auto [first, last] = team_share(c.work_cost_before, omp_get_thread_num(), omp_get_num_threads(), &c.team_split);
+                  double corner_radius, int first, int last) {
     for (int w = first; w < last; ++w) {
         const auto& item = c.work[w];
-        const std::span<const int> ids(c.batches[item.batch].data() + item.begin, item.end - item.begin);
+        const std::span<const int> ids(c.batch_contact.data() + c.batch_first[item.batch] + item.begin,
+                                       item.end - item.begin);
         c.partial_sum[w] = std::visit(
             [&](const auto& law) {
                 return item.batch % 2 ? batch_pass<true>(law, ids, c, b, dt, corner_radius)

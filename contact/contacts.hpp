@@ -30,14 +30,15 @@
 // batches of one property set so that each law is dispatched once per batch.
 //
 // Determinism: a block's force is the sum of its contacts' forces in contact-id
-// order, whatever the number of threads (step_contacts computes every contact's
-// force first, then gathers per block), so a run gives the same bits on 1 or 64
+// order, whatever the number of threads (contact_pass computes every contact's
+// force first, block_contact_force then gathers per block), so a run gives the same bits on 1 or 64
 // threads — failure is chaotic, and a result that depends on the partition of the
 // work cannot be reproduced on another machine.
 #pragma once
 
-#include "contact/joint_law.hpp"
+#include "base/fields.hpp"
 #include "base/vec2.hpp"
+#include "contact/joint_law.hpp"
 
 #include <array>
 #include <cstdint>
@@ -46,23 +47,20 @@
 
 namespace bbm::contact {
 
-/// What the contact loop reads of a block, packed into one 48-byte record so
-/// that a contact touches one cache line per block, not one per array (the
-/// solver refreshes it from its arrays at the start of every step).
+/// A rigid block's hot state: what the contact loop reads of it and integration
+/// writes, one 48-byte record per block (the world stores them so: a contact
+/// touches one cache line per block, and no step copies them).
 struct BodyState {
     Vec2 centroid, velocity;
-    double omega;
-    double pad_ = 0.0;
+    double omega = 0.0; ///< rad per unit time, counter-clockwise
+    double theta = 0.0; ///< rotation since the model was built, rad
 };
 static_assert(sizeof(BodyState) == 48);
 
 /// The geometry the contact kernels read: flat per-block and per-vertex arrays
-/// owned by the solver (core/solver.hpp).
+/// of the world (core/world.hpp).
 struct BlockView {
-    const BodyState* body;    ///< per block, packed copy of the three arrays below
-    const Vec2* centroid;     ///< per block
-    const Vec2* velocity;     ///< per block
-    const double* omega;      ///< per block
+    const BodyState* body;    ///< per block
     const Vec2* vertex;       ///< current vertex positions, all blocks, CSR by `first`
     const std::uint32_t* first;
     const double* inv_edge_length; ///< 1 / length of the edge starting at each vertex (rigid: constant)
@@ -80,19 +78,24 @@ struct BlockView {
 /// Velocity of the material point of block `blk` at `x`, which is its vertex `v`
 /// (deformable: that node's velocity; rigid: v + ω × (x − c)).
 inline Vec2 vertex_velocity(const BlockView& b, int blk, int v, Vec2 x) {
-    return b.deformable[blk] ? b.node_velocity[b.vertex_node[v]] : b.velocity[blk] + b.omega[blk] * perp(x - b.centroid[blk]);
+    if (b.deformable[blk]) return b.node_velocity[b.vertex_node[v]];
+    const BodyState& s = b.body[blk];
+    return s.velocity + s.omega * perp(x - s.centroid);
 }
 
 /// Velocity of block `blk` at `x`, near its edge (e0, e1) at parameter s: on a
 /// deformable edge, linear between the two nodes (s clamped to the edge).
 inline Vec2 edge_velocity(const BlockView& b, int blk, int e0, int e1, double s, Vec2 x) {
-    if (!b.deformable[blk]) return b.velocity[blk] + b.omega[blk] * perp(x - b.centroid[blk]);
+    if (!b.deformable[blk]) {
+        const BodyState& r = b.body[blk];
+        return r.velocity + r.omega * perp(x - r.centroid);
+    }
     const double w = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
     return (1.0 - w) * b.node_velocity[b.vertex_node[e0]] + w * b.node_velocity[b.vertex_node[e1]];
 }
 
-/// Stage 2's first pass writes one record per contact; the second pass gathers
-/// them per block and per node (see step_contacts).
+/// Stage 2's first pass (contact_pass) writes one record per contact; the second
+/// pass gathers them per block and per node (block_contact_force, node_contact_force).
 struct ContactForce {
     Vec2 force; ///< on the vertex block A (B gets −force)
     /// [0]: moment about A's centroid (rigid A); [1]: about B's centroid, of −force
@@ -101,6 +104,8 @@ struct ContactForce {
     double moment[2];
 };
 
+/// The contacts: plain data, one entry per contact in every per-contact array;
+/// the functions below add, remove, renumber and index them.
 struct Contacts {
     // Topology (cold).
     std::vector<int> vertex_block, vertex_id; ///< A and the global id of its vertex
@@ -122,10 +127,12 @@ struct Contacts {
     bool flow_on = false; ///< the two arrays above are kept, one entry per contact
     bool wet() const { return flow_on; }
 
-    // Derived index, rebuilt by rebuild_index() whenever contacts are added or removed.
-    /// Contacts by property set and kind: batch 2p holds the rigid–rigid contacts
-    /// of set p (the fast kernel), batch 2p+1 those with a deformable side.
-    std::vector<std::vector<int>> batches;
+    // Derived index, rebuilt by rebuild_contact_index() whenever contacts are added or removed.
+    /// Contacts by property set and kind, flat (CSR): batch k is the contacts
+    /// batch_contact[batch_first[k] .. batch_first[k + 1]), in contact order;
+    /// batch 2p holds the rigid–rigid contacts of set p (the fast kernel), batch
+    /// 2p+1 those with a deformable side.
+    std::vector<int> batch_first, batch_contact;
     /// Fixed pieces of the batches (at most `work_item_size` contacts each): the
     /// units of parallel work, and of the partial sums of Σ|F|², so that neither
     /// depends on the thread count.
@@ -168,25 +175,67 @@ struct Contacts {
     /// assign_face_groups' (face, contact) pairs, kept between rebuilds so that a
     /// rebuild allocates only when the model has grown.
     std::vector<std::pair<int, int>> face_scratch;
-    // Per-step scratch of step_contacts (sized by rebuild_index, never in a step).
+    // Per-step scratch of contact_pass (sized by rebuild_contact_index, never in a step).
     std::vector<ContactForce> force;
     std::vector<double> partial_sum; ///< per work item
-    std::vector<int> fill_;          ///< rebuild_index's cursor
+    std::vector<int> fill;           ///< rebuild_contact_index's and the renumbering's cursor
 
     int size() const { return static_cast<int>(length.size()); }
-    void add(int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h);
-    void remove_if_flagged(const std::vector<std::uint8_t>& remove);
-    /// Renumbers the contacts in order of their block pair (lower block id first,
-    /// then the other; ties by vertex): with blocks numbered along a space-filling
-    /// curve, a contact's blocks then sit near those of the contacts before it, and
-    /// the loop reads them from cache. Returns whether anything moved.
-    bool sort_by_blocks();
-    /// Rebuilds batches, work items and the per-block and per-node index.
-    /// `deformable`: per block, non-zero for deformable blocks; `vertex_node`: per
-    /// vertex, its FE node (−1 on rigid blocks); both may be null for rigid models.
-    void rebuild_index(int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
-                       const int* vertex_node);
 };
+
+/// Its fields (base/fields.hpp), in the checkpoint's order: topology and
+/// histories (saved), then normals and forces (rebuilt). The water links are
+/// the flow's (core/joint_flow.hpp), the index the next function's.
+template <part_of<Contacts> C, class Visit>
+void visit_fields(C& c, Visit&& v) {
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, R = field_use::rebuilt;
+    v(FieldInfo{"contacts.vertex_block", G::contacts, E}, c.vertex_block);
+    v(FieldInfo{"contacts.vertex_id", G::contacts, E}, c.vertex_id);
+    v(FieldInfo{"contacts.edge_block", G::contacts, E}, c.edge_block);
+    v(FieldInfo{"contacts.edge_id", G::contacts, E}, c.edge_id);
+    v(FieldInfo{"contacts.edge_end", G::contacts, E}, c.edge_end);
+    v(FieldInfo{"contacts.length", G::contacts, E}, c.length);
+    v(FieldInfo{"contacts.property", G::contacts, E}, c.property);
+    v(FieldInfo{"contacts.history", G::contacts, E}, c.history);
+    v(FieldInfo{"contacts.normal", G::contacts, R}, c.normal);
+    v(FieldInfo{"contacts.force", G::contacts, R}, c.force);
+}
+/// The index and scratch rebuilt from the contacts (rebuilt fields).
+template <part_of<Contacts> C, class Visit>
+void visit_index_fields(C& c, Visit&& v) {
+    using G = MemoryGroup;
+    constexpr unsigned R = field_use::rebuilt;
+    v(FieldInfo{"contacts.block_first", G::blocks, R}, c.block_first);
+    v(FieldInfo{"contacts.block_entry", G::contacts, R}, c.block_entry);
+    v(FieldInfo{"contacts.node_first", G::nodes, R}, c.node_first);
+    v(FieldInfo{"contacts.node_entry", G::contacts, R}, c.node_entry);
+    v(FieldInfo{"contacts.fill", G::contacts, R}, c.fill);
+    v(FieldInfo{"contacts.partial_sum", G::contacts, R}, c.partial_sum);
+    v(FieldInfo{"contacts.work", G::contacts, R}, c.work);
+    v(FieldInfo{"contacts.work_cost_before", G::contacts, R}, c.work_cost_before);
+    v(FieldInfo{"contacts.team_split", G::other, R}, c.team_split);
+    v(FieldInfo{"contacts.face_group", G::contacts, R}, c.face_group);
+    v(FieldInfo{"contacts.face_first", G::contacts, R}, c.face_first);
+    v(FieldInfo{"contacts.face_entry", G::contacts, R}, c.face_entry);
+    v(FieldInfo{"contacts.face_du_s", G::contacts, R}, c.face_du_s);
+    v(FieldInfo{"contacts.face_scratch", G::contacts, R}, c.face_scratch);
+    v(FieldInfo{"contacts.batch_first", G::contacts, R}, c.batch_first);
+    v(FieldInfo{"contacts.batch_contact", G::contacts, R}, c.batch_contact);
+}
+
+void add_contact(Contacts& c, int a, int vertex, int b, int edge, int end, double l, int prop, const JointHistory& h);
+void remove_flagged_contacts(Contacts& c, const std::vector<std::uint8_t>& remove);
+/// Renumbers the contacts in order of their block pair (lower block id first,
+/// then the other; ties by vertex): with blocks numbered along a space-filling
+/// curve, a contact's blocks then sit near those of the contacts before it, and
+/// the loop reads them from cache. Returns whether anything moved.
+bool sort_contacts_by_blocks(Contacts& c);
+/// Rebuilds batches, work items and the per-block and per-node index.
+/// `deformable`: per block, non-zero for deformable blocks; `vertex_node`: per
+/// vertex, its FE node (−1 on rigid blocks); both may be null for rigid models.
+void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
+                           const int* vertex_node);
 
 /// Global id of the vertex after `v` around its block.
 inline int next_vertex(const std::uint32_t* first, int block, int v) {
@@ -246,15 +295,16 @@ void update_normals(Contacts& c, const BlockView& b, double corner_radius);
 /// no set asks for them.
 void assign_face_groups(Contacts& c, const BlockView& b, const std::vector<std::uint8_t>& face_shear);
 
-/// Per face, the length-weighted mean of its contacts' shear-slip increments this
-/// step, into `c.face_du_s` (the same kinematics as contact_pass). Between a rigid
-/// face and a deformable body the pointwise slip grows along the face with the
-/// body's strain, and pointwise shear springs would load the rigid block with a
-/// couple of forces a joint between two rigid blocks never carries; on the mean
-/// slip the face's shear traction is uniform, as on such a joint (docs/theory.md
-/// §11.1). An OpenMP work-sharing loop with `nowait` like contact_pass: the team
-/// must meet at a barrier before contact_pass reads the result.
-void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_radius);
+/// Per face of [first, last), the length-weighted mean of its contacts'
+/// shear-slip increments this step, into `c.face_du_s` (the same kinematics as
+/// contact_pass). Between a rigid face and a deformable body the pointwise slip
+/// grows along the face with the body's strain, and pointwise shear springs
+/// would load the rigid block with a couple of forces a joint between two rigid
+/// blocks never carries; on the mean slip the face's shear traction is uniform,
+/// as on such a joint (docs/theory.md §11.1). Faces are independent: a team
+/// shares them and meets at a barrier before contact_pass reads the result.
+void face_slip_pass(Contacts& c, const BlockView& b, double dt, double corner_radius, int first, int last);
+inline int face_count(const Contacts& c) { return static_cast<int>(c.face_du_s.size()); }
 
 /// Contact force on the vertex block (A); B gets the opposite.
 inline Vec2 contact_force(const Contacts& c, int i) {
@@ -264,14 +314,14 @@ inline Vec2 contact_force(const Contacts& c, int i) {
     return c.length[i] * (sn * n - h.tau * tangent_of(n));
 }
 
-/// Stage 2 of a step, first pass: per contact (work items, each law dispatched
-/// once per batch) its kinematics, the law, and its force and moments into
-/// `c.force` — no contact writes anything another contact reads. An OpenMP
-/// work-sharing loop without a parallel region of its own and without a barrier
-/// at its end (`nowait`): a team calling it shares the work and must meet at a
-/// barrier before the gathers below; called outside a team it runs serially.
+/// Stage 2 of a step, first pass: per contact of the work items [first, last)
+/// (each law dispatched once per batch) its kinematics, the law, and its force
+/// and moments into `c.force` — no contact writes anything another contact
+/// reads, so a team shares the items (contact_share) and meets at a barrier
+/// before the gathers below.
 void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                  double corner_radius);
+                  double corner_radius, int first, int last);
+inline int contact_items(const Contacts& c) { return static_cast<int>(c.work.size()); }
 
 /// The work items [first, last) of `thread` in a team of `team`: contiguous runs
 /// of about equal cost (`cost_before`: Contacts::work_cost_before), or of the
@@ -279,6 +329,16 @@ void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockVie
 /// so); every item goes to exactly one thread, in order.
 std::pair<int, int> team_share(const std::vector<double>& cost_before, int thread, int team,
                                const std::vector<double>* split = nullptr);
+
+/// The work items of `thread` in the contact pass: contiguous runs of equal
+/// estimated cost moved toward equal measured times (Contacts::team_split). The
+/// same run every step while the contacts do not change, so its contacts'
+/// histories and forces stay in that core's cache (dynamic handing-out moved them
+/// between cores every step; paired runs of the trigon tunnel on 2 threads: 8%
+/// less wall time, median of 8).
+inline std::pair<int, int> contact_share(const Contacts& c, int thread, int team) {
+    return team_share(c.work_cost_before, thread, team, &c.team_split);
+}
 
 /// Second pass, per block: the force and moment of its contacts, summed in
 /// contact order — so the sum does not depend on which thread computed what.

@@ -73,7 +73,9 @@ std::vector<Junction> find_junctions(const std::vector<Vec2>& vertex, const std:
     return out;
 }
 
-bool Detector::known(const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) const {
+namespace {
+
+bool known(const Detector& d, const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) {
     // An existing contact of the pair (either way round) at this point? Searched
     // among the contacts of the block that has fewer.
     const Vec2 x = in.blocks.vertex[vertex];
@@ -84,13 +86,13 @@ bool Detector::known(const Contacts& c, int vertex_block, int vertex, int edge_b
     for (int e = c.block_first[own]; e < c.block_first[own + 1]; ++e) {
         const int i = c.block_entry[e] >> 1;
         const int partner = (c.block_entry[e] & 1) ? c.vertex_block[i] : c.edge_block[i];
-        if (partner != other || drop_[i]) continue;
+        if (partner != other || d.drop[i]) continue;
         if (norm2(in.blocks.vertex[c.vertex_id[i]] - x) <= tol2) return true;
     }
     return false;
 }
 
-Box2 Detector::current_box(const Piece& pc, const BlockView& b, double inflate) const {
+Box2 current_box(const Detector::Piece& pc, const BlockView& b, double inflate) {
     // An edge's box holds both its ends: the next vertex closes it.
     Box2 box;
     for (std::uint32_t v = pc.v0; v < pc.v1; ++v) {
@@ -102,7 +104,7 @@ Box2 Detector::current_box(const Piece& pc, const BlockView& b, double inflate) 
     return box;
 }
 
-void Detector::build_grid(const DetectionInput& in) {
+void build_grid(Detector& d, const DetectionInput& in) {
     // A block with many vertices (a deformable block's boundary, hundreds of
     // nodes) enters as pieces of at most `chunk` consecutive vertices, each with
     // its own box: otherwise its one box, as large as the model, would pair it
@@ -111,63 +113,62 @@ void Detector::build_grid(const DetectionInput& in) {
     constexpr std::uint32_t chunk = 16;
     const BlockView& b = in.blocks;
     const int nb = in.block_count;
-    if (int(block_piece_.size()) != nb + 1) {
-        pieces_.clear();
-        block_piece_.assign(1, 0);
+    if (int(d.block_piece.size()) != nb + 1) {
+        d.pieces.clear();
+        d.block_piece.assign(1, 0);
         for (int k = 0; k < nb; ++k) {
             for (std::uint32_t v0 = b.first[k]; v0 < b.first[k + 1]; v0 += chunk)
-                pieces_.push_back({k, v0, std::min(b.first[k + 1], v0 + chunk)});
-            block_piece_.push_back(int(pieces_.size()));
+                d.pieces.push_back({k, v0, std::min(b.first[k + 1], v0 + chunk)});
+            d.block_piece.push_back(int(d.pieces.size()));
         }
     }
-    const int np = int(pieces_.size());
-    stored_.resize(np);
-    grid_box_ = Box2{};
+    const int np = int(d.pieces.size());
+    d.stored.resize(np);
+    d.grid_box = Box2{};
     double extent = 0.0;
     int counted = 0;
     for (int p = 0; p < np; ++p) {
-        if (in.removed && in.removed[pieces_[p].block]) continue;
-        stored_[p] = current_box(pieces_[p], b, in.tolerance);
-        extent += stored_[p].width() + stored_[p].height();
+        if (in.removed && in.removed[d.pieces[p].block]) continue;
+        d.stored[p] = current_box(d.pieces[p], b, in.tolerance);
+        extent += d.stored[p].width() + d.stored[p].height();
         ++counted;
     }
     extent /= std::max(1, 2 * counted);
-    margin_ = std::max(4.0 * in.tolerance, 0.1 * extent);
+    d.margin = std::max(4.0 * in.tolerance, 0.1 * extent);
     for (int p = 0; p < np; ++p) {
-        if (in.removed && in.removed[pieces_[p].block]) continue;
-        stored_[p].lo -= Vec2{margin_, margin_};
-        stored_[p].hi += Vec2{margin_, margin_};
-        grid_box_.add(stored_[p].lo);
-        grid_box_.add(stored_[p].hi);
+        if (in.removed && in.removed[d.pieces[p].block]) continue;
+        d.stored[p].lo -= Vec2{d.margin, d.margin};
+        d.stored[p].hi += Vec2{d.margin, d.margin};
+        d.grid_box.add(d.stored[p].lo);
+        d.grid_box.add(d.stored[p].hi);
     }
-    cell_ = std::max(extent + 2.0 * margin_, 1e-12);
-    nx_ = std::clamp(int(grid_box_.width() / cell_) + 1, 1, 1 << 14);
-    ny_ = std::clamp(int(grid_box_.height() / cell_) + 1, 1, 1 << 14);
+    d.cell = std::max(extent + 2.0 * d.margin, 1e-12);
+    d.nx = std::clamp(int(d.grid_box.width() / d.cell) + 1, 1, 1 << 14);
+    d.ny = std::clamp(int(d.grid_box.height() / d.cell) + 1, 1, 1 << 14);
     auto for_cells = [&](const Box2& bx, auto&& visit) {
-        const int i0 = std::clamp(int((bx.lo.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
-        const int i1 = std::clamp(int((bx.hi.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
-        const int j0 = std::clamp(int((bx.lo.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
-        const int j1 = std::clamp(int((bx.hi.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
+        const int i0 = std::clamp(int((bx.lo.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
+        const int i1 = std::clamp(int((bx.hi.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
+        const int j0 = std::clamp(int((bx.lo.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
+        const int j1 = std::clamp(int((bx.hi.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
         for (int j = j0; j <= j1; ++j)
-            for (int i = i0; i <= i1; ++i) visit(std::size_t(j) * nx_ + i);
+            for (int i = i0; i <= i1; ++i) visit(std::size_t(j) * d.nx + i);
     };
     // Counting sort of the pieces into the cells their stored boxes cover.
-    cell_first_.assign(std::size_t(nx_) * ny_ + 1, 0);
+    d.cell_first.assign(std::size_t(d.nx) * d.ny + 1, 0);
     for (int p = 0; p < np; ++p)
-        if (!(in.removed && in.removed[pieces_[p].block])) for_cells(stored_[p], [&](std::size_t k) { ++cell_first_[k + 1]; });
-    for (std::size_t k = 0; k + 1 < cell_first_.size(); ++k) cell_first_[k + 1] += cell_first_[k];
-    cell_piece_.resize(cell_first_.back());
+        if (!(in.removed && in.removed[d.pieces[p].block])) for_cells(d.stored[p], [&](std::size_t k) { ++d.cell_first[k + 1]; });
+    for (std::size_t k = 0; k + 1 < d.cell_first.size(); ++k) d.cell_first[k + 1] += d.cell_first[k];
+    d.cell_piece.resize(d.cell_first.back());
     for (int p = 0; p < np; ++p)
-        if (!(in.removed && in.removed[pieces_[p].block]))
-            for_cells(stored_[p], [&](std::size_t k) { cell_piece_[cell_first_[k]++] = p; });
-    for (std::size_t k = cell_first_.size() - 1; k > 0; --k) cell_first_[k] = cell_first_[k - 1];
-    cell_first_[0] = 0;
-    grid_valid_ = true;
-    ++grid_builds_;
+        if (!(in.removed && in.removed[d.pieces[p].block]))
+            for_cells(d.stored[p], [&](std::size_t k) { d.cell_piece[d.cell_first[k]++] = p; });
+    for (std::size_t k = d.cell_first.size() - 1; k > 0; --k) d.cell_first[k] = d.cell_first[k - 1];
+    d.cell_first[0] = 0;
+    d.grid_valid = true;
 }
 
-void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in,
-                              std::vector<Candidate>& out) const {
+void add_candidates(const Detector::Piece& P, const Detector::Piece& Q, const Box2& q_box, const DetectionInput& in,
+                    std::vector<Detector::Candidate>& out) {
     // Vertices of P against edges of Q.
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
@@ -252,41 +253,39 @@ void Detector::add_candidates(const Piece& P, const Piece& Q, const Box2& q_box,
     }
 }
 
-namespace {
 /// A block that takes part in this pass: active (moving) and not removed.
 inline bool is_active(const DetectionInput& in, int k) {
     return (!in.active || in.active[k]) && !(in.removed && in.removed[k]);
 }
-} // namespace
 
 /// Every thread: the pass's active blocks and cleared scratch (one thread writes).
-void Detector::start_pass(const Contacts& c, const DetectionInput& in) {
+void start_pass(Detector& d, const Contacts& c, const DetectionInput& in) {
 #pragma omp single
     {
-        drop_.resize(c.size(), 0);
-        active_blocks_.clear();
+        d.drop.resize(c.size(), 0);
+        d.active_blocks.clear();
         for (int k = 0; k < in.block_count; ++k)
-            if (is_active(in, k)) active_blocks_.push_back(k);
-        team_.resize(std::max(1, omp_get_num_threads()));
-        for (auto& t : team_) {
+            if (is_active(in, k)) d.active_blocks.push_back(k);
+        d.team.resize(std::max(1, omp_get_num_threads()));
+        for (auto& t : d.team) {
             t.candidates.clear();
             t.dropped = t.dropped_tensile = t.dropped_shear = t.transferred = t.transferred_on_nodes = 0;
         }
-        stale_ = !grid_valid_;
-        left_box_ = false;
+        d.stale = !d.grid_valid;
+        d.left_box = false;
     }
 }
 
 /// 1–2. Transfer along the edge block's boundary, and removal of separated
 /// unbonded contacts: the contacts of active blocks, each once (from its vertex
 /// block if that is active).
-void Detector::transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadScratch& mine) {
+void transfer_and_drop(Detector& d, Contacts& c, const DetectionInput& in, Detector::ThreadScratch& mine) {
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
-    const int na = int(active_blocks_.size());
+    const int na = int(d.active_blocks.size());
 #pragma omp for schedule(static)
     for (int a = 0; a < na; ++a) {
-        const int k = active_blocks_[a];
+        const int k = d.active_blocks[a];
         for (int e = c.block_first[k]; e < c.block_first[k + 1]; ++e) {
             const int i = c.block_entry[e] >> 1;
             const int A = c.vertex_block[i], B = c.edge_block[i];
@@ -325,7 +324,7 @@ void Detector::transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadSc
             }
             const double beyond = std::max(-f.s, f.s - 1.0) / b.inv_edge_length[c.edge_id[i]];
             if (f.gap > tol || beyond > 2.0 * tol) {
-                drop_[i] = 1;
+                d.drop[i] = 1;
                 ++mine.dropped;
                 mine.dropped_tensile += c.history[i].broken == JointState::broken_tension;
                 mine.dropped_shear += c.history[i].broken == JointState::broken_shear;
@@ -336,55 +335,55 @@ void Detector::transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadSc
 
 /// 3a. The grid is rebuilt if it is invalid or one of the active pieces has left
 /// its stored box (with a quarter tolerance to spare: a block is checked again
-/// before it has moved that far). stale_ is read by every thread here and not
+/// before it has moved that far). d.stale is read by every thread here and not
 /// written before the single below: a thread's piece that left its box raises
-/// left_box_ instead.
-void Detector::refresh_grid(const DetectionInput& in) {
-    const int na = int(active_blocks_.size());
-    if (!stale_) {
+/// d.left_box instead.
+void refresh_grid(Detector& d, const DetectionInput& in) {
+    const int na = int(d.active_blocks.size());
+    if (!d.stale) {
         bool left = false;
 #pragma omp for schedule(static) nowait
         for (int a = 0; a < na; ++a) {
-            const int k = active_blocks_[a];
-            for (int p = block_piece_[k]; p < block_piece_[k + 1] && !left; ++p) {
-                const Box2 box = current_box(pieces_[p], in.blocks, 1.25 * in.tolerance);
-                const Box2& s = stored_[p];
+            const int k = d.active_blocks[a];
+            for (int p = d.block_piece[k]; p < d.block_piece[k + 1] && !left; ++p) {
+                const Box2 box = current_box(d.pieces[p], in.blocks, 1.25 * in.tolerance);
+                const Box2& s = d.stored[p];
                 left = box.lo.x < s.lo.x || box.lo.y < s.lo.y || box.hi.x > s.hi.x || box.hi.y > s.hi.y;
             }
         }
         if (left) {
 #pragma omp atomic write
-            left_box_ = true;
+            d.left_box = true;
         }
 #pragma omp barrier
     }
 #pragma omp single
-    if (stale_ || left_box_) build_grid(in);
+    if (d.stale || d.left_box) build_grid(d, in);
 }
 
 /// 3b. Broad phase from the active pieces: the pieces near each in the grid,
 /// their vertex-edge candidates (narrow phase, add_candidates) into the thread's list.
-void Detector::broad_phase(const DetectionInput& in, ThreadScratch& mine) {
+void broad_phase(Detector& d, const DetectionInput& in, Detector::ThreadScratch& mine) {
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
-    const int na = int(active_blocks_.size());
+    const int na = int(d.active_blocks.size());
 #pragma omp for schedule(static)
     for (int a = 0; a < na; ++a) {
-        const int k = active_blocks_[a];
-        for (int p = block_piece_[k]; p < block_piece_[k + 1]; ++p) {
-            const Box2 box = current_box(pieces_[p], b, tol);
-            const int i0 = std::clamp(int((box.lo.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
-            const int i1 = std::clamp(int((box.hi.x - grid_box_.lo.x) / cell_), 0, nx_ - 1);
-            const int j0 = std::clamp(int((box.lo.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
-            const int j1 = std::clamp(int((box.hi.y - grid_box_.lo.y) / cell_), 0, ny_ - 1);
+        const int k = d.active_blocks[a];
+        for (int p = d.block_piece[k]; p < d.block_piece[k + 1]; ++p) {
+            const Box2 box = current_box(d.pieces[p], b, tol);
+            const int i0 = std::clamp(int((box.lo.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
+            const int i1 = std::clamp(int((box.hi.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
+            const int j0 = std::clamp(int((box.lo.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
+            const int j1 = std::clamp(int((box.hi.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
             auto& near = mine.near;
             near.clear();
             for (int j = j0; j <= j1; ++j)
                 for (int i = i0; i <= i1; ++i) {
-                    const std::size_t cell = std::size_t(j) * nx_ + i;
-                    for (int e = cell_first_[cell]; e < cell_first_[cell + 1]; ++e) {
-                        const int q = cell_piece_[e];
-                        const int other = pieces_[q].block;
+                    const std::size_t cell = std::size_t(j) * d.nx + i;
+                    for (int e = d.cell_first[cell]; e < d.cell_first[cell + 1]; ++e) {
+                        const int q = d.cell_piece[e];
+                        const int other = d.pieces[q].block;
                         // A pair of active pieces is handled from its lower piece.
                         if (other != k && !(is_active(in, other) && q < p)) near.push_back(q);
                     }
@@ -392,10 +391,10 @@ void Detector::broad_phase(const DetectionInput& in, ThreadScratch& mine) {
             std::sort(near.begin(), near.end());
             near.erase(std::unique(near.begin(), near.end()), near.end());
             for (int q : near) {
-                const Box2 q_box = current_box(pieces_[q], b, tol);
+                const Box2 q_box = current_box(d.pieces[q], b, tol);
                 if (box.hi.x < q_box.lo.x || q_box.hi.x < box.lo.x || box.hi.y < q_box.lo.y || q_box.hi.y < box.lo.y)
                     continue;
-                const Piece &P = pieces_[p], &Q = pieces_[q];
+                const Detector::Piece &P = d.pieces[p], &Q = d.pieces[q];
                 if (P.block < Q.block) {
                     add_candidates(P, Q, q_box, in, mine.candidates);
                     add_candidates(Q, P, box, in, mine.candidates);
@@ -411,7 +410,7 @@ void Detector::broad_phase(const DetectionInput& in, ThreadScratch& mine) {
 /// 4. One thread: the threads' candidates gathered in block order, accepted pair
 /// by pair in the order they came, and the dropped contacts removed; the result
 /// for every thread (the single's barrier).
-void Detector::accept_candidates(Contacts& c, const DetectionInput& in) {
+void accept_candidates(Detector& d, Contacts& c, const DetectionInput& in) {
     const BlockView& b = in.blocks;
     const double tol = in.tolerance;
 #pragma omp single
@@ -419,58 +418,60 @@ void Detector::accept_candidates(Contacts& c, const DetectionInput& in) {
         DetectionResult res;
         int on_nodes = 0;
         // The threads' runs of active blocks follow each other in block order.
-        candidates_.clear();
-        for (auto& t : team_) {
-            candidates_.insert(candidates_.end(), t.candidates.begin(), t.candidates.end());
+        d.candidates.clear();
+        for (auto& t : d.team) {
+            d.candidates.insert(d.candidates.end(), t.candidates.begin(), t.candidates.end());
             res.transferred += t.transferred;
             on_nodes += t.transferred_on_nodes;
             res.removed += t.dropped;
             res.removed_tensile += t.dropped_tensile;
             res.removed_shear += t.dropped_shear;
         }
-        order_.resize(candidates_.size());
-        std::iota(order_.begin(), order_.end(), 0);
+        d.order.resize(d.candidates.size());
+        std::iota(d.order.begin(), d.order.end(), 0);
         // By pair, then in the order they came (a total order: std::sort gives the same
         // result as a stable sort, without the buffer std::stable_sort allocates).
-        std::sort(order_.begin(), order_.end(), [&](int x, int y) {
-            return candidates_[x].pair < candidates_[y].pair || (candidates_[x].pair == candidates_[y].pair && x < y);
+        std::sort(d.order.begin(), d.order.end(), [&](int x, int y) {
+            return d.candidates[x].pair < d.candidates[y].pair || (d.candidates[x].pair == d.candidates[y].pair && x < y);
         });
-        accepted_.clear();
-        for (std::size_t k = 0; k < order_.size(); ++k) {
-            const Candidate& cand = candidates_[order_[k]];
-            if (k == 0 || candidates_[order_[k - 1]].pair != cand.pair) accepted_.clear();
-            if (known(c, cand.vertex_block, cand.vertex, cand.edge_block, in)) continue;
+        d.accepted.clear();
+        for (std::size_t k = 0; k < d.order.size(); ++k) {
+            const Detector::Candidate& cand = d.candidates[d.order[k]];
+            if (k == 0 || d.candidates[d.order[k - 1]].pair != cand.pair) d.accepted.clear();
+            if (known(d, c, cand.vertex_block, cand.vertex, cand.edge_block, in)) continue;
             const Vec2 x = b.vertex[cand.vertex];
             bool duplicate = false;
-            for (int a : accepted_) duplicate = duplicate || norm(b.vertex[candidates_[a].vertex] - x) <= tol;
+            for (int a : d.accepted) duplicate = duplicate || norm(b.vertex[d.candidates[a].vertex] - x) <= tol;
             if (duplicate) continue;
-            accepted_.push_back(order_[k]);
+            d.accepted.push_back(d.order[k]);
             JointHistory h;
             h.bonded = false;
             h.un = cand.un;
-            c.add(cand.vertex_block, cand.vertex, cand.edge_block, cand.edge, cand.edge_end, cand.length,
+            add_contact(c, cand.vertex_block, cand.vertex, cand.edge_block, cand.edge, cand.edge_end, cand.length,
                   in.new_contact_property, h);
-            drop_.push_back(0);
+            d.drop.push_back(0);
             ++res.created;
         }
         if (res.removed > 0) {
-            c.remove_if_flagged(drop_);
-            drop_.resize(c.size());
-            std::fill(drop_.begin(), drop_.end(), 0);
+            remove_flagged_contacts(c, d.drop);
+            d.drop.resize(c.size());
+            std::fill(d.drop.begin(), d.drop.end(), 0);
         }
-        result_ = res;
-        transferred_on_nodes_ = on_nodes;
+        d.result = res;
+        d.transferred_on_nodes = on_nodes;
     }
 }
 
-DetectionResult Detector::update(Contacts& c, const DetectionInput& in) {
-    start_pass(c, in);
-    ThreadScratch& mine = team_[omp_get_thread_num()];
-    transfer_and_drop(c, in, mine);
-    refresh_grid(in);
-    broad_phase(in, mine);
-    accept_candidates(c, in);
-    return result_;
+} // namespace
+
+DetectionResult detect(Contacts& c, Detector& d, const DetectionInput& in) {
+    start_pass(d, c, in);
+    Detector::ThreadScratch& mine = d.team[omp_get_thread_num()];
+    transfer_and_drop(d, c, in, mine);
+    refresh_grid(d, in);
+    broad_phase(d, in, mine);
+    accept_candidates(d, c, in);
+    return d.result;
 }
 
 } // namespace bbm::contact

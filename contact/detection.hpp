@@ -27,7 +27,7 @@
 // other block's edge (that edge's share at this end). Candidates are produced and
 // accepted in an order fixed by block and vertex numbers, so a pass gives the same
 // contacts in the same order every time. The Detector keeps its scratch arrays
-// between passes: once their sizes have settled, a pass allocates nothing.
+// between passes (struct Detector): once their sizes have settled, a pass allocates nothing.
 // A team of threads may run a pass together: steps 1–3 share the active blocks
 // (contiguous runs in block order, each thread with its own candidate list; the
 // lists joined in thread order are the serial order), step 4 and the grid's
@@ -99,67 +99,42 @@ struct DetectionResult {
     /// Of the removed: cracks (broken bonds), so that crack counts stay cumulative.
     int removed_tensile = 0, removed_shear = 0;
 };
+static_assert(sizeof(DetectionResult) == 5 * sizeof(int)); // saved and hashed as raw bytes
 
-class Detector {
-public:
-    /// One pass (steps 1–4 above). Needs `c`'s index (Contacts::rebuild_index) to
-    /// be current; leaves it stale if contacts were created or removed (the
-    /// result says so) or passed to another edge of a deformable block
-    /// (transferred_on_nodes), for the caller to rebuild once. Called by every thread of
-    /// an OpenMP team (all get the result), or outside one: the same contacts in
-    /// the same order on any number of threads.
-    DetectionResult update(Contacts& c, const DetectionInput& in);
-    /// Blocks were removed (or the state replaced): the grid is rebuilt next pass.
-    void invalidate() { grid_valid_ = false; }
-    /// How many times the broad-phase grid has been built (for statistics).
-    long grid_builds() const { return grid_builds_; }
-    /// Of the last pass's transfers, those onto another edge of a deformable block:
-    /// they change which nodes a contact loads, so the index is stale after them too.
-    int transferred_on_nodes() const { return transferred_on_nodes_; }
-
-private:
+/// The detection's state between passes: the broad-phase grid and the scratch
+/// arrays (plain data; detect() below runs a pass over it). Nothing here is part
+/// of the physics: a grid rebuilt from scratch offers a superset of the same
+/// pairs, so a checkpoint does not save it.
+struct Detector {
     /// A run of at most 16 consecutive vertices of a block and the edges they start.
     struct Piece {
         int block;
         std::uint32_t v0, v1;
     };
-    Box2 current_box(const Piece& pc, const BlockView& b, double inflate) const;
-    void build_grid(const DetectionInput& in);
     struct Candidate {
         std::uint64_t pair;
         int vertex_block, vertex, edge_block, edge, edge_end;
         double length, un;
     };
-    void add_candidates(const Piece& P, const Piece& Q, const Box2& q_box, const DetectionInput& in,
-                        std::vector<Candidate>& out) const;
-    bool known(const Contacts& c, int vertex_block, int vertex, int edge_block, const DetectionInput& in) const;
-
-    // The stages of update(), each called by every thread of the team.
-    struct ThreadScratch;
-    void start_pass(const Contacts& c, const DetectionInput& in);
-    void transfer_and_drop(Contacts& c, const DetectionInput& in, ThreadScratch& mine);
-    void refresh_grid(const DetectionInput& in);
-    void broad_phase(const DetectionInput& in, ThreadScratch& mine);
-    void accept_candidates(Contacts& c, const DetectionInput& in);
-
     // Broad phase. Pieces enter the grid with their box at the build inflated by
     // the tolerance and a margin; while every piece stays inside its stored box
     // (checked for the active ones, which are the ones that moved), the grid
     // still finds every pair within the tolerance, and only needs rebuilding
     // when one leaves it — not at every pass.
-    std::vector<Piece> pieces_;
-    std::vector<int> block_piece_; ///< per block, its first piece (CSR)
-    std::vector<Box2> stored_;     ///< per piece, its box at the last build (inflated)
-    Box2 grid_box_;
-    double cell_ = 0.0, margin_ = 0.0;
-    int nx_ = 0, ny_ = 0;
-    std::vector<int> cell_first_, cell_piece_;
-    bool grid_valid_ = false;
-    long grid_builds_ = 0;
+    std::vector<Piece> pieces;
+    std::vector<int> block_piece; ///< per block, its first piece (CSR)
+    std::vector<Box2> stored;     ///< per piece, its box at the last build (inflated)
+    Box2 grid_box;
+    double cell = 0.0, margin = 0.0;
+    int nx = 0, ny = 0;
+    std::vector<int> cell_first, cell_piece;
+    /// false: the grid is rebuilt at the next pass (blocks were removed, or the
+    /// state replaced by a checkpoint's).
+    bool grid_valid = false;
 
     // Scratch kept between passes.
-    std::vector<std::uint8_t> drop_; ///< per contact; all zero between passes
-    std::vector<int> active_blocks_; ///< this pass's active blocks, in order
+    std::vector<std::uint8_t> drop; ///< per contact; all zero between passes
+    std::vector<int> active_blocks; ///< this pass's active blocks, in order
     /// Per thread of the team: its candidates, the contacts it dropped and moved,
     /// and its broad-phase scratch (one cache line apart).
     struct alignas(64) ThreadScratch {
@@ -167,12 +142,25 @@ private:
         std::vector<int> near;
         int dropped = 0, dropped_tensile = 0, dropped_shear = 0, transferred = 0, transferred_on_nodes = 0;
     };
-    std::vector<ThreadScratch> team_;
-    std::vector<Candidate> candidates_;
-    std::vector<int> order_, accepted_;
-    bool stale_ = false, left_box_ = false; ///< this pass: grid invalid, a piece left its box
-    DetectionResult result_;
-    int transferred_on_nodes_ = 0;
+    std::vector<ThreadScratch> team;
+    std::vector<Candidate> candidates;
+    std::vector<int> order, accepted;
+    bool stale = false, left_box = false; ///< this pass: grid invalid, a piece left its box
+    DetectionResult result;
+    /// Of the last pass's transfers, those onto another edge of a deformable block:
+    /// they change which nodes a contact loads, so the index is stale after them too.
+    int transferred_on_nodes = 0;
 };
 
+/// One pass (steps 1–4 above). Needs `c`'s index (rebuild_contact_index) to be
+/// current; leaves it stale if contacts were created or removed (the result says
+/// so) or passed to another edge of a deformable block (d.transferred_on_nodes),
+/// for the caller to rebuild once. Called by every thread of an OpenMP team (all
+/// get the result), or outside one: the same contacts in the same order on any
+/// number of threads.
+DetectionResult detect(Contacts& c, Detector& d, const DetectionInput& in);
+
 } // namespace bbm::contact
+
+template <>
+struct bbm::ElementTraits<bbm::contact::DetectionResult> : bbm::PackedRecordTraits<bbm::contact::DetectionResult> {};

@@ -2,6 +2,8 @@
 // every joint law (joint_law.hpp, barton_bandis.hpp) updates in place.
 #pragma once
 
+#include "base/fields.hpp"
+
 #include <cstdint>
 
 namespace bbm::contact {
@@ -26,5 +28,9 @@ struct alignas(64) JointHistory {
     bool counted = false; ///< its crack has been recorded (statistics at formation)
 };
 static_assert(sizeof(JointHistory) == 64);
+static_assert(sizeof(JointHistory) == 7 * 8 + 4 + 4); // saved and hashed as raw bytes: no padding
 
 } // namespace bbm::contact
+
+template <>
+struct bbm::ElementTraits<bbm::contact::JointHistory> : bbm::PackedRecordTraits<bbm::contact::JointHistory> {};

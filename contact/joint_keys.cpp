@@ -56,6 +56,17 @@ std::optional<KeyProblem> check_joint_property(const JointPropertySpec& j) {
     return std::nullopt;
 }
 
+void law_parameters(const JointPropertySpec& j, std::vector<double>& out) {
+    out.push_back(double(j.law));
+    out.push_back(double(j.face_shear));
+    for (const JointKey& k : joint_keys)
+        if (k.get) out.push_back(k.get(j));
+    for (const auto* curve : {&j.tension_softening, &j.shear_softening}) {
+        out.push_back(double(curve->size()));
+        for (const auto& [alpha, beta] : *curve) out.insert(out.end(), {alpha, beta});
+    }
+}
+
 std::string joint_keys_markdown() {
     std::string md =
         "# [[joint_property]] keys\n\n"

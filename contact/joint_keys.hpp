@@ -19,6 +19,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace bbm::contact {
 
@@ -106,6 +107,10 @@ struct KeyProblem {
     std::string message;
 };
 std::optional<KeyProblem> check_joint_property(const JointPropertySpec& j);
+
+/// Every parameter of a set, as numbers (the model fingerprint: a checkpoint of
+/// another set's model is refused): its law, every declared key's value, its curves.
+void law_parameters(const JointPropertySpec& j, std::vector<double>& out);
 
 /// The flag of a key (base/keys.hpp).
 inline std::string joint_flag(std::string_view key, std::string_view prefix = "") { return key_flag(key, prefix); }

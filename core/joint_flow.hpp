@@ -28,7 +28,7 @@
 
 #include "contact/contacts.hpp"
 #include "core/flow.hpp"
-#include "core/state_fields.hpp"
+#include "base/fields.hpp"
 #include "meshing/blocks.hpp"
 
 #include <optional>
@@ -71,77 +71,67 @@ struct FlowSpec {
     std::vector<FlowSourceSpec> sources;
 };
 
-class JointFlow {
-public:
-    /// The network of the flow regions' joints, initial pressures and held domains.
-    /// Throws InputError (key "flow") for a water table or head without gravity, a
-    /// flow region that does not exist, or a network with no joint.
-    JointFlow(const meshing::BlockAssembly& a, const FlowSpec& spec, Vec2 solver_gravity);
-
-    /// Ties contact `contact` (at end p0 or p1 of joint `joint`) to its domain and
-    /// pipe; call for both ends of every joint as its contacts are made.
-    void link(contact::Contacts& c, int contact, int joint, bool at_p0) const;
-
-    /// The stage: apertures from the contacts, pressures (steady or transient over
-    /// `dt`), then each contact's fluid pressure. Serial.
-    void stage(contact::Contacts& c, double dt, long step);
-    /// Only the contacts' fluid pressures from the current domain pressures.
-    void write_contact_pressures(contact::Contacts& c) const;
-    /// After an excavation: pipes of removed blocks close; their walls' domains
-    /// (ends of a pipe with one removed block) are held at the opening's water
-    /// pressure, `wall_pressure` (0: drained to atmospheric; a pressurised borehole:
-    /// the excavate stage's `pressure`), if `drain_openings`.
-    void excavated(const std::vector<std::uint8_t>& removed, double wall_pressure = 0.0);
-    /// The latest opening's water pressure changed (a `pressurise` stage): its
-    /// wall's domains are held at `wall_pressure`; `solve_now` asks for a steady
-    /// solve at the next stage (a jump), else the usual cadence follows a ramp.
-    void set_opening_pressure(double wall_pressure, bool solve_now);
-
-    /// Net flow into the drained walls of openings, m²/s per unit depth (positive: out of the rock).
-    double inflow() const;
-    /// Per contact: its pipes' mean hydraulic aperture (m; 0 where it has none).
-    std::vector<double> contact_apertures(const contact::Contacts& c) const;
-
-    const flow::Network& network() const { return net_; }
-    const flow::State& state() const { return state_; }
-    const flow::FluidSpec& fluid() const { return fluid_; }
-    const FlowSpec& spec() const { return spec_; }
-    const std::vector<std::uint8_t>& drained() const { return drained_; }
-    /// The two blocks of pipe k's joint (the solver's block numbers).
-    std::pair<int, int> pipe_blocks(int k) const { return {pipe_block_a_[k], pipe_block_b_[k]}; }
-    int steady_solves() const { return solves_; }
-
-    /// Its arrays in the solver's state list (core/state.cpp): visit(info, array).
-    template <class Visit>
-    void visit_fields(Visit&& v, unsigned evolving, unsigned rebuilt) {
-        v({"flow.pressure", MemoryGroup::other, evolving}, state_.pressure);
-        v({"flow.held", MemoryGroup::other, evolving}, state_.held);
-        v({"flow.drained", MemoryGroup::other, evolving}, drained_);
-        v({"flow.pipe_open", MemoryGroup::other, evolving}, pipe_open_);
-        v({"flow.time", MemoryGroup::other, evolving}, state_.time);
-        v({"flow.pending_solve", MemoryGroup::other, evolving}, pending_solve_);
-        v({"flow.aperture", MemoryGroup::other, rebuilt}, state_.aperture);
-        v({"flow.source", MemoryGroup::other, rebuilt}, state_.source);
-    }
-
-private:
-    void update_apertures(const contact::Contacts& c);
-    double initial_pressure(Vec2 x) const;
-
-    FlowSpec spec_;
-    flow::FluidSpec fluid_;
-    flow::Network net_;
-    flow::State state_;
-    std::vector<int> joint_pipe_;         ///< per joint: its pipe, −1 if none
-    std::vector<int> pipe_block_a_, pipe_block_b_;
-    std::vector<std::uint8_t> pipe_open_; ///< 0: a block of it removed
+/// The water in the joints: the network, its state, and its ties to the blocks
+/// (plain data; the functions below build and step it).
+struct JointFlow {
+    FlowSpec spec;
+    flow::FluidSpec fluid; ///< gravity: the solver's unless the spec gives its own
+    flow::Network net;
+    flow::State state{flow::Network{}};
+    std::vector<int> joint_pipe;         ///< per joint: its pipe, −1 if none
+    std::vector<int> pipe_block_a, pipe_block_b; ///< per pipe, the two blocks of its joint
+    std::vector<std::uint8_t> pipe_open; ///< 0: a block of it removed
     /// per domain: 0, or the number (from 1) of the excavation whose opening's
     /// wall it is on (a later one keeps the earlier's number)
-    std::vector<std::uint8_t> drained_;
-    std::vector<double> aperture_sum_;
-    std::vector<int> aperture_count_;
-    std::uint8_t pending_solve_ = 1;      ///< a steady solve due at the next stage
-    int solves_ = 0;
+    std::vector<std::uint8_t> drained;
+    std::vector<double> aperture_sum;    ///< update_apertures' scratch, per pipe
+    std::vector<int> aperture_count;
+    std::uint8_t pending_solve = 1;      ///< a steady solve due at the next stage
+    int solves = 0;                      ///< steady solves so far
 };
+
+/// Its fields (base/fields.hpp): the pressures and what holds them evolve.
+template <part_of<JointFlow> F, class Visit>
+void visit_fields(F& f, Visit&& v) {
+    constexpr unsigned E = field_use::evolving, R = field_use::rebuilt;
+    v(FieldInfo{"flow.pressure", MemoryGroup::other, E}, f.state.pressure);
+    v(FieldInfo{"flow.held", MemoryGroup::other, E}, f.state.held);
+    v(FieldInfo{"flow.drained", MemoryGroup::other, E}, f.drained);
+    v(FieldInfo{"flow.pipe_open", MemoryGroup::other, E}, f.pipe_open);
+    v(FieldInfo{"flow.time", MemoryGroup::other, E}, f.state.time);
+    v(FieldInfo{"flow.pending_solve", MemoryGroup::other, E}, f.pending_solve);
+    v(FieldInfo{"flow.aperture", MemoryGroup::other, R}, f.state.aperture);
+    v(FieldInfo{"flow.source", MemoryGroup::other, R}, f.state.source);
+}
+
+/// The network of the flow regions' joints, initial pressures and held domains.
+/// Throws InputError (key "flow") for a water table or head without gravity, a
+/// flow region that does not exist, a network with no joint, or a source farther
+/// from every junction than the longest joint of the network.
+JointFlow make_joint_flow(const meshing::BlockAssembly& a, const FlowSpec& spec, Vec2 solver_gravity);
+
+/// Ties contact `contact` (at end p0 or p1 of joint `joint`) to its domain and
+/// pipe; call for both ends of every joint as its contacts are made.
+void link_contact(const JointFlow& f, contact::Contacts& c, int contact, int joint, bool at_p0);
+
+/// The stage: apertures from the contacts, pressures (steady or transient over
+/// `dt`), then each contact's fluid pressure. Serial.
+void advance_flow(JointFlow& f, contact::Contacts& c, double dt, long step);
+/// Only the contacts' fluid pressures from the current domain pressures.
+void write_contact_pressures(const JointFlow& f, contact::Contacts& c);
+/// After an excavation: pipes of removed blocks close; their walls' domains
+/// (ends of a pipe with one removed block) are held at the opening's water
+/// pressure, `wall_pressure` (0: drained to atmospheric; a pressurised borehole:
+/// the excavate stage's `pressure`), if `drain_openings`.
+void flow_excavated(JointFlow& f, const std::vector<std::uint8_t>& removed, double wall_pressure = 0.0);
+/// The latest opening's water pressure changed (a `pressurise` stage): its
+/// wall's domains are held at `wall_pressure`; `solve_now` asks for a steady
+/// solve at the next stage (a jump), else the usual cadence follows a ramp.
+void set_flow_opening_pressure(JointFlow& f, double wall_pressure, bool solve_now);
+
+/// Net flow into the drained walls of openings, m²/s per unit depth (positive: out of the rock).
+double inflow(const JointFlow& f);
+/// Per contact: its pipes' mean hydraulic aperture (m; 0 where it has none).
+std::vector<double> contact_apertures(const JointFlow& f, const contact::Contacts& c);
 
 } // namespace bbm

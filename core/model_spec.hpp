@@ -1,18 +1,16 @@
 // bbm core: the analysis part of a model file — materials, joint properties,
 // boundary conditions, the solver settings, histories and the stages to run.
 //
-// Like meshing/spec.hpp these are plain data filled by the input layer (apps/)
-// and checked there for types and ranges; the solver (core/solver.hpp) turns
-// them into flat arrays once. SI units throughout (SPEC §2): stresses in Pa with
+// Like meshing/spec.hpp these are plain data filled by the input layer (io/)
+// and checked there for types and ranges; build_world (core/build_world.hpp)
+// turns them into the world's flat arrays once. SI units throughout (SPEC §2): stresses in Pa with
 // tension positive for continuum stress tensors (a 15 MPa overburden is
 // syy = -15e6), joint stiffness in Pa/m, angles in degrees.
 #pragma once
 
 #include "base/vec2.hpp"
-#include "core/bolts.hpp"
-#include "core/dowels.hpp"
 #include "core/joint_flow.hpp"
-#include "core/liners.hpp"
+#include "core/supports/registry.hpp"
 #include "contact/joint_property.hpp"
 #include "meshing/blocks.hpp"
 
@@ -146,11 +144,11 @@ struct StageSpec {
     /// good). A tunnel face's three-dimensional stress path in a plane section
     /// (examples/field/face_path.py; docs/theory.md §6.5).
     std::vector<std::array<double, 3>> support_path;
-    std::vector<std::string> supports; ///< install: names of [[bolt]] and [[liner]] sets
+    std::vector<std::string> supports; ///< install: names of support sets (of any registered type)
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;
-/// core/stages.hpp measure_opening()).
+/// studies/opening.hpp).
 struct ReportSpec {
     bool opening = false;           ///< measure the opening (center, springline, crown given)
     Vec2 center{}, springline{}, crown{};
@@ -167,9 +165,9 @@ struct AnalysisSpec {
     SolverSpec solver;
     std::vector<HistorySpec> histories;
     std::vector<StageSpec> stages;
-    std::vector<BoltSetSpec> bolts; ///< support sets, installed by install stages
-    std::vector<LinerSpec> liners;
-    std::vector<DowelSetSpec> dowels;
+    /// The support sets of each registered type (core/supports/registry.hpp), in
+    /// file order, installed by install stages.
+    SupportSpecs supports;
     FlowSpec flow; ///< [flow], [[flow_boundary]], [[flow_source]]: water in the joints
     ReportSpec report;
 };

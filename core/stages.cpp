@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace bbm {
 
@@ -46,6 +47,7 @@ SupportPath support_path_of(const std::vector<StageSpec>& stages, int index) {
 
 std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs,
                                     StageCursor start) {
+    World& w = s.world();
     std::vector<StageReport> reports;
     for (int index = start.stage; index < int(stages.size()); ++index) {
         const StageSpec& st = stages[index];
@@ -65,14 +67,14 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         // the rock at rest, or only the verdict of equilibrium.
         auto solved = [&](long k) {
             using U = StageSpec::Until;
-            const bool sampled = s.steps() % StageMonitor::sample_every == 0;
+            const bool sampled = w.clock.steps % StageMonitor::sample_every == 0;
             if (st.until == U::equilibrium) {
                 if (!sampled) return false;
-                const auto kind = s.monitor().verdict(st.ratio).kind;
+                const auto kind = verdict(w.monitor, st.ratio).kind;
                 return kind == Verdict::Kind::equilibrium || kind == Verdict::Kind::equilibrium_with_fragments;
             }
-            if (k >= 10 && s.unbalanced_ratio() <= st.ratio) return true;
-            return st.until == U::rest && sampled && s.monitor().at_rest(st.ratio, st.quiet_steps);
+            if (k >= 10 && w.clock.ratio <= st.ratio) return true;
+            return st.until == U::rest && sampled && at_rest(w.monitor, st.ratio, st.quiet_steps);
         };
         // A pressurise stage's ramp: the pressure at its step k (1 ... steps).
         // (Plain variables, not a structured binding: lambdas capture them in C++20's clang 14.)
@@ -82,12 +84,12 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         auto run = [&](long max_steps, bool solve) {
             for (long k = cursor.step + 1; k <= max_steps; ++k) {
                 if (st.kind == StageSpec::Kind::pressurise)
-                    s.set_opening_pressure(pressure_before + (st.pressure - pressure_before) * double(k) / double(max_steps),
-                                           excavation_pressure, true);
+                    set_opening_pressure(w, pressure_before + (st.pressure - pressure_before) * double(k) / double(max_steps),
+                                         excavation_pressure, true);
                 s.step();
                 ++r.steps;
                 cursor.step = k;
-                if (judged && s.steps() % StageMonitor::sample_every == 0) s.monitor().sample(s);
+                if (judged && w.clock.steps % StageMonitor::sample_every == 0) sample_monitor(w.monitor, w);
                 obs.step_done(s, st, k);
                 obs.at(s, cursor);
                 if (obs.stop_requested() || (solve && solved(k))) return;
@@ -95,19 +97,19 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         };
         if (!resumed) {
             if (judged) {
-                s.monitor().start_stage();
-                s.monitor().sample(s);
+                start_stage(w.monitor);
+                sample_monitor(w.monitor, w);
             }
             obs.stage_started(s, st);
             switch (st.kind) {
-            case StageSpec::Kind::initialize: s.initialize_stress(st.stress); break;
+            case StageSpec::Kind::initialize: initialize_stress(w, st.stress); break;
             case StageSpec::Kind::excavate:
-                s.excavate(st.regions, st.relax_steps, st.keep, st.pressure, support_path_of(stages, index));
+                excavate(w, st.regions, st.relax_steps, st.keep, st.pressure, support_path_of(stages, index));
                 break;
-            case StageSpec::Kind::elastic: r.method = s.solve_elastic().method; break;
-            case StageSpec::Kind::install: s.install_supports(st.supports); break;
+            case StageSpec::Kind::elastic: r.method = solve_elastic(w).method; break;
+            case StageSpec::Kind::install: install_supports(w, st.supports); break;
             case StageSpec::Kind::pressurise:
-                if (st.steps == 0) s.set_opening_pressure(st.pressure, excavation_pressure, true);
+                if (st.steps == 0) set_opening_pressure(w, st.pressure, excavation_pressure, true);
                 break;
             case StageSpec::Kind::solve:
             case StageSpec::Kind::cycle: break;
@@ -117,7 +119,7 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         switch (st.kind) {
         case StageSpec::Kind::solve:
             if (!(resumed && solved(cursor.step))) run(st.max_steps, true);
-            r.converged = s.unbalanced_ratio() <= st.ratio;
+            r.converged = w.clock.ratio <= st.ratio;
             break;
         case StageSpec::Kind::excavate: run(st.steps, false); break;
         case StageSpec::Kind::cycle: run(st.steps, false); break;
@@ -126,13 +128,13 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
         case StageSpec::Kind::install:
         case StageSpec::Kind::elastic: break;
         }
-        r.ratio = s.unbalanced_ratio();
+        r.ratio = w.clock.ratio;
         r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const bool stopped = obs.stop_requested();
         if (judged && !stopped) {
-            const auto& samples = s.monitor().samples();
-            if (samples.empty() || samples.back().step != s.steps()) s.monitor().sample(s);
-            r.verdict = s.monitor().verdict(st.kind == StageSpec::Kind::solve ? st.ratio : StageSpec{}.ratio);
+            const auto& samples = w.monitor.samples;
+            if (samples.empty() || samples.back().step != w.clock.steps) sample_monitor(w.monitor, w);
+            r.verdict = verdict(w.monitor, st.kind == StageSpec::Kind::solve ? st.ratio : StageSpec{}.ratio);
         }
         if (!stopped) obs.stage_done(s, r);
         reports.push_back(r);
@@ -142,12 +144,12 @@ std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& sta
     return reports;
 }
 
-HistoryRecorder::HistoryRecorder(const Solver& s, std::vector<HistorySpec> h) : histories_(std::move(h)) {
-    const auto& n = s.nodes();
+HistoryRecorder::HistoryRecorder(const World& w, std::vector<HistorySpec> h) : histories_(std::move(h)) {
+    const auto& n = w.nodes;
     for (const auto& x : histories_) {
-        const int b = x.point ? s.block_at(*x.point) : -1;
+        const int b = x.point ? block_at(w, *x.point) : -1;
         int node = -1;
-        if (b >= 0 && s.blocks().deformable[b]) {
+        if (b >= 0 && w.blocks.deformable[b]) {
             double best = INFINITY;
             for (int k = 0; k < n.count(); ++k)
                 if (n.block[k] == b && norm(n.position[k] - *x.point) < best) best = norm(n.position[k] - *x.point), node = k;
@@ -157,45 +159,54 @@ HistoryRecorder::HistoryRecorder(const Solver& s, std::vector<HistorySpec> h) : 
     }
 }
 
-std::vector<double> HistoryRecorder::sample(const Solver& s) const {
+namespace {
+
+/// A point's quantity at its nearest node (a deformable block: no rotation), if
+/// it is one a node has.
+std::optional<double> node_quantity(const World& w, HistorySpec::Quantity q, int nd) {
     using Q = HistorySpec::Quantity;
-    const auto& b = s.blocks();
+    const auto& n = w.nodes;
+    switch (q) {
+    case Q::displacement_x: return n.position[nd].x - n.position0[nd].x;
+    case Q::displacement_y: return n.position[nd].y - n.position0[nd].y;
+    case Q::velocity_x: return n.velocity[nd].x;
+    case Q::velocity_y: return n.velocity[nd].y;
+    case Q::rotation: return 0.0;
+    default: return std::nullopt;
+    }
+}
+
+double quantity(const World& w, const HistorySpec& h, int i) {
+    using Q = HistorySpec::Quantity;
+    switch (h.quantity) {
+    case Q::unbalanced_ratio: return w.clock.ratio;
+    case Q::displacement_x: return w.bodies.state[i].centroid.x - w.blocks.centroid0[i].x;
+    case Q::displacement_y: return w.bodies.state[i].centroid.y - w.blocks.centroid0[i].y;
+    case Q::velocity_x: return w.bodies.state[i].velocity.x;
+    case Q::velocity_y: return w.bodies.state[i].velocity.y;
+    case Q::rotation: return w.bodies.state[i].theta;
+    case Q::boundary_force_x: return boundary_force(w, h.boundary).x;
+    case Q::boundary_force_y: return boundary_force(w, h.boundary).y;
+    case Q::cracks_tensile: return cracks(w, contact::JointState::broken_tension);
+    case Q::cracks_shear: return cracks(w, contact::JointState::broken_shear);
+    case Q::kinetic_energy: return kinetic_energy(w);
+    case Q::strain_energy: return strain_energy(w);
+    case Q::dissipated_energy: return dissipated_energy(w);
+    case Q::work: return w.clock.work;
+    case Q::inflow: return w.flow ? inflow(*w.flow) : 0.0;
+    }
+    return 0.0;
+}
+
+} // namespace
+
+std::vector<double> HistoryRecorder::sample(const World& w) const {
     std::vector<double> out;
     out.reserve(histories_.size());
     for (std::size_t k = 0; k < histories_.size(); ++k) {
         const auto& h = histories_[k];
-        const int i = block_[k], nd = node_[k];
-        const auto& n = s.nodes();
-        double v = 0.0;
-        if (nd >= 0) {
-            // A point of a deformable block: its nearest node (no rotation).
-            switch (h.quantity) {
-            case Q::displacement_x: out.push_back(n.position[nd].x - n.position0[nd].x); continue;
-            case Q::displacement_y: out.push_back(n.position[nd].y - n.position0[nd].y); continue;
-            case Q::velocity_x: out.push_back(n.velocity[nd].x); continue;
-            case Q::velocity_y: out.push_back(n.velocity[nd].y); continue;
-            case Q::rotation: out.push_back(0.0); continue;
-            default: break;
-            }
-        }
-        switch (h.quantity) {
-        case Q::unbalanced_ratio: v = s.unbalanced_ratio(); break;
-        case Q::displacement_x: v = b.centroid[i].x - b.centroid0[i].x; break;
-        case Q::displacement_y: v = b.centroid[i].y - b.centroid0[i].y; break;
-        case Q::velocity_x: v = b.velocity[i].x; break;
-        case Q::velocity_y: v = b.velocity[i].y; break;
-        case Q::rotation: v = b.theta[i]; break;
-        case Q::boundary_force_x: v = s.boundary_force(h.boundary).x; break;
-        case Q::boundary_force_y: v = s.boundary_force(h.boundary).y; break;
-        case Q::cracks_tensile: v = s.cracks(contact::JointState::broken_tension); break;
-        case Q::cracks_shear: v = s.cracks(contact::JointState::broken_shear); break;
-        case Q::kinetic_energy: v = s.kinetic_energy(); break;
-        case Q::strain_energy: v = s.strain_energy(); break;
-        case Q::dissipated_energy: v = s.dissipated_energy(); break;
-        case Q::work: v = s.external_work(); break;
-        case Q::inflow: v = s.flow() ? s.flow()->inflow() : 0.0; break;
-        }
-        out.push_back(v);
+        const std::optional<double> at_node = node_[k] >= 0 ? node_quantity(w, h.quantity, node_[k]) : std::nullopt;
+        out.push_back(at_node ? *at_node : quantity(w, h, block_[k]));
     }
     return out;
 }

@@ -57,9 +57,9 @@ std::vector<StageReport> run_stages(Solver& solver, const std::vector<StageSpec>
 /// Evaluates named history quantities; blocks named by a point are found once.
 class HistoryRecorder {
 public:
-    HistoryRecorder(const Solver& solver, std::vector<HistorySpec> histories);
+    HistoryRecorder(const World& w, std::vector<HistorySpec> histories);
     const std::vector<HistorySpec>& histories() const { return histories_; }
-    std::vector<double> sample(const Solver& solver) const;
+    std::vector<double> sample(const World& w) const;
 
 private:
     std::vector<HistorySpec> histories_;

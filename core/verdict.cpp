@@ -1,6 +1,7 @@
 #include "core/verdict.hpp"
 
-#include "core/solver.hpp"
+#include "core/measures.hpp"
+#include "core/world.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,11 +19,11 @@ int find_root(std::vector<int>& parent, int i) {
 
 } // namespace
 
-Fragments find_fragments(const Solver& s) {
-    const auto& b = s.blocks();
-    const auto& n = s.nodes();
-    const auto& c = s.contacts();
-    const int nb = b.count();
+Fragments find_fragments(const World& w) {
+    const auto& n = w.nodes;
+    const auto& c = w.contacts;
+    const auto& removed = w.bodies.removed;
+    const int nb = w.bodies.count();
     // Groups of bodies joined by contacts that carry force: bonded, or touching
     // with a stress (a broken contact that has opened carries none).
     std::vector<int> parent(nb);
@@ -37,25 +38,25 @@ Fragments find_fragments(const Solver& s) {
     std::vector<std::uint8_t> anchored(nb, 0);
     std::vector<double> mass(nb, 0.0);
     for (int i = 0; i < nb; ++i) {
-        if (b.removed[i]) continue;
+        if (removed[i]) continue;
         const int r = find_root(parent, i);
-        if (b.fixed[i]) anchored[r] = 1;
-        mass[r] += b.real_mass[i];
+        if (w.loads.block_fixed[i]) anchored[r] = 1;
+        mass[r] += w.blocks.real_mass[i];
     }
     for (int k = 0; k < n.count(); ++k) {
         const int i = n.block[k];
-        if (b.removed[i]) continue;
+        if (removed[i]) continue;
         const int r = find_root(parent, i);
-        if (n.fixed[k]) anchored[r] = 1;
+        if (w.loads.node_fixed[k]) anchored[r] = 1;
         mass[r] += n.real_mass[k];
     }
     int heaviest = -1;
     for (int i = 0; i < nb; ++i)
-        if (!b.removed[i] && parent[i] == i && (heaviest < 0 || mass[i] > mass[heaviest])) heaviest = i;
+        if (!removed[i] && parent[i] == i && (heaviest < 0 || mass[i] > mass[heaviest])) heaviest = i;
     Fragments f;
     f.detached.assign(nb, 0);
     for (int i = 0; i < nb; ++i) {
-        if (b.removed[i]) continue;
+        if (removed[i]) continue;
         const int r = find_root(parent, i);
         if (anchored[r] || r == heaviest) continue;
         f.detached[i] = 1;
@@ -65,38 +66,40 @@ Fragments find_fragments(const Solver& s) {
     return f;
 }
 
-void StageMonitor::sample(const Solver& s) {
-    const auto fragments = find_fragments(s);
-    const auto& b = s.blocks();
-    const auto& n = s.nodes();
+void sample_monitor(StageMonitor& monitor, const World& w) {
+    const auto fragments = find_fragments(w);
+    const auto& n = w.nodes;
+    const auto& fixed = w.loads.block_fixed;
     MonitorSample m;
-    m.step = s.steps();
-    m.cracks = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
-    m.ratio = s.unbalanced_ratio();
+    m.step = w.clock.steps;
+    m.cracks = cracks(w, contact::JointState::broken_tension) + cracks(w, contact::JointState::broken_shear);
+    m.ratio = w.clock.ratio;
     m.fragments = fragments.groups, m.fragment_blocks = fragments.blocks, m.fragment_mass = fragments.mass;
     // The rock mass's largest unbalanced force over its free components, as the
-    // step measures the model's (Solver::integrate).
+    // step measures the model's (the integrate row of core/step.cpp).
     double unbalanced = 0.0, kinetic = 0.0, speed = 0.0;
-    for (int i = 0; i < b.count(); ++i) {
-        if (b.removed[i] || b.deformable[i] || fragments.detached[i]) continue;
-        if (!(b.fixed[i] & 1)) unbalanced = std::max(unbalanced, std::abs(b.force[i].x));
-        if (!(b.fixed[i] & 2)) unbalanced = std::max(unbalanced, std::abs(b.force[i].y));
-        kinetic += 0.5 * b.real_mass[i] * norm2(b.velocity[i]) + 0.5 * b.real_inertia[i] * b.omega[i] * b.omega[i];
-        speed = std::max(speed, norm(b.velocity[i]));
+    for (int i = 0; i < w.bodies.count(); ++i) {
+        if (w.bodies.removed[i] || w.blocks.deformable[i] || fragments.detached[i]) continue;
+        const auto& b = w.bodies.state[i];
+        const Vec2 force = w.bodies.force[i];
+        if (!(fixed[i] & 1)) unbalanced = std::max(unbalanced, std::abs(force.x));
+        if (!(fixed[i] & 2)) unbalanced = std::max(unbalanced, std::abs(force.y));
+        kinetic += 0.5 * w.blocks.real_mass[i] * norm2(b.velocity) + 0.5 * w.blocks.real_inertia[i] * b.omega * b.omega;
+        speed = std::max(speed, norm(b.velocity));
     }
     for (int k = 0; k < n.count(); ++k) {
         const int i = n.block[k];
-        if (b.removed[i] || fragments.detached[i]) continue;
-        if (!(n.fixed[k] & 1)) unbalanced = std::max(unbalanced, std::abs(n.force[k].x));
-        if (!(n.fixed[k] & 2)) unbalanced = std::max(unbalanced, std::abs(n.force[k].y));
+        if (w.bodies.removed[i] || fragments.detached[i]) continue;
+        if (!(w.loads.node_fixed[k] & 1)) unbalanced = std::max(unbalanced, std::abs(n.force[k].x));
+        if (!(w.loads.node_fixed[k] & 2)) unbalanced = std::max(unbalanced, std::abs(n.force[k].y));
         kinetic += 0.5 * n.real_mass[k] * norm2(n.velocity[k]);
         speed = std::max(speed, norm(n.velocity[k]));
     }
-    const double scale = s.force_scale();
+    const double scale = force_scale(w);
     m.rock_ratio = scale > 0.0 ? unbalanced / scale : 0.0;
     m.rock_kinetic = kinetic;
-    m.rock_speed = speed * s.timestep();
-    samples_.push_back(m);
+    m.rock_speed = speed * w.clock.dt;
+    monitor.samples.push_back(m);
 }
 
 namespace {
@@ -122,8 +125,6 @@ double mean_speed(const std::vector<MonitorSample>& v, std::size_t from, std::si
 }
 
 } // namespace
-
-Verdict StageMonitor::verdict(double target) const { return judge(samples_, target); }
 
 Verdict judge(const std::vector<MonitorSample>& samples, double target) {
     Verdict v;
@@ -161,11 +162,12 @@ Verdict judge(const std::vector<MonitorSample>& samples, double target) {
     return v;
 }
 
-bool StageMonitor::at_rest(double target, long quiet_steps) const {
-    if (samples_.empty()) return false;
-    const auto& last = samples_.back();
-    if (last.step - samples_.front().step < quiet_steps) return false;
-    const auto& then = samples_[first_from(samples_, last.step - quiet_steps)];
+bool at_rest(const StageMonitor& m, double target, long quiet_steps) {
+    const auto& samples = m.samples;
+    if (samples.empty()) return false;
+    const auto& last = samples.back();
+    if (last.step - samples.front().step < quiet_steps) return false;
+    const auto& then = samples[first_from(samples, last.step - quiet_steps)];
     return last.cracks == then.cracks && last.rock_ratio <= target;
 }
 

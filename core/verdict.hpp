@@ -26,13 +26,15 @@
 // verdict the uninterrupted one gives.
 #pragma once
 
+#include "base/fields.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace bbm {
 
-class Solver;
+struct World;
 
 /// What the monitor records at one step.
 struct MonitorSample {
@@ -47,6 +49,8 @@ struct MonitorSample {
     double fragment_mass = 0;   ///< their mass, kg/m
 };
 static_assert(sizeof(MonitorSample) == 64); // no padding: saved raw in checkpoints
+template <>
+struct ElementTraits<MonitorSample> : PackedRecordTraits<MonitorSample> {};
 
 /// Fragments at the current state: per body (block), 1 if it belongs to a
 /// detached group; and the group count.
@@ -55,7 +59,7 @@ struct Fragments {
     int groups = 0, blocks = 0;
     double mass = 0; ///< kg/m
 };
-Fragments find_fragments(const Solver& s);
+Fragments find_fragments(const World& w);
 
 /// Trivially copyable without padding (written raw into checkpoints).
 struct Verdict {
@@ -82,24 +86,22 @@ std::string describe(const Verdict& v);
 /// The verdict over the window ending at the last sample (samples in step order).
 Verdict judge(const std::vector<MonitorSample>& samples, double target_ratio);
 
-class StageMonitor {
-public:
+/// What the current stage did so far: its samples (part of the world: a
+/// checkpoint saves them, so a resumed run gives the verdict the uninterrupted
+/// one gives).
+struct StageMonitor {
     static constexpr long sample_every = 100;
-
-    /// A new stage: forget the samples of the last one.
-    void start_stage() { samples_.clear(); }
-    /// Records the solver's state (called by run_stages every sample_every steps).
-    void sample(const Solver& s);
-    const std::vector<MonitorSample>& samples() const { return samples_; }
-    /// The verdict over the window ending at the last sample.
-    Verdict verdict(double target_ratio) const;
-    /// At rest now: no crack over the last `quiet_steps` and the rock's ratio at
-    /// the target (a stage asked to stop at its verdict stops here).
-    bool at_rest(double target_ratio, long quiet_steps) const;
-
-private:
-    friend class Solver; // the samples are part of its checkpoint (core/state.cpp)
-    std::vector<MonitorSample> samples_;
+    std::vector<MonitorSample> samples;
 };
+
+/// A new stage: forget the samples of the last one.
+inline void start_stage(StageMonitor& m) { m.samples.clear(); }
+/// Records the world's state (run_stages calls it every sample_every steps).
+void sample_monitor(StageMonitor& m, const World& w);
+/// The verdict over the window ending at the last sample.
+inline Verdict verdict(const StageMonitor& m, double target_ratio) { return judge(m.samples, target_ratio); }
+/// At rest now: no crack over the last `quiet_steps` and the rock's ratio at
+/// the target (a stage asked to stop at its verdict stops here).
+bool at_rest(const StageMonitor& m, double target_ratio, long quiet_steps);
 
 } // namespace bbm

@@ -21,17 +21,17 @@ std::array<double, 36> element_stiffness(const TriangleGradients& g, const Elast
     return k;
 }
 
-void Zones::index_nodes(int nodes) {
-    node_first.assign(nodes + 1, 0);
-    for (const auto& t : node)
-        for (int k : t) ++node_first[k + 1];
-    for (int k = 0; k < nodes; ++k) node_first[k + 1] += node_first[k];
-    node_entry.resize(node_first[nodes]);
-    std::vector<int> fill(node_first.begin(), node_first.end() - 1);
-    for (int z = 0; z < size(); ++z)
-        for (int c = 0; c < 3; ++c) node_entry[fill[node[z][c]]++] = 3 * z + c;
-    nodal_force.resize(size());
-    partial_sum.resize((size() + work_item_size - 1) / work_item_size);
+void index_zone_nodes(Zones& z, int nodes) {
+    z.node_first.assign(nodes + 1, 0);
+    for (const auto& t : z.node)
+        for (int k : t) ++z.node_first[k + 1];
+    for (int k = 0; k < nodes; ++k) z.node_first[k + 1] += z.node_first[k];
+    z.node_entry.resize(z.node_first[nodes]);
+    std::vector<int> fill(z.node_first.begin(), z.node_first.end() - 1);
+    for (int k = 0; k < z.size(); ++k)
+        for (int c = 0; c < 3; ++c) z.node_entry[fill[z.node[k][c]]++] = 3 * k + c;
+    z.nodal_force.resize(z.size());
+    z.partial_sum.resize((z.size() + Zones::work_item_size - 1) / Zones::work_item_size);
 }
 
 namespace {
@@ -71,10 +71,10 @@ inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double 
 }
 } // namespace
 
-void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip) {
-    const int count = z.size(), items = int(z.partial_sum.size());
-#pragma omp for schedule(static) nowait
-    for (int w = 0; w < items; ++w) {
+void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip, int first_item,
+               int last_item) {
+    const int count = z.size();
+    for (int w = first_item; w < last_item; ++w) {
         double sum = 0.0;
         for (int k = w * Zones::work_item_size; k < std::min(count, (w + 1) * Zones::work_item_size); ++k) {
             if (skip[z.block[k]]) {

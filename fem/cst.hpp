@@ -17,6 +17,7 @@
 // implicit solve and by mass scaling. Stress is tension positive (SPEC §2).
 #pragma once
 
+#include "base/fields.hpp"
 #include "base/vec2.hpp"
 
 #include <array>
@@ -63,24 +64,51 @@ struct Zones {
     std::vector<double> density;
     int size() const { return static_cast<int>(node.size()); }
 
-    // Derived by index_nodes() once the zones are complete.
+    // Derived by index_zone_nodes() once the zones are complete.
     /// Per node, its zone corners (entry 3·zone + corner) in zone order (CSR).
     std::vector<int> node_first, node_entry;
     static constexpr int work_item_size = 256; ///< zones per partial sum of Σ|f|²
     // Per-step scratch of zone_pass.
     std::vector<std::array<Vec2, 3>> nodal_force;
     std::vector<double> partial_sum;
-    /// Builds the per-node index and sizes the scratch; `nodes` = number of FE nodes.
-    void index_nodes(int nodes);
 };
+static_assert(sizeof(Elasticity) == 2 * sizeof(double)); // in the model fingerprint as raw bytes
+} // namespace bbm::fem
+template <>
+struct bbm::ElementTraits<bbm::fem::Elasticity> : bbm::PackedRecordTraits<bbm::fem::Elasticity> {};
+namespace bbm::fem {
+
+/// Its fields (base/fields.hpp): stresses and strains evolve, the elasticity is
+/// the model's, the rest is rebuilt.
+template <part_of<Zones> Z, class Visit>
+void visit_fields(Z& z, Visit&& v) {
+    using G = MemoryGroup;
+    constexpr unsigned E = field_use::evolving, M = field_use::model, R = field_use::rebuilt;
+    v(FieldInfo{"zones.stress", G::zones, E}, z.stress);
+    v(FieldInfo{"zones.strain", G::zones, E}, z.strain);
+    v(FieldInfo{"zones.elasticity", G::zones, M}, z.elasticity);
+    v(FieldInfo{"zones.node", G::zones, R}, z.node);
+    v(FieldInfo{"zones.block", G::zones, R}, z.block);
+    v(FieldInfo{"zones.density", G::zones, R}, z.density);
+    v(FieldInfo{"zones.node_first", G::nodes, R}, z.node_first);
+    v(FieldInfo{"zones.node_entry", G::zones, R}, z.node_entry);
+    v(FieldInfo{"zones.nodal_force", G::zones, R}, z.nodal_force);
+    v(FieldInfo{"zones.partial_sum", G::zones, R}, z.partial_sum);
+}
+
+/// Builds the per-node index and sizes the scratch; `nodes` = number of FE nodes.
+void index_zone_nodes(Zones& z, int nodes);
 
 /// Stage 3 of a step, first pass: zone stresses from the node velocities of the
-/// step, and each zone's nodal forces into `z.nodal_force`. As the contact pass
-/// (contact/contacts.hpp): an OpenMP work-sharing loop without a region of its
-/// own and without a barrier at its end; the team meets at a barrier before
-/// gathering with node_zone_force(). Zones of removed blocks are skipped
-/// (`skip[block]` non-zero) and contribute nothing. Needs index_nodes().
-void zone_pass(Zones& z, const Vec2* position, const Vec2* velocity, double dt, const std::uint8_t* skip);
+/// step, and each zone's nodal forces into `z.nodal_force`, for the work items
+/// [first_item, last_item) (zone_items(z): Zones::work_item_size zones each, one
+/// partial sum of Σ|f|² each). Who computes an item does not change its result:
+/// a team shares the items and meets at a barrier before gathering with
+/// node_zone_force(). Zones of removed blocks are skipped (`skip[block]`
+/// non-zero) and contribute nothing. Needs index_zone_nodes().
+void zone_pass(Zones& z, const Vec2* position, const Vec2* velocity, double dt, const std::uint8_t* skip,
+               int first_item, int last_item);
+inline int zone_items(const Zones& z) { return static_cast<int>(z.partial_sum.size()); }
 
 /// Second pass, per node: the forces of its zones in zone order (the same sum on
 /// any number of threads).

@@ -575,6 +575,19 @@ void read_report(Ctx& c, const toml::table& doc, ReportSpec& r) {
     }
 }
 
+/// How large the model is (base/table_reader.hpp): its regions' outlines and the
+/// smallest size of their block patterns, for the checks of lengths and positions.
+ModelScale model_scale(const meshing::ModelGeometrySpec& g) {
+    ModelScale scale;
+    for (const RegionSpec& r : g.regions) {
+        // A coarse polygon is enough for the extent (every circle an octagon).
+        for (Vec2 p : meshing::outline_polygon(r.outline, 1e30)) scale.extent.add(p);
+        if (r.pattern.kind != meshing::PatternSpec::Kind::single && r.pattern.size > 0.0)
+            scale.block_size = scale.block_size > 0.0 ? std::min(scale.block_size, r.pattern.size) : r.pattern.size;
+    }
+    return scale;
+}
+
 /// The analysis tables, after the regions (whose names they refer to) are read.
 /// `region_material` is the `material` key of each region, if given.
 void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
@@ -620,30 +633,13 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     read_tables(c, doc, "history", [&](const toml::table& t, const Path& p, std::size_t) {
         an.histories.push_back(read_history(c, t, p, histories, boundaries));
     });
-    // Support: bolt sets, dowel sets and liners, named apart from each other;
+    // Support sets of every registered type, named apart from each other;
     // install stages name any of them.
-    Names supports{"support", "supports", "bolt]], [[dowel]] or [[liner", {}, {}};
-    Names bolt_sets{"bolt set", "bolt sets", "bolt", {}, {}}, dowel_sets{"dowel set", "dowel sets", "dowel", {}, {}},
-        liners{"liner", "liners", "liner", {}, {}};
-    read_bolt_sets(c, doc, an.bolts, bolt_sets);
-    read_dowel_sets(c, doc, an.dowels, dowel_sets);
-    read_liners(c, doc, an.liners, liners);
-    const Names* support_kinds[] = {&bolt_sets, &dowel_sets, &liners};
-    for (std::size_t later = 1; later < std::size(support_kinds); ++later)
-        for (std::size_t i = 0; i < support_kinds[later]->names.size(); ++i)
-            for (std::size_t earlier = 0; earlier < later; ++earlier) {
-                const Names& mine = *support_kinds[later];
-                const Names& theirs = *support_kinds[earlier];
-                const auto other = std::ranges::find(theirs.names, mine.names[i]);
-                if (other == theirs.names.end()) continue;
-                const Path np = Path{}.key(std::string(mine.table)).at(i).key("name");
-                const auto j = std::size_t(other - theirs.names.begin());
-                c.fail(mf.source.line_of(np.full), np,
-                       "name " + quoted(mine.names[i]) + " is already used by " + std::string(theirs.table) + "[" +
-                           std::to_string(j) + "] (line " + std::to_string(theirs.lines[j]) +
-                           "): bolt sets, dowel sets and liners share their names (install stages name any)");
-            }
-    for (const Names* kind : support_kinds) supports.names.insert(supports.names.end(), kind->names.begin(), kind->names.end());
+    std::string support_tables_text;
+    for (const std::string_view t : support_tables())
+        support_tables_text += (support_tables_text.empty() ? "" : "]], [[") + std::string(t);
+    Names supports{"support", "supports", support_tables_text, {}, {}};
+    read_supports(c, doc, an.supports, supports, model_scale(mf.geometry));
     read_flow(c, doc, an.flow, regions);
     for (std::size_t i = 0; i < an.histories.size(); ++i)
         if (an.histories[i].quantity == HistorySpec::Quantity::inflow && !an.flow.on) {
@@ -775,10 +771,11 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     c.file = name;
     c.source = &mf.source;
     const Path root{};
-    static constexpr std::array<std::string_view, 16> top_keys{
-        "model",   "region", "material", "joint_property", "joint_assignment", "boundary",
-        "solver",  "history", "stage",   "report",         "bolt",             "liner",
-        "dowel",   "flow",   "flow_boundary", "flow_source"};
+    // The sections, and one table per registered support type (core/supports/registry.hpp).
+    std::vector<std::string_view> top_keys{"model", "region",  "material", "joint_property", "joint_assignment",
+                                           "boundary", "solver", "history", "stage", "report", "flow",
+                                           "flow_boundary", "flow_source"};
+    for (const std::string_view t : support_tables()) top_keys.push_back(t);
     check_keys(c, doc, root, top_keys);
 
     if (const toml::node* n = find(c, doc, root, "model")) {

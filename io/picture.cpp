@@ -1,6 +1,7 @@
 #include "io/picture.hpp"
 
-#include "core/solver.hpp"
+#include "core/measures.hpp"
+#include "core/supports/ties.hpp"
 
 #include <cairo-svg.h>
 #include <cairo.h>
@@ -205,12 +206,12 @@ namespace {
 
 /// The picture's frame: the model as it was built (blocks thrown far off would
 /// shrink the rest), unless a window is given.
-Box2 failure_frame(const Solver& s, const FailurePlotOptions& o) {
-    const auto& b = s.blocks();
+Box2 failure_frame(const World& w, const FailurePlotOptions& o) {
+    const auto& b = w.blocks;
     Box2 box = o.window;
     if (!box.empty()) return box;
     for (int i = 0; i < b.count(); ++i)
-        for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.centroid0[i] + b.local[v]);
+        for (auto v = b.first[i]; v < b.first[i + 1]; ++v) box.add(b.centroid0[i] + w.vertices.local[v]);
     const double m = 0.03 * std::max(box.width(), box.height());
     box.lo -= Vec2{m, m};
     box.hi += Vec2{m, m};
@@ -226,21 +227,22 @@ struct Shade {
     bool water = false;
     std::vector<double> block, zone; ///< per block (rigid), per zone
     double top = 0.0, largest = 0.0;
-    Shade(const Solver& s, bool by_pressure) : water(by_pressure && s.flow()) {
-        const auto& b = s.blocks();
-        const auto& z = s.zones();
-        const auto& nodes = s.nodes();
+    Shade(const World& w, bool by_pressure) : water(by_pressure && w.flow) {
+        const auto& b = w.blocks;
+        const auto& z = w.zones;
+        const auto& nodes = w.nodes;
+        const auto& removed = w.bodies.removed;
         block.assign(b.count(), 0.0), zone.assign(z.size(), 0.0);
         if (water) {
             // A block's pressure: the length-weighted mean of its contacts' water pressure.
-            const auto& c = s.contacts();
+            const auto& c = w.contacts;
             std::vector<double> length(b.count(), 0.0);
             for (int i = 0; i < c.size(); ++i)
                 for (int blk : {c.vertex_block[i], c.edge_block[i]})
                     block[blk] += c.fluid_pressure[i] * c.length[i], length[blk] += c.length[i];
             for (int i = 0; i < b.count(); ++i) block[i] = length[i] > 0 ? block[i] / length[i] : 0.0;
         } else {
-            for (int i = 0; i < b.count(); ++i) block[i] = norm(b.centroid[i] - b.centroid0[i]);
+            for (int i = 0; i < b.count(); ++i) block[i] = norm(w.bodies.state[i].centroid - b.centroid0[i]);
             for (int k = 0; k < z.size(); ++k) {
                 Vec2 u{};
                 for (int nd : z.node[k]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0;
@@ -249,9 +251,9 @@ struct Shade {
         }
         std::vector<double> v;
         for (int i = 0; i < b.count(); ++i)
-            if (!b.removed[i] && !b.deformable[i]) v.push_back(block[i]);
+            if (!removed[i] && !b.deformable[i]) v.push_back(block[i]);
         for (int k = 0; k < z.size(); ++k)
-            if (!b.removed[z.block[k]]) v.push_back(zone[k]);
+            if (!removed[z.block[k]]) v.push_back(zone[k]);
         std::sort(v.begin(), v.end());
         largest = v.empty() ? 0.0 : v.back();
         top = v.empty() ? 0.0 : water ? largest : v[std::size_t(0.995 * double(v.size() - 1))];
@@ -275,12 +277,14 @@ struct Shade {
 };
 
 /// Zones and blocks shaded; deformable blocks outlined.
-void draw_material(cairo_t* cr, const Solver& s, const Shade& shade, double px) {
-    const auto& b = s.blocks();
-    const auto& nodes = s.nodes();
-    const auto& z = s.zones();
+void draw_material(cairo_t* cr, const World& w, const Shade& shade, double px) {
+    const auto& b = w.blocks;
+    const auto& nodes = w.nodes;
+    const auto& z = w.zones;
+    const auto& removed = w.bodies.removed;
+    const auto& vertex = w.vertices.position;
     for (int k = 0; k < z.size(); ++k) {
-        if (b.removed[z.block[k]]) continue;
+        if (removed[z.block[k]]) continue;
         const auto& t = z.node[k];
         const Vec2 corners[3] = {nodes.position[t[0]], nodes.position[t[1]], nodes.position[t[2]]};
         polygon_path(cr, corners);
@@ -291,8 +295,8 @@ void draw_material(cairo_t* cr, const Solver& s, const Shade& shade, double px) 
         cairo_stroke(cr);
     }
     for (int i = 0; i < b.count(); ++i) {
-        if (b.removed[i]) continue;
-        polygon_path(cr, {b.vertex.data() + b.first[i], b.vertex.data() + b.first[i + 1]});
+        if (removed[i]) continue;
+        polygon_path(cr, {vertex.data() + b.first[i], vertex.data() + b.first[i + 1]});
         if (b.deformable[i]) { // outline only: its zones are drawn above
             cairo_set_source_rgba(cr, 0.3, 0.3, 0.3, 0.9);
             cairo_set_line_width(cr, 0.8 * px);
@@ -308,16 +312,16 @@ void draw_material(cairo_t* cr, const Solver& s, const Shade& shade, double px) 
 }
 
 /// Each broken contact as a short line along its joint: red tensile, blue shear.
-void draw_cracks(cairo_t* cr, const Solver& s, double px) {
-    const auto& b = s.blocks();
-    const auto& c = s.contacts();
+void draw_cracks(cairo_t* cr, const World& w, double px) {
+    const auto& vertex = w.vertices.position;
+    const auto& c = contacts(w);
     cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
     for (int i = 0; i < c.size(); ++i) {
         const auto mode = c.history[i].broken;
         if (mode == contact::JointState::intact) continue;
         const Rgb col = mode == contact::JointState::broken_tension ? tensile_red : shear_blue;
-        const Vec2 x = b.vertex[c.vertex_id[i]];
-        const Vec2 mid = 0.5 * (b.vertex[c.edge_id[i]] + b.vertex[c.edge_end[i]]);
+        const Vec2 x = vertex[c.vertex_id[i]];
+        const Vec2 mid = 0.5 * (vertex[c.edge_id[i]] + vertex[c.edge_end[i]]);
         const Vec2 t = contact::tangent_of(c.normal[i]);
         const Vec2 y = x + (dot(mid - x, t) >= 0 ? 1.0 : -1.0) * c.length[i] * t;
         cairo_set_source_rgb(cr, col.r, col.g, col.b);
@@ -328,20 +332,18 @@ void draw_cracks(cairo_t* cr, const Solver& s, double px) {
     }
 }
 
-/// Supports (core/support.hpp), each line cell shaded by its headline force
+/// Supports (core/supports/support.hpp), each line cell shaded by its headline force
 /// against the largest now. Bars (bolts, dowels): green (none) to purple, yielded
 /// segments thicker, broken ones dashed black. Linings: a thick line along the
 /// wall, darker blue the higher its thrust. Returns their legend.
-std::string draw_supports(cairo_t* cr, const Solver& s, double px) {
+std::string draw_supports(cairo_t* cr, const World& w, double px) {
     std::string support_legend;
-    for (const auto& support : s.supports()) {
-        if (support->tie_count() == 0) continue;
-        const SupportLines lines = support->lines();
+    for (const auto& [name, lines] : support_lines(w)) {
         const auto& shading = lines.cell_data[lines.shade].values;
         double largest = 0.0;
         for (double v : shading) largest = std::max(largest, std::abs(v));
         char label[160];
-        std::snprintf(label, sizeof label, "   %s: %s %.0f %s", support->name(),
+        std::snprintf(label, sizeof label, "   %s: %s %.0f %s", name.c_str(),
                       lines.look == SupportLines::Look::lining ? "light to dark blue" : "green 0 to purple", largest,
                       lines.shade_label.c_str());
         support_legend += label;
@@ -386,18 +388,18 @@ void draw_outline(cairo_t* cr, const std::vector<Vec2>& outline, double px) {
 
 } // namespace
 
-void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o) {
-    const Box2 box = failure_frame(s, o);
+void draw_failure(const World& w, const std::filesystem::path& file, const FailurePlotOptions& o) {
+    const Box2 box = failure_frame(w, o);
     const double legend = 40.0;
     const View view(box, o.width_px, legend);
     Canvas canvas(file, view.w, view.h);
     cairo_t* cr = canvas.cr;
-    const Shade shade(s, o.shade_pressure);
+    const Shade shade(w, o.shade_pressure);
     view.apply(cr, box, legend);
     const double px = 1.0 / view.scale;
-    draw_material(cr, s, shade, px);
-    draw_cracks(cr, s, px);
-    const std::string support_legend = draw_supports(cr, s, px);
+    draw_material(cr, w, shade, px);
+    draw_cracks(cr, w, px);
+    const std::string support_legend = draw_supports(cr, w, px);
     draw_outline(cr, o.outline, px);
     cairo_restore(cr);
     // Legend.
@@ -407,12 +409,12 @@ void draw_failure(const Solver& s, const std::filesystem::path& file, const Fail
     cairo_set_source_rgb(cr, tensile_red.r, tensile_red.g, tensile_red.b);
     cairo_move_to(cr, 20, y0 - 5), cairo_line_to(cr, 45, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    std::snprintf(buf, sizeof buf, "tensile cracks (%d)", s.cracks(contact::JointState::broken_tension));
+    std::snprintf(buf, sizeof buf, "tensile cracks (%d)", cracks(w, contact::JointState::broken_tension));
     text(cr, 52, y0, buf);
     cairo_set_source_rgb(cr, shear_blue.r, shear_blue.g, shear_blue.b);
     cairo_move_to(cr, 260, y0 - 5), cairo_line_to(cr, 285, y0 - 5), cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    std::snprintf(buf, sizeof buf, "shear cracks (%d)   %s%s%s%s%s", s.cracks(contact::JointState::broken_shear),
+    std::snprintf(buf, sizeof buf, "shear cracks (%d)   %s%s%s%s%s", cracks(w, contact::JointState::broken_shear),
                   shade.words().c_str(),
                   o.outline.empty() ? "" : "   dashed: failed zone", support_legend.c_str(), o.title.empty() ? "" : "   ",
                   o.title.c_str());

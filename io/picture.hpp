@@ -13,7 +13,7 @@
 #include <vector>
 
 namespace bbm {
-class Solver;
+struct World;
 }
 
 namespace bbm::io {
@@ -44,7 +44,7 @@ struct FailurePlotOptions {
 
 /// Blocks shaded by displacement magnitude (or the water's pressure), with broken contacts drawn along their
 /// joints: tensile cracks red, shear cracks blue; a legend.
-void draw_failure(const Solver& s, const std::filesystem::path& file, const FailurePlotOptions& o = {});
+void draw_failure(const World& w, const std::filesystem::path& file, const FailurePlotOptions& o = {});
 
 struct Series {
     std::string label;

@@ -1,6 +1,6 @@
 // bbm io: the helpers every section reader of the model file uses (internal).
 //
-// A section of the model file ([[region]], [[bolt]], ...) is read by its own
+// A section of the model file ([[region]], [[stage]], ...) is read by its own
 // file on these: a Path beside every node (its full dotted key for messages and
 // its key inside a region for ModelSource), a Ctx that fails with file, line and
 // key, typed conversions with ranges, key checks with "did you mean", and the
@@ -9,6 +9,7 @@
 
 #include "base/bounds.hpp"
 #include "base/keys.hpp"
+#include "base/table_reader.hpp"
 #include "io/model_input.hpp"
 
 // toml++ 3.3 asserts in its parser a condition that input can break (parse_key
@@ -574,10 +575,9 @@ void read_declared_key(const Ctx& c, const toml::table& t, const Path& p, const 
 
 // --- section readers (one file each) ---------------------------------------------
 
-/// [[bolt]] tables (io/read_bolts.cpp): appended to `bolts`; their names to `names`.
-void read_bolt_sets(Ctx& c, const toml::table& doc, std::vector<BoltSetSpec>& bolts, Names& names);
-/// [[dowel]] tables (io/read_bolts.cpp).
-void read_dowel_sets(Ctx& c, const toml::table& doc, std::vector<DowelSetSpec>& dowels, Names& names);
+/// Every registered support type's tables (io/read_supports.cpp), each by its
+/// type's own reader; their names, unique over all types, to `names`.
+void read_supports(Ctx& c, const toml::table& doc, SupportSpecs& specs, Names& names, const ModelScale& scale);
 /// A [[history]] table and a [[stage]] table (io/read_stages.cpp).
 HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& names, const Names& boundaries);
 StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
@@ -586,8 +586,6 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
 /// region's sets before it, and gets its name.
 meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier,
                                  const meshing::OutlineSpec& outline);
-/// [[liner]] tables (io/read_liners.cpp).
-void read_liners(Ctx& c, const toml::table& doc, std::vector<LinerSpec>& liners, Names& names);
 /// [flow], [[flow_boundary]] and [[flow_source]] (io/read_flow.cpp).
 void read_flow(Ctx& c, const toml::table& doc, FlowSpec& flow, const Names& regions);
 

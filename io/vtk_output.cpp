@@ -2,7 +2,7 @@
 #include "io/vtk_output.hpp"
 
 #include "base/error.hpp"
-#include "core/solver.hpp"
+#include "core/measures.hpp"
 
 // VTK 9.1's type macros end in a stray ';' that -Wpedantic reports in every file;
 // CMake passes VTK's directory with -isystem, this keeps a plain -I build quiet too.
@@ -353,11 +353,11 @@ namespace {
 
 /// The state's cells in one grid: rigid blocks (polygons) first, then the zones
 /// of deformable blocks (triangles), with their points' displacement.
-void add_state_cells(vtkUnstructuredGrid* grid, const Solver& s, const std::vector<int>& kept,
+void add_state_cells(vtkUnstructuredGrid* grid, const World& w, const std::vector<int>& kept,
                      const std::vector<int>& zones) {
-    const auto& b = s.blocks();
-    const auto& nodes = s.nodes();
-    const auto& z = s.zones();
+    const auto& x = w.vertices;
+    const auto& nodes = w.nodes;
+    const auto& z = w.zones;
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     auto point_disp = double_array("displacement", 0);
@@ -366,10 +366,10 @@ void add_state_cells(vtkUnstructuredGrid* grid, const Solver& s, const std::vect
     vtkNew<vtkUnsignedCharArray> types;
     offsets->InsertNextValue(0);
     for (int i : kept) {
-        const Vec2 c0 = b.centroid0[i];
-        for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
-            connectivity->InsertNextValue(points->InsertNextPoint(b.vertex[v].x, b.vertex[v].y, 0.0));
-            const Vec2 u = b.vertex[v] - (c0 + b.local[v]);
+        const Vec2 c0 = w.blocks.centroid0[i];
+        for (std::uint32_t v = w.blocks.first[i]; v < w.blocks.first[i + 1]; ++v) {
+            connectivity->InsertNextValue(points->InsertNextPoint(x.position[v].x, x.position[v].y, 0.0));
+            const Vec2 u = x.position[v] - (c0 + x.local[v]);
             point_disp->InsertNextTuple3(u.x, u.y, 0.0);
         }
         offsets->InsertNextValue(connectivity->GetNumberOfValues());
@@ -398,18 +398,18 @@ void add_state_cells(vtkUnstructuredGrid* grid, const Solver& s, const std::vect
 
 } // namespace
 
-void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
-    const auto& b = s.blocks();
-    const auto& nodes = s.nodes();
-    const auto& z = s.zones();
-    const auto stress = s.block_stresses();
+void write_state_blocks_vtu(const World& w, const fs::path& file) {
+    const auto& b = w.blocks;
+    const auto& nodes = w.nodes;
+    const auto& z = w.zones;
+    const auto stress = block_stresses(w);
     std::vector<int> kept, zones; // the rigid blocks and the zones not removed
-    for (int i = 0; i < b.count(); ++i)
-        if (!b.removed[i] && !b.deformable[i]) kept.push_back(i);
+    for (int i = 0; i < w.bodies.count(); ++i)
+        if (!w.bodies.removed[i] && !b.deformable[i]) kept.push_back(i);
     for (int k = 0; k < z.size(); ++k)
-        if (!b.removed[z.block[k]]) zones.push_back(k);
+        if (!w.bodies.removed[z.block[k]]) zones.push_back(k);
     vtkNew<vtkUnstructuredGrid> grid;
-    add_state_cells(grid, s, kept, zones);
+    add_state_cells(grid, w, kept, zones);
     const auto nk = static_cast<vtkIdType>(kept.size());
     const auto n = nk + static_cast<vtkIdType>(zones.size());
     auto id = int_array("block_id", n), region = int_array("region", n), material = int_array("material", n);
@@ -430,10 +430,11 @@ void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
         region->SetValue(k, b.region[i]);
         material->SetValue(k, b.material[i]);
         kind->SetValue(k, 0);
-        rotation->SetValue(k, b.theta[i]);
-        const Vec2 u = b.centroid[i] - b.centroid0[i];
+        const auto& body = w.bodies.state[i];
+        rotation->SetValue(k, body.theta);
+        const Vec2 u = body.centroid - b.centroid0[i];
         disp->SetTuple3(k, u.x, u.y, 0.0);
-        vel->SetTuple3(k, b.velocity[i].x, b.velocity[i].y, 0.0);
+        vel->SetTuple3(k, body.velocity.x, body.velocity.y, 0.0);
         const double t[6] = {stress[i][0], stress[i][1], 0.0, stress[i][2], 0.0, 0.0};
         sig->SetTuple(k, t);
         const double e[6] = {0, 0, 0, 0, 0, 0}; // rigid: the strain lives in the joints
@@ -462,13 +463,13 @@ void write_state_blocks_vtu(const Solver& s, const fs::path& file) {
         eps->SetTuple(k, e);
     }
     add_cell_arrays(grid, id, region, material, kind, disp, vel, rotation, sig, eps);
-    grid->GetFieldData()->AddArray(string_array("region_names", s.region_names(), [](const std::string& x) { return x; }));
+    grid->GetFieldData()->AddArray(string_array("region_names", w.region_names, [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }
 
-void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
-    const auto& c = s.contacts();
-    const auto& b = s.blocks();
+void write_state_contacts_vtu(const World& w, const fs::path& file) {
+    const auto& c = contacts(w);
+    const auto& vertex = w.vertices.position;
     const auto n = static_cast<vtkIdType>(c.size());
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
@@ -481,9 +482,9 @@ void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
     auto state = int_array("state", n), property = int_array("property", n);
     for (vtkIdType i = 0; i < n; ++i) {
         // The contact's share of the joint: from its vertex along the edge inwards.
-        const Vec2 x = b.vertex[c.vertex_id[i]];
-        const int e0 = c.edge_id[i], e1 = contact::next_vertex(b.first.data(), c.edge_block[i], e0);
-        const Vec2 mid = 0.5 * (b.vertex[e0] + b.vertex[e1]);
+        const Vec2 x = vertex[c.vertex_id[i]];
+        const int e0 = c.edge_id[i], e1 = contact::next_vertex(w.blocks.first.data(), c.edge_block[i], e0);
+        const Vec2 mid = 0.5 * (vertex[e0] + vertex[e1]);
         const Vec2 t = contact::tangent_of(c.normal[i]);
         const Vec2 y = x + (dot(mid - x, t) >= 0 ? 1.0 : -1.0) * c.length[i] * t;
         points->SetPoint(2 * i, x.x, x.y, 0.0);
@@ -508,16 +509,16 @@ void write_state_contacts_vtu(const Solver& s, const fs::path& file) {
     grid->SetPoints(points);
     grid->SetCells(VTK_LINE, cells);
     add_cell_arrays(grid, sn, tau, un, us, damage, state, property, length);
-    if (const JointFlow* flow = s.flow()) {
+    if (w.flow) {
         // Water in the joints: the fluid's pressure on the contact and its pipes' aperture.
         auto pressure = double_array("fluid_pressure", n), aperture = double_array("aperture", n);
-        const std::vector<double> a = flow->contact_apertures(c);
+        const std::vector<double> a = contact_apertures(*w.flow, c);
         for (vtkIdType i = 0; i < n; ++i) pressure->SetValue(i, c.fluid_pressure[i]), aperture->SetValue(i, a[i]);
         add_cell_arrays(grid, pressure, aperture);
     }
     const std::vector<std::string> states{"intact", "softening", "broken_tension", "broken_shear", "sliding"};
     grid->GetFieldData()->AddArray(string_array("state_names", states, [](const std::string& x) { return x; }));
-    grid->GetFieldData()->AddArray(string_array("property_names", s.property_names(), [](const std::string& x) { return x; }));
+    grid->GetFieldData()->AddArray(string_array("property_names", w.properties.names, [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }
 
@@ -549,27 +550,27 @@ vtkSmartPointer<vtkUnstructuredGrid> line_grid(const std::vector<Vec2>& nodes, v
 }
 } // namespace
 
-void write_flow_vtu(const Solver& s, const fs::path& file) {
-    const JointFlow& flow = *s.flow();
-    const auto& net = flow.network();
-    const auto& st = flow.state();
+void write_flow_vtu(const World& w, const fs::path& file) {
+    const JointFlow& flow = *w.flow;
+    const auto& net = flow.net;
+    const auto& st = flow.state;
     const auto nd = static_cast<vtkIdType>(net.domains()), np = static_cast<vtkIdType>(net.pipes());
     auto grid = line_grid(net.domain_position, np, [&](vtkIdType k) {
         return std::pair<vtkIdType, vtkIdType>{net.pipe_from[k], net.pipe_to[k]};
     });
     auto pressure = double_array("pressure", nd), head = double_array("head", nd);
     auto held = int_array("held", nd), drained = int_array("drained", nd);
-    const double rho_g = flow.fluid().density * norm(flow.fluid().gravity);
+    const double rho_g = flow.fluid.density * norm(flow.fluid.gravity);
     for (vtkIdType d = 0; d < nd; ++d) {
         pressure->SetValue(d, st.pressure[d]);
         head->SetValue(d, rho_g > 0 ? net.domain_position[d].y + st.pressure[d] / rho_g : 0.0);
-        held->SetValue(d, st.held[d]), drained->SetValue(d, flow.drained()[d]);
+        held->SetValue(d, st.held[d]), drained->SetValue(d, flow.drained[d]);
     }
     auto aperture = double_array("aperture", np), rate = double_array("flow_rate", np);
     auto joint = int_array("joint", np);
-    const std::vector<double> q = flow::pipe_flows(net, flow.fluid(), st);
+    const std::vector<double> q = flow::pipe_flows(net, flow.fluid, st);
     for (vtkIdType k = 0; k < np; ++k) {
-        aperture->SetValue(k, flow::hydraulic_aperture(flow.fluid(), st.aperture[k]));
+        aperture->SetValue(k, flow::hydraulic_aperture(flow.fluid, st.aperture[k]));
         rate->SetValue(k, q[k]);
         joint->SetValue(k, net.pipe_joint[k]);
     }

@@ -20,12 +20,8 @@
 // Failures throw std::runtime_error naming the file.
 #pragma once
 
-#include "core/support.hpp"
+#include "core/world.hpp"
 #include "meshing/blocks.hpp"
-
-namespace bbm {
-class Solver;
-}
 
 #include <filesystem>
 #include <string>
@@ -59,24 +55,23 @@ void make_output_directory(const std::filesystem::path& dir);
 /// Writes `text` to `file` atomically (summary.json, logs of a finished run).
 void write_text_atomically(const std::filesystem::path& file, std::string_view text);
 
-/// The solver's current state in one grid: rigid blocks as polygons at their
+/// The world's current state in one grid: rigid blocks as polygons at their
 /// current place, then the zones (triangles) of deformable blocks. Cell data
 /// block_id, region, material, zone (0 rigid block, 1 zone), cell_displacement,
 /// velocity, rotation, stress and strain as symmetric tensors XX YY ZZ XY YZ XZ
 /// (tension positive; rigid blocks: block-averaged stress, zero strain); point
 /// data displacement (of every vertex and node). Excavated blocks are left out.
-void write_state_blocks_vtu(const Solver& s, const std::filesystem::path& file);
+void write_state_blocks_vtu(const World& w, const std::filesystem::path& file);
 /// Contacts as line cells along their share of the joint (cell data sn, tau, un,
 /// us, damage, state (0 intact, 1 softening, 2 broken-tension, 3 broken-shear,
 /// 4 sliding), property, length).
-void write_state_contacts_vtu(const Solver& s, const std::filesystem::path& file);
+void write_state_contacts_vtu(const World& w, const std::filesystem::path& file);
 /// Water in the joints (a model with [flow]): the network's domains as points
 /// (point data pressure, head, held, drained) and its pipes as line cells (cell
 /// data aperture, flow_rate from pipe_from to pipe_to in m²/s per m, joint).
-void write_flow_vtu(const Solver& s, const std::filesystem::path& file);
-/// An installed support type (core/support.hpp) as line cells with the arrays
-/// its lines() names: bolts (core/bolts.hpp), liners (core/liners.hpp), dowels
-/// (core/dowels.hpp) document theirs.
+void write_flow_vtu(const World& w, const std::filesystem::path& file);
+/// An installed support type (core/supports/support.hpp) as line cells with the
+/// arrays its lines() names (each type's header documents its own).
 void write_support_vtu(const SupportLines& lines, const std::filesystem::path& file);
 
 } // namespace bbm::io

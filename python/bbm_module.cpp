@@ -4,15 +4,17 @@
 // tests and the calibration parse their keyword arguments, turned into option
 // strings by bbm/__init__.py, with the program's own option definitions.
 //
-// Arrays: the state the solver keeps in flat arrays that never move once the
-// model is built (block centroids, velocities, rotations, areas, regions; FE node
-// positions and velocities; zone corners, stresses and strains) is handed out as
-// read-only numpy views of the solver's memory, alive as long as the model.
-// Values derived on request (displacements, block stresses, zone areas) and the
-// contact arrays are fresh arrays: contacts are created and removed as blocks
+// Arrays: every field of the world's state list (core/world.hpp) is an attribute
+// of its group — model.blocks.centroid is "blocks.centroid", model.dowels.shear
+// "dowels.shear" — generated from the list (FieldGroup), so a field added to a
+// part, or a support type added to the registry, is in Python with no line here.
+// Groups whose arrays never move once the model is built (blocks, nodes, zones)
+// hand out read-only numpy views of the world's memory, alive as long as the
+// model; the others fresh copies: contacts are created and removed as blocks
 // move, so their storage grows and moves during a run, and a view of it would
-// dangle. The GIL is released while the loop runs; a callback, or Ctrl-C every
-// 1,000 steps, takes it back.
+// dangle. Values derived on request (displacements, block stresses, the joints'
+// stresses) are the groups' properties. The GIL is released while the loop
+// runs; a callback, or Ctrl-C every 1,000 steps, takes it back.
 #include "base/error.hpp"
 #include "studies/commands.hpp"
 #include "studies/envelope.hpp"
@@ -28,6 +30,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <mutex>
 #include <optional>
 
@@ -39,23 +42,6 @@ namespace {
 
 py::object json_to_python(const nlohmann::json& j) {
     return py::module_::import("json").attr("loads")(j.dump());
-}
-
-/// A read-only numpy view of `count` rows of `cols` values of type T starting at
-/// `data`, `stride` bytes between rows; `owner` keeps the memory alive.
-template <class T>
-py::array view(const void* data, py::ssize_t count, py::ssize_t cols, py::ssize_t stride, py::handle owner) {
-    std::vector<py::ssize_t> shape{count}, strides{stride};
-    if (cols > 0) shape.push_back(cols), strides.push_back(sizeof(T));
-    py::array a(py::dtype::of<T>(), shape, strides, data, owner);
-    py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-    return a;
-}
-
-template <class T>
-py::array_t<T> fresh(py::ssize_t count, py::ssize_t cols = 0) {
-    if (cols > 0) return py::array_t<T>({count, cols});
-    return py::array_t<T>(count);
 }
 
 /// Runs `work` without the GIL; a Python callback every `every` steps, and a check
@@ -85,44 +71,129 @@ void run_released(Model& m, const std::optional<py::function>& callback, long ev
     if (failure) throw std::move(*failure);
 }
 
-/// The arrays of a solver's state: `model` keeps it alive (views point into it);
-/// a lab test's frame has none, and its arrays are copied at once (snapshot()).
-struct StateArrays {
+/// A group of the world's field list — every field named "<group>.<name>"
+/// (core/world.hpp, Model.state_fields()) — as an object whose attributes are
+/// those fields: `model.blocks.centroid` is the field "blocks.centroid". Groups
+/// whose arrays never move once the model is built (blocks, nodes, zones) give
+/// read-only numpy views of the world's memory, alive as long as the model; the
+/// others (contacts, which detection creates and removes, supports, which grow
+/// at an install) give fresh copies. Values derived on request (displacements,
+/// block stresses, contact stresses from their histories) are the groups'
+/// properties. A lab test's frame has no model: its arrays are copied at once
+/// (frame_snapshot()).
+struct FieldGroup {
     py::object model;
-    const Solver* solver = nullptr;
+    World* world = nullptr;
+    std::string prefix;
+    bool views = false; ///< its fields as views (storage that never moves), else copies
 };
-struct BlockArrays : StateArrays {};
-struct ContactArrays : StateArrays {};
-struct ZoneArrays : StateArrays {};
-struct NodeArrays : StateArrays {};
-struct BoltArrays : StateArrays {};
-struct LinerArrays : StateArrays {};
+struct BlockArrays : FieldGroup {};
+struct ContactArrays : FieldGroup {};
+struct ZoneArrays : FieldGroup {};
+struct NodeArrays : FieldGroup {};
+struct SupportArrays : FieldGroup {};
 
-const Solver& solver_of(const StateArrays& a) { return *a.solver; }
+const World& world_of(const FieldGroup& g) { return *g.world; }
 
-template <class Arrays>
-Arrays arrays_of(py::object model) {
-    Arrays a;
-    a.solver = &model.cast<const Model&>().solver();
-    a.model = std::move(model);
-    return a;
+template <class Group>
+Group group_of(py::object model, std::string prefix, bool views) {
+    Group g;
+    g.world = &model.cast<Model&>().solver().world();
+    g.model = std::move(model);
+    g.prefix = std::move(prefix);
+    g.views = views;
+    return g;
+}
+
+py::dtype dtype_of(const StateField& f) {
+    switch (f.type) {
+    case ScalarType::f64: return py::dtype::of<double>();
+    case ScalarType::f32: return py::dtype::of<float>();
+    case ScalarType::i32: return py::dtype::of<std::int32_t>();
+    case ScalarType::i64: return py::dtype::of<std::int64_t>();
+    case ScalarType::u32: return py::dtype::of<std::uint32_t>();
+    case ScalarType::u64: return py::dtype::of<std::uint64_t>();
+    case ScalarType::u8:
+    case ScalarType::record: break;
+    }
+    return py::dtype::of<std::uint8_t>();
+}
+
+/// A field of the state list (base/fields.hpp) as a numpy array: shape (count,)
+/// or (count, components), records as their bytes (uint8); a view of the world's
+/// memory (read-only, `owner` keeping it alive) or a copy.
+py::array field_array(const StateField& f, py::handle owner, bool as_view) {
+    const py::dtype dtype = dtype_of(f);
+    const auto scalar = py::ssize_t(dtype.itemsize());
+    std::vector<py::ssize_t> shape{py::ssize_t(f.size())}, strides{py::ssize_t(f.stride)};
+    if (f.components > 1) shape.push_back(f.components), strides.push_back(scalar);
+    if (as_view) {
+        py::array a(dtype, shape, strides, f.data, owner);
+        py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+        return a;
+    }
+    py::array out(dtype, shape);
+    auto* to = static_cast<std::byte*>(out.mutable_data());
+    for (std::size_t k = 0; k < f.size(); ++k) std::memcpy(to + k * f.element_size, f.element(k), f.element_size);
+    return out;
+}
+
+/// The field `<group>.<name>`, or AttributeError naming what the group has.
+py::object group_field(const FieldGroup& g, const std::string& name) {
+    const std::string full = g.prefix + "." + name;
+    if (g.prefix == "contacts") contacts(*g.world); // the normals up to date
+    std::string known;
+    for (const auto& f : state_fields(*g.world)) {
+        if (f.name == full) return field_array(f, g.model, g.views);
+        if (f.name.rfind(g.prefix + ".", 0) == 0) known += (known.empty() ? "" : ", ") + f.name.substr(g.prefix.size() + 1);
+    }
+    throw py::attribute_error("'" + g.prefix + "' has no field '" + name + "' (its fields: " + known + ")");
+}
+
+/// The names of the group's fields.
+std::vector<std::string> group_fields(const FieldGroup& g) {
+    std::vector<std::string> out;
+    for (const auto& f : state_fields(*g.world))
+        if (f.name.rfind(g.prefix + ".", 0) == 0) out.push_back(f.name.substr(g.prefix.size() + 1));
+    return out;
+}
+
+/// What every group class has: its fields as attributes, their names, dir().
+template <class Group>
+py::class_<Group> group_class(py::module_& mod, const char* name, const char* doc) {
+    py::class_<Group> cls(mod, name, doc);
+    cls.def("__getattr__", [](const Group& g, const std::string& field) { return group_field(g, field); })
+        .def("__dir__", [](py::object self) {
+            py::list names = py::module_::import("builtins").attr("object").attr("__dir__")(self);
+            for (const auto& f : group_fields(self.cast<const Group&>())) names.append(f);
+            return names;
+        })
+        .def_property_readonly("fields", [](const Group& g) { return group_fields(g); },
+                               "The names of the group's fields (Model.state_fields(): saved, hashed, … each)");
+    return cls;
+}
+
+template <class T>
+py::array_t<T> fresh(py::ssize_t count, py::ssize_t cols = 0) {
+    if (cols > 0) return py::array_t<T>({count, cols});
+    return py::array_t<T>(count);
 }
 
 /// A fresh array of one value per contact (or `cols` values: get fills a row).
 template <class T, class Get>
 py::array_t<T> per_contact(const ContactArrays& a, Get get, py::ssize_t cols = 0) {
-    const Solver& s = solver_of(a);
-    const auto& c = s.contacts();
+    const World& w = world_of(a);
+    const auto& c = contacts(w);
     auto out = fresh<T>(c.size(), cols);
     T* data = out.mutable_data();
-    for (int i = 0; i < c.size(); ++i) get(s, c, i, data + (cols > 0 ? cols * i : i));
+    for (int i = 0; i < c.size(); ++i) get(w, c, i, data + (cols > 0 ? cols * i : i));
     return out;
 }
 
-/// Every property of `arrays`, copied, as a dict (the solver outlives it not).
+/// Every property of `arrays`, copied, as a dict (the world outlives it not).
 py::dict copy_properties(py::object arrays, std::initializer_list<const char*> names) {
     py::dict d;
-    for (const char* n : names) d[n] = arrays.attr(n).attr("copy")();
+    for (const char* n : names) d[n] = py::array(arrays.attr(n)).attr("copy")();
     return d;
 }
 
@@ -132,40 +203,18 @@ py::dict frame_snapshot(const Solver& s, const StressStrainPoint& p, int realiza
     d["realization"] = realization, d["step"] = p.step, d["axial_strain"] = p.axial_strain;
     d["axial_stress"] = p.axial_stress, d["lateral_strain"] = p.lateral_strain;
     d["cracks_tensile"] = p.cracks_tensile, d["cracks_shear"] = p.cracks_shear;
+    World& w = const_cast<World&>(s.world()); // read only: the groups take a World*
     BlockArrays b;
-    b.solver = &s, b.model = py::none();
+    b.world = &w, b.model = py::none(), b.prefix = "blocks";
     d["blocks"] = copy_properties(py::cast(b), {"centroid", "velocity", "rotation", "area", "region", "removed",
                                                 "displacement", "stress"});
     ContactArrays c;
-    c.solver = &s, c.model = py::none();
+    c.world = &w, c.model = py::none(), c.prefix = "contacts";
     d["contacts"] = copy_properties(py::cast(c), {"normal_stress", "shear_stress", "normal_displacement",
                                                   "shear_displacement", "damage", "state", "bonded", "property",
                                                   "block_pair", "length", "normal", "position", "edge_parameter"});
-    d["property_names"] = s.property_names();
+    d["property_names"] = w.properties.names;
     return d;
-}
-
-/// A field of the solver's state list (core/state_fields.hpp) as a numpy copy:
-/// shape (count,) or (count, components); records as their bytes (uint8).
-py::array state_field_array(const StateField& f) {
-    auto dtype = [&]() -> py::dtype {
-        switch (f.type) {
-        case ScalarType::f64: return py::dtype::of<double>();
-        case ScalarType::f32: return py::dtype::of<float>();
-        case ScalarType::i32: return py::dtype::of<std::int32_t>();
-        case ScalarType::i64: return py::dtype::of<std::int64_t>();
-        case ScalarType::u32: return py::dtype::of<std::uint32_t>();
-        case ScalarType::u64: return py::dtype::of<std::uint64_t>();
-        case ScalarType::u8:
-        case ScalarType::record: break;
-        }
-        return py::dtype::of<std::uint8_t>();
-    }();
-    std::vector<py::ssize_t> shape{py::ssize_t(f.size())};
-    if (f.components > 1) shape.push_back(f.components);
-    py::array out(dtype, shape);
-    if (!f.bytes.empty()) std::memcpy(out.mutable_data(), f.bytes.data(), f.bytes.size());
-    return out;
 }
 
 const char* group_name(MemoryGroup g) {
@@ -210,48 +259,33 @@ PYBIND11_MODULE(_bbm, mod) {
         }
     });
 
-    py::class_<BlockArrays>(mod, "BlockArrays", "Per-block arrays (N = blocks, excavated ones included)")
-        .def_property_readonly("count", [](const BlockArrays& a) { return solver_of(a).blocks().count(); })
-        .def_property_readonly("centroid", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<double>(b.centroid.data(), b.count(), 2, sizeof(Vec2), a.model);
-        }, "N×2 current centroids, m (view)")
-        .def_property_readonly("velocity", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<double>(b.velocity.data(), b.count(), 2, sizeof(Vec2), a.model);
-        }, "N×2 velocities, m/s (quasi-static: m per step) (view)")
-        .def_property_readonly("rotation", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<double>(b.theta.data(), b.count(), 0, sizeof(double), a.model);
-        }, "N rotations, rad, counter-clockwise (view)")
-        .def_property_readonly("area", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<double>(b.area.data(), b.count(), 0, sizeof(double), a.model);
-        }, "N areas, m² (view)")
-        .def_property_readonly("region", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<int>(b.region.data(), b.count(), 0, sizeof(int), a.model);
-        }, "N region indices into Model.region_names (view)")
-        .def_property_readonly("removed", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<std::uint8_t>(b.removed.data(), b.count(), 0, 1, a.model).attr("astype")("bool");
-        }, "N flags: excavated")
+    group_class<FieldGroup>(mod, "FieldGroup",
+                            "A group of the state list (Model.group(prefix)): every field '<prefix>.*' of "
+                            "Model.state_fields() as an attribute, a fresh copy");
+    group_class<BlockArrays>(mod, "BlockArrays",
+                             "Per-block arrays (N = blocks, excavated ones included): every field 'blocks.*' of "
+                             "Model.state_fields() (centroid, velocity, theta, omega, mass, area, region, …) as a "
+                             "read-only numpy view, and what is computed from them")
+        .def_property_readonly("count", [](const BlockArrays& a) { return world_of(a).bodies.count(); })
+        .def_property_readonly("rotation", [](const BlockArrays& a) { return group_field(a, "theta"); },
+                               "N rotations, rad, counter-clockwise (the field theta; view)")
+        .def_property_readonly("removed", [](const BlockArrays& a) { return group_field(a, "removed").attr("astype")("bool"); },
+                               "N flags: excavated")
         .def_property_readonly("deformable", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            return view<std::uint8_t>(b.deformable.data(), b.count(), 0, 1, a.model).attr("astype")("bool");
+            return group_field(a, "deformable").attr("astype")("bool");
         }, "N flags: meshed into zones")
         .def_property_readonly("displacement", [](const BlockArrays& a) {
-            const auto& b = solver_of(a).blocks();
-            auto out = fresh<double>(b.count(), 2);
+            const World& w = world_of(a);
+            auto out = fresh<double>(w.bodies.count(), 2);
             auto o = out.mutable_unchecked<2>();
-            for (int i = 0; i < b.count(); ++i) {
-                const Vec2 d = b.centroid[i] - b.centroid0[i];
+            for (int i = 0; i < w.bodies.count(); ++i) {
+                const Vec2 d = w.bodies.state[i].centroid - w.blocks.centroid0[i];
                 o(i, 0) = d.x, o(i, 1) = d.y;
             }
             return out;
         }, "N×2 centroid displacements since the start, m (computed)")
         .def_property_readonly("stress", [](const BlockArrays& a) {
-            const auto s = solver_of(a).block_stresses();
+            const auto s = block_stresses(world_of(a));
             auto out = fresh<double>(py::ssize_t(s.size()), 3);
             auto o = out.mutable_unchecked<2>();
             for (std::size_t i = 0; i < s.size(); ++i)
@@ -259,125 +293,110 @@ PYBIND11_MODULE(_bbm, mod) {
             return out;
         }, "N×3 block-averaged stress sxx, syy, sxy, Pa, tension positive (SPEC §7; computed)");
 
-    py::class_<ContactArrays>(mod, "ContactArrays", "Per-contact arrays (M = contacts now; fresh copies)")
-        .def_property_readonly("count", [](const ContactArrays& a) { return solver_of(a).contacts().size(); })
+    using contact::Contacts;
+    group_class<ContactArrays>(mod, "ContactArrays",
+                               "Per-contact arrays (M = contacts now): every field 'contacts.*' of "
+                               "Model.state_fields() (vertex_block, length, property, normal, …) as a fresh copy "
+                               "(detection creates and removes contacts: their storage moves), and the joints' "
+                               "stresses and displacements from their histories")
+        .def_property_readonly("count", [](const ContactArrays& a) { return contacts(world_of(a)).size(); })
         .def_property_readonly("normal_stress", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].sn; });
+            return per_contact<double>(a, [](const World&, const Contacts& c, int i, double* o) { *o = c.history[i].sn; });
         }, "M normal stresses σn, Pa, compression positive")
         .def_property_readonly("shear_stress", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].tau; });
+            return per_contact<double>(a, [](const World&, const Contacts& c, int i, double* o) { *o = c.history[i].tau; });
         }, "M shear stresses τ, Pa")
         .def_property_readonly("damage", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].damage; });
+            return per_contact<double>(a, [](const World&, const Contacts& c, int i, double* o) { *o = c.history[i].damage; });
         }, "M damage D of SPEC §4, 0 intact to 1 broken")
         .def_property_readonly("state", [](const ContactArrays& a) {
-            return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { *o = int(contact::state_of(c.history[i])); /* as contacts.vtu */ });
+            return per_contact<std::int32_t>(a, [](const World&, const Contacts& c, int i, std::int32_t* o) {
+                *o = int(contact::state_of(c.history[i])); // as contacts.vtu
+            });
         }, "M states: 0 intact, 1 softening, 2 broken in tension, 3 broken in shear, 4 sliding")
         .def_property_readonly("bonded", [](const ContactArrays& a) {
-            return per_contact<bool>(a, [](const Solver&, const contact::Contacts& c, int i, bool* o) { *o = c.history[i].bonded; });
+            return per_contact<bool>(a, [](const World&, const Contacts& c, int i, bool* o) { *o = c.history[i].bonded; });
         }, "M flags: the bond holds")
         .def_property_readonly("block_pair", [](const ContactArrays& a) {
-            return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { o[0] = c.vertex_block[i], o[1] = c.edge_block[i]; }, 2);
+            return per_contact<std::int32_t>(a, [](const World&, const Contacts& c, int i, std::int32_t* o) {
+                o[0] = c.vertex_block[i], o[1] = c.edge_block[i];
+            }, 2);
         }, "M×2 blocks: the vertex's, the edge's")
-        .def_property_readonly("length", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.length[i]; });
-        }, "M joint lengths the contacts stand for, m")
-        .def_property_readonly("normal", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { o[0] = c.normal[i].x, o[1] = c.normal[i].y; }, 2);
-        }, "M×2 unit normals (out of the edge's block)")
         .def_property_readonly("position", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver& s, const contact::Contacts& c, int i, double* o) { const Vec2 x = s.blocks().vertex[c.vertex_id[i]];
-                o[0] = x.x, o[1] = x.y; }, 2);
+            return per_contact<double>(a, [](const World& w, const Contacts& c, int i, double* o) {
+                const Vec2 x = w.vertices.position[c.vertex_id[i]];
+                o[0] = x.x, o[1] = x.y;
+            }, 2);
         }, "M×2 contact points (the vertices), m")
         .def_property_readonly("normal_displacement", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].un; });
+            return per_contact<double>(a, [](const World&, const Contacts& c, int i, double* o) { *o = c.history[i].un; });
         }, "M normal displacements un since bonding, m, opening positive (overlap negative)")
         .def_property_readonly("shear_displacement", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.history[i].us; });
+            return per_contact<double>(a, [](const World&, const Contacts& c, int i, double* o) { *o = c.history[i].us; });
         }, "M shear displacements us, m")
         .def_property_readonly("fluid_pressure", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver&, const contact::Contacts& c, int i, double* o) { *o = c.wet() ? c.fluid_pressure[i] : 0.0; });
+            return per_contact<double>(a, [](const World&, const Contacts& c, int i, double* o) {
+                *o = c.wet() ? c.fluid_pressure[i] : 0.0;
+            });
         }, "M water pressures on the contacts, Pa ([flow]; 0 in a dry model): the law's normal_stress is the effective one")
         .def_property_readonly("aperture", [](const ContactArrays& a) {
-            const Solver& s = solver_of(a);
-            const auto values = s.flow() ? s.flow()->contact_apertures(s.contacts()) : std::vector<double>(s.contacts().size(), 0.0);
+            const World& w = world_of(a);
+            const auto values = w.flow ? contact_apertures(*w.flow, contacts(w)) : std::vector<double>(w.contacts.size(), 0.0);
             auto out = fresh<double>(py::ssize_t(values.size()), 0);
             std::copy(values.begin(), values.end(), out.mutable_data());
             return out;
         }, "M hydraulic apertures of the contacts' joints, m ([flow]; 0: none or sealed)")
-        .def_property_readonly("property", [](const ContactArrays& a) {
-            return per_contact<std::int32_t>(a, [](const Solver&, const contact::Contacts& c, int i, std::int32_t* o) { *o = c.property[i]; });
-        }, "M property sets (indices into Model.property_names; contacts formed in the run get solver.new_contact_property)")
         .def_property_readonly("edge_parameter", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const Solver& s, const contact::Contacts& c, int i, double* o) {
-                const auto& v = s.blocks().vertex;
+            return per_contact<double>(a, [](const World& w, const Contacts& c, int i, double* o) {
+                const auto& v = w.vertices.position;
                 const Vec2 p = v[c.edge_id[i]], e = v[c.edge_end[i]] - p;
                 *o = dot(v[c.vertex_id[i]] - p, e) / dot(e, e);
             });
         }, "M positions of the vertex along its edge, 0 to 1 (outside: a vertex past the edge's end, on the rounded corner)");
 
-    py::class_<ZoneArrays>(mod, "ZoneArrays", "Per-zone arrays of deformable blocks (K = constant-strain triangles)")
-        .def_property_readonly("count", [](const ZoneArrays& a) { return solver_of(a).zones().size(); })
-        .def_property_readonly("nodes", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a).zones();
-            return view<int>(z.node.data(), z.size(), 3, sizeof(std::array<int, 3>), a.model);
-        }, "K×3 node indices, counter-clockwise (view)")
-        .def_property_readonly("stress", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a).zones();
-            return view<double>(z.stress.data(), z.size(), 3, sizeof(std::array<double, 3>), a.model);
-        }, "K×3 stress sxx, syy, sxy, Pa, tension positive (view)")
-        .def_property_readonly("strain", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a).zones();
-            return view<double>(z.strain.data(), z.size(), 3, sizeof(std::array<double, 3>), a.model);
-        }, "K×3 strain exx, eyy, exy (tensor shear) (view)")
-        .def_property_readonly("block", [](const ZoneArrays& a) {
-            const auto& z = solver_of(a).zones();
-            return view<int>(z.block.data(), z.size(), 0, sizeof(int), a.model);
-        }, "K owning blocks (view)")
+    group_class<ZoneArrays>(mod, "ZoneArrays",
+                            "Per-zone arrays of deformable blocks (K = constant-strain triangles): every field "
+                            "'zones.*' of Model.state_fields() (node, stress, strain, block, …) as a read-only numpy "
+                            "view, and what is computed from them")
+        .def_property_readonly("count", [](const ZoneArrays& a) { return world_of(a).zones.size(); })
+        .def_property_readonly("nodes", [](const ZoneArrays& a) { return group_field(a, "node"); },
+                               "K×3 node indices, counter-clockwise (the field node; view)")
         .def_property_readonly("region", [](const ZoneArrays& a) {
-            const auto& s = solver_of(a);
-            const auto& z = s.zones();
-            auto out = fresh<std::int32_t>(z.size());
+            const World& w = world_of(a);
+            auto out = fresh<std::int32_t>(w.zones.size());
             auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < z.size(); ++i) o(i) = s.blocks().region[z.block[i]];
+            for (int i = 0; i < w.zones.size(); ++i) o(i) = w.blocks.region[w.zones.block[i]];
             return out;
         }, "K region indices (computed)")
         .def_property_readonly("centroid", [](const ZoneArrays& a) {
-            const auto& s = solver_of(a);
-            const auto& z = s.zones();
+            const World& w = world_of(a);
+            const auto& z = w.zones;
+            const auto& p = w.nodes.position;
             auto out = fresh<double>(z.size(), 2);
             auto o = out.mutable_unchecked<2>();
             for (int i = 0; i < z.size(); ++i) {
-                const auto& p = s.nodes().position;
                 const Vec2 c = (p[z.node[i][0]] + p[z.node[i][1]] + p[z.node[i][2]]) / 3.0;
                 o(i, 0) = c.x, o(i, 1) = c.y;
             }
             return out;
         }, "K×2 current centroids, m (computed)")
         .def_property_readonly("area", [](const ZoneArrays& a) {
-            const auto& s = solver_of(a);
-            const auto& z = s.zones();
+            const World& w = world_of(a);
+            const auto& z = w.zones;
+            const auto& p = w.nodes.position;
             auto out = fresh<double>(z.size());
             auto o = out.mutable_unchecked<1>();
-            for (int i = 0; i < z.size(); ++i) {
-                const auto& p = s.nodes().position;
+            for (int i = 0; i < z.size(); ++i)
                 o(i) = 0.5 * cross(p[z.node[i][1]] - p[z.node[i][0]], p[z.node[i][2]] - p[z.node[i][0]]);
-            }
             return out;
         }, "K current areas, m² (computed)");
 
-    py::class_<NodeArrays>(mod, "NodeArrays", "Per-node arrays of deformable blocks")
-        .def_property_readonly("count", [](const NodeArrays& a) { return solver_of(a).nodes().count(); })
-        .def_property_readonly("position", [](const NodeArrays& a) {
-            const auto& n = solver_of(a).nodes();
-            return view<double>(n.position.data(), n.count(), 2, sizeof(Vec2), a.model);
-        }, "n×2 positions, m (view)")
-        .def_property_readonly("velocity", [](const NodeArrays& a) {
-            const auto& n = solver_of(a).nodes();
-            return view<double>(n.velocity.data(), n.count(), 2, sizeof(Vec2), a.model);
-        }, "n×2 velocities (view)")
+    group_class<NodeArrays>(mod, "NodeArrays",
+                            "Per-node arrays of deformable blocks: every field 'nodes.*' of Model.state_fields() "
+                            "(position, velocity, mass, …) as a read-only numpy view")
+        .def_property_readonly("count", [](const NodeArrays& a) { return world_of(a).nodes.count(); })
         .def_property_readonly("displacement", [](const NodeArrays& a) {
-            const auto& n = solver_of(a).nodes();
+            const auto& n = world_of(a).nodes;
             auto out = fresh<double>(n.count(), 2);
             auto o = out.mutable_unchecked<2>();
             for (int i = 0; i < n.count(); ++i) {
@@ -387,85 +406,59 @@ PYBIND11_MODULE(_bbm, mod) {
             return out;
         }, "n×2 displacements since the start, m (computed)");
 
-    py::class_<BoltArrays>(mod, "BoltArrays",
-                           "Installed bolts (core/bolts.hpp): n nodes, s segments (segment i joins nodes "
-                           "segment_node[i] and segment_node[i] + 1). Forces per bolt (times the out-of-plane spacing).")
-        .def_property_readonly("node_count", [](const BoltArrays& a) { return solver_of(a).bolts().node_count(); })
-        .def_property_readonly("segment_count", [](const BoltArrays& a) { return solver_of(a).bolts().segment_count(); })
-        .def_property_readonly("position", [](const BoltArrays& a) {
-            const auto& b = solver_of(a).bolts();
-            return view<double>(b.position.data(), b.node_count(), 2, sizeof(Vec2), a.model);
-        }, "n×2 node positions, m (view)")
-        .def_property_readonly("segment_node", [](const BoltArrays& a) {
-            const auto& b = solver_of(a).bolts();
-            auto out = fresh<int>(b.segment_count());
-            std::copy(b.segment_node.begin(), b.segment_node.end(), out.mutable_data());
+    group_class<SupportArrays>(mod, "SupportArrays",
+                               "One registered support type (Model.bolts, Model.liners, Model.dowels, …; the "
+                               "registry of core/supports/registry.hpp): every field '<type>.*' of "
+                               "Model.state_fields() (position, axial, thrust, …, per metre of model) as a fresh "
+                               "copy, its drawn arrays per element and node (per bolt, as VTK has them) and its "
+                               "sets' figures (as summary.json has them)")
+        .def_property_readonly("count", [](const SupportArrays& a) {
+            py::object position = group_field(a, "position");
+            return py::len(position);
+        }, "Its installed nodes")
+        .def_property_readonly("lines", [](const SupportArrays& a) {
+            py::dict d;
+            for (const auto& [type, lines] : support_lines(world_of(a))) {
+                if (type != a.prefix) continue;
+                for (const auto* arrays : {&lines.cell_data, &lines.point_data})
+                    for (const auto& array : *arrays) {
+                        auto out = fresh<double>(py::ssize_t(array.values.size()));
+                        std::copy(array.values.begin(), array.values.end(), out.mutable_data());
+                        d[py::str(array.name)] = out;
+                    }
+                auto cells = fresh<std::int32_t>(py::ssize_t(lines.cells.size()), 2);
+                for (std::size_t k = 0; k < lines.cells.size(); ++k)
+                    cells.mutable_data()[2 * k] = lines.cells[k][0], cells.mutable_data()[2 * k + 1] = lines.cells[k][1];
+                d["cells"] = cells;
+                for (const auto& [name, values] : lines.names) d[py::str(name)] = values;
+            }
+            return d;
+        }, "Its arrays as VTK has them (<type>.pvd): per element and per node, per bolt (times the out-of-plane "
+           "spacing) where the type reports so; 'cells' the element's two nodes; empty before an install")
+        .def_property_readonly("summary", [](const SupportArrays& a) {
+            py::list out;
+            for (const auto& [type, sets] : support_summaries(world_of(a))) {
+                if (type != a.prefix) continue;
+                for (const auto& set : sets) {
+                    py::dict d;
+                    d["name"] = set.name;
+                    for (const auto& f : set.figures) d[py::str(f.key)] = f.count ? py::object(py::int_(long(f.value))) : py::object(py::float_(f.value));
+                    out.append(d);
+                }
+            }
             return out;
-        }, "s first nodes of the segments")
-        .def_property_readonly("axial_force", [](const BoltArrays& a) {
-            const auto& b = solver_of(a).bolts();
-            auto out = fresh<double>(b.segment_count());
-            for (int i = 0; i < b.segment_count(); ++i)
-                out.mutable_data()[i] = b.axial[i] * b.sets[b.node_set[b.segment_node[i]]].spacing;
-            return out;
-        }, "s axial forces, N per bolt, tension positive")
-        .def_property_readonly("state", [](const BoltArrays& a) {
-            const auto& b = solver_of(a).bolts();
-            auto out = fresh<int>(b.segment_count());
-            std::copy(b.state.begin(), b.state.end(), out.mutable_data());
-            return out;
-        }, "s segment states: 0 elastic, 1 yielded, 2 broken")
-        .def_property_readonly("bond", [](const BoltArrays& a) {
-            const auto& b = solver_of(a).bolts();
-            auto out = fresh<double>(b.node_count());
-            for (int i = 0; i < b.node_count(); ++i) out.mutable_data()[i] = b.bond[i] * b.sets[b.node_set[i]].spacing;
-            return out;
-        }, "n grout forces along the bolt, N per m of bolt, per bolt")
-        .def_property_readonly("set", [](const BoltArrays& a) {
-            const auto& b = solver_of(a).bolts();
-            auto out = fresh<int>(b.node_count());
-            std::copy(b.node_set.begin(), b.node_set.end(), out.mutable_data());
-            return out;
-        }, "n set index of each node (set_names)")
-        .def_property_readonly("set_names", [](const BoltArrays& a) { return solver_of(a).support<BoltSupport>().set_names(); });
+        }, "Per installed set, its figures (summary.json's entry of the type)")
+        .def_property_readonly("set_names", [](const SupportArrays& a) {
+            std::vector<std::string> names;
+            for_each_support(world_of(a).supports, [&](auto type, const auto& state) {
+                using T = typename decltype(type)::type;
+                if (T::name == a.prefix) names = T::set_names(state);
+            });
+            return names;
+        }, "Its sets (model-file tables) by name, in file order");
 
-    py::class_<LinerArrays>(mod, "LinerArrays",
-                            "Installed liners (core/liners.hpp): n nodes, e beam elements (element i joins nodes "
-                            "element_node[i] and the next node of its liner). Per metre of tunnel.")
-        .def_property_readonly("node_count", [](const LinerArrays& a) { return solver_of(a).liners().node_count(); })
-        .def_property_readonly("element_count", [](const LinerArrays& a) { return solver_of(a).liners().element_count(); })
-        .def_property_readonly("position", [](const LinerArrays& a) {
-            const auto& l = solver_of(a).liners();
-            return view<double>(l.position.data(), l.node_count(), 2, sizeof(Vec2), a.model);
-        }, "n×2 node positions, m (view)")
-        .def_property_readonly("element_node", [](const LinerArrays& a) {
-            const auto& l = solver_of(a).liners();
-            auto out = fresh<int>(l.element_count());
-            std::copy(l.element_node.begin(), l.element_node.end(), out.mutable_data());
-            return out;
-        }, "e first nodes of the elements")
-        .def_property_readonly("thrust", [](const LinerArrays& a) {
-            const auto& l = solver_of(a).liners();
-            auto out = fresh<double>(l.element_count());
-            std::copy(l.thrust.begin(), l.thrust.end(), out.mutable_data());
-            return out;
-        }, "e thrusts, N/m, compression positive")
-        .def_property_readonly("moment", [](const LinerArrays& a) {
-            const auto& l = solver_of(a).liners();
-            auto out = fresh<double>(l.element_count(), 2);
-            for (int e = 0; e < l.element_count(); ++e)
-                out.mutable_data()[2 * e] = l.moment_a[e], out.mutable_data()[2 * e + 1] = l.moment_b[e];
-            return out;
-        }, "e×2 end moments, N·m/m")
-        .def_property_readonly("interface_normal_stress", [](const LinerArrays& a) {
-            const auto& l = solver_of(a).liners();
-            auto out = fresh<double>(l.node_count());
-            std::copy(l.normal_stress.begin(), l.normal_stress.end(), out.mutable_data());
-            return out;
-        }, "n normal stresses on the wall, Pa, tension positive")
-        .def_property_readonly("names", [](const LinerArrays& a) { return solver_of(a).support<LinerSupport>().set_names(); });
-
-    py::class_<Model>(mod, "Model")
+    py::class_<Model> model(mod, "Model");
+    model
         .def(py::init([](const std::string& path, int threads, double max_elements) {
                  py::gil_scoped_release release;
                  return Model::from_file(path, threads, max_elements);
@@ -500,45 +493,46 @@ PYBIND11_MODULE(_bbm, mod) {
              "The dict of summary.json (as `bbm run` writes it) for the state now.")
         .def("write_vtk", [](const Model& m, const std::filesystem::path& dir) { m.write_vtk(dir); }, py::arg("dir"),
              "Writes DIR/blocks.vtu, contacts.vtu and result.pvd of the state now, for ParaView.")
-        .def_property_readonly("blocks", [](py::object self) { return arrays_of<BlockArrays>(self); })
-        .def_property_readonly("contacts", [](py::object self) { return arrays_of<ContactArrays>(self); })
-        .def_property_readonly("zones", [](py::object self) { return arrays_of<ZoneArrays>(self); })
-        .def_property_readonly("nodes", [](py::object self) { return arrays_of<NodeArrays>(self); })
-        .def_property_readonly("bolts", [](py::object self) { return arrays_of<BoltArrays>(self); },
-                               "Installed bolts: positions, axial forces, grout forces, states")
-        .def_property_readonly("liners", [](py::object self) { return arrays_of<LinerArrays>(self); },
-                               "Installed liners: positions, thrusts, moments, interface stresses")
+        .def_property_readonly("blocks", [](py::object self) { return group_of<BlockArrays>(self, "blocks", true); })
+        .def_property_readonly("contacts", [](py::object self) { return group_of<ContactArrays>(self, "contacts", false); })
+        .def_property_readonly("zones", [](py::object self) { return group_of<ZoneArrays>(self, "zones", true); })
+        .def_property_readonly("nodes", [](py::object self) { return group_of<NodeArrays>(self, "nodes", true); })
+        .def("group", [](py::object self, const std::string& prefix) {
+            return group_of<FieldGroup>(self, prefix, false);
+        }, py::arg("prefix"), "Any group of the state list (Model.state_fields(): 'relax', 'detection', 'flow', "
+                              "…) with its fields as attributes (fresh copies)")
         .def_property_readonly("flow", [](const Model& m) -> py::object {
-            const JointFlow* f = m.solver().flow();
-            if (!f) return py::none();
-            const auto& net = f->network();
-            const auto& st = f->state();
+            const auto& flow = m.solver().world().flow;
+            if (!flow) return py::none();
+            const JointFlow* f = &*flow;
+            const auto& net = f->net;
+            const auto& st = f->state;
             auto domains = fresh<double>(net.domains(), 2), pressure = fresh<double>(net.domains(), 0);
             auto aperture = fresh<double>(net.pipes(), 0), rate = fresh<double>(net.pipes(), 0);
             auto pipes = fresh<std::int32_t>(net.pipes(), 2);
-            const auto q = flow::pipe_flows(net, f->fluid(), st);
+            const auto q = flow::pipe_flows(net, f->fluid, st);
             for (int d = 0; d < net.domains(); ++d) {
                 domains.mutable_data()[2 * d] = net.domain_position[d].x, domains.mutable_data()[2 * d + 1] = net.domain_position[d].y;
                 pressure.mutable_data()[d] = st.pressure[d];
             }
             for (int k = 0; k < net.pipes(); ++k) {
-                aperture.mutable_data()[k] = flow::hydraulic_aperture(f->fluid(), st.aperture[k]);
+                aperture.mutable_data()[k] = flow::hydraulic_aperture(f->fluid, st.aperture[k]);
                 rate.mutable_data()[k] = q[k];
                 pipes.mutable_data()[2 * k] = net.pipe_from[k], pipes.mutable_data()[2 * k + 1] = net.pipe_to[k];
             }
             py::dict d;
             d["domain_position"] = domains, d["pressure"] = pressure, d["pipes"] = pipes, d["aperture"] = aperture;
-            d["flow_rate"] = rate, d["inflow"] = f->inflow();
+            d["flow_rate"] = rate, d["inflow"] = inflow(*f);
             return d;
         }, "Water in the joints ([flow]; None when dry), copied: domain_position (D×2, m), pressure (D, Pa), pipes "
            "(P×2 domains), aperture (P, m), flow_rate (P, m²/s per m, from the first domain to the second), inflow "
            "(into the drained openings, m²/s per m)")
-        .def_property_readonly("steps", [](const Model& m) { return m.solver().steps(); })
-        .def_property_readonly("time", [](const Model& m) { return m.solver().time(); })
-        .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().unbalanced_ratio(); })
+        .def_property_readonly("steps", [](const Model& m) { return m.solver().world().clock.steps; })
+        .def_property_readonly("time", [](const Model& m) { return m.solver().world().clock.time; })
+        .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().world().clock.ratio; })
         .def("state_fields", [](Model& m) {
                  py::list out;
-                 for (const auto& f : m.solver().state_fields()) {
+                 for (const auto& f : state_fields(m.solver().world())) {
                      py::dict d;
                      d["name"] = f.name, d["indexed_by"] = group_name(f.group), d["count"] = f.size();
                      d["saved"] = bool(f.uses & field_use::saved), d["hashed"] = bool(f.uses & field_use::hashed);
@@ -547,18 +541,20 @@ PYBIND11_MODULE(_bbm, mod) {
                  }
                  return out;
              },
-             "Every field of the solver's state list, as the checkpoint, state hash and memory report see it: "
+             "Every field of the world's state list, as the checkpoint, state hash and memory report see it: "
              "name, what it is indexed by, count, whether saved / hashed / fixed by the model file, bytes held.")
         .def("state", [](Model& m, const std::string& name) {
-                 for (const auto& f : m.solver().state_fields())
-                     if (f.name == name) return state_field_array(f);
+                 contacts(m.solver().world()); // the normals up to date
+                 for (const auto& f : state_fields(m.solver().world()))
+                     if (f.name == name) return field_array(f, py::none(), false);
                  throw py::key_error("no state field '" + name + "' (Model.state_fields() lists them)");
              }, py::arg("name"), "A copy of one field of the state list (Model.state_fields()) as a numpy array.")
-        .def_property_readonly("state_hash", [](const Model& m) { return std::to_string(m.solver().state_hash()); },
+        .def_property_readonly("state_hash", [](const Model& m) { return std::to_string(state_hash(m.solver().world())); },
                                "The hash summary.json reports: equal hashes, equal states")
         .def_property_readonly("cracks", [](const Model& m) {
-            return py::dict(py::arg("tensile") = m.solver().cracks(contact::JointState::broken_tension),
-                            py::arg("shear") = m.solver().cracks(contact::JointState::broken_shear));
+            const World& w = m.solver().world();
+            return py::dict(py::arg("tensile") = cracks(w, contact::JointState::broken_tension),
+                            py::arg("shear") = cracks(w, contact::JointState::broken_shear));
         })
         .def_property_readonly("stage_names", &Model::stage_names)
         .def_property_readonly("stages_done", [](const Model& m) {
@@ -567,9 +563,19 @@ PYBIND11_MODULE(_bbm, mod) {
             for (int k = 0; k < m.cursor().stage && k < int(all.size()); ++k) names.push_back(all[k]);
             return names;
         })
-        .def_property_readonly("region_names", [](const Model& m) { return m.solver().region_names(); })
-        .def_property_readonly("property_names", [](const Model& m) { return m.solver().property_names(); })
+        .def_property_readonly("region_names", [](const Model& m) { return m.solver().world().region_names; })
+        .def_property_readonly("property_names", [](const Model& m) { return m.solver().world().properties.names; })
         .def_property_readonly("name", &Model::name);
+    // One property per registered support type (core/supports/registry.hpp).
+    static std::deque<std::string> words; // its name and doc, alive with the module
+    for_each_support_type([&](auto type) {
+        using T = typename decltype(type)::type;
+        const std::string& name = words.emplace_back(T::name);
+        const std::string& doc = words.emplace_back("Installed " + name + " (SupportArrays): their fields, drawn arrays and figures");
+        model.def_property_readonly(
+            name.c_str(), [](py::object self) { return group_of<SupportArrays>(self, std::string(T::name), false); },
+            doc.c_str());
+    });
 
     mod.def("_labtest", [](const std::string& command, const std::vector<std::string>& args, bool quiet,
                            std::optional<py::function> callback) {

@@ -47,7 +47,7 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
     top.stress.syy = -1e6;
     an.boundaries.push_back(top);
     Solver s(blocks, an);
-    s.solve_elastic();
+    solve_elastic(s.world());
     double y_lo = 0, y_hi = 0, x_left = 0, x_right = 0;
     int n_lo = 0, n_hi = 0, n_left = 0, n_right = 0;
     const double h = o.height, w = o.width, d = o.size;
@@ -59,10 +59,10 @@ ElasticMeasure elastic_measure(const JointPropertySpec& joint, const LabTestOpti
         if (c.y > 0.3 * h && c.y < 0.7 * h && c.x < d) x_left += u.x, ++n_left;
         if (c.y > 0.3 * h && c.y < 0.7 * h && c.x > w - d) x_right += u.x, ++n_right;
     };
-    const auto& b = s.blocks();
+    const auto& b = s.world().blocks;
     for (int i = 0; i < b.count(); ++i)
-        if (!b.deformable[i]) sample(b.centroid0[i], b.centroid[i] - b.centroid0[i]);
-    const auto& nodes = s.nodes();
+        if (!b.deformable[i]) sample(b.centroid0[i], s.world().bodies.state[i].centroid - b.centroid0[i]);
+    const auto& nodes = s.world().nodes;
     for (int i = 0; i < nodes.count(); ++i) sample(nodes.position0[i], nodes.position[i] - nodes.position0[i]);
     const double axial = (y_hi / n_hi - y_lo / n_lo) / (0.4 * h);
     const double lateral = (x_right / n_right - x_left / n_left) / w;

@@ -532,12 +532,12 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
 void write_labtest_frame(const Solver& s, const fs::path& dir, std::vector<std::pair<double, std::string>>& frames) {
     fs::create_directories(dir / "vtk");
     char name[64];
-    std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
-    io::write_state_blocks_vtu(s, dir / name);
-    frames.push_back({double(s.steps()), name});
-    std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
-    io::write_state_contacts_vtu(s, dir / name);
-    frames.push_back({double(s.steps()), name});
+    std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.world().clock.steps);
+    io::write_state_blocks_vtu(s.world(), dir / name);
+    frames.push_back({double(s.world().clock.steps), name});
+    std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.world().clock.steps);
+    io::write_state_contacts_vtu(s.world(), dir / name);
+    frames.push_back({double(s.world().clock.steps), name});
 }
 
 void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path& dir, const std::string& title,
@@ -575,10 +575,10 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
                     label);
     io::FailurePlotOptions fo;
     fo.title = title;
-    io::draw_failure(s, dir / "failure.png", fo);
-    io::draw_failure(s, dir / "failure.svg", fo);
-    io::write_state_blocks_vtu(s, dir / "vtk/blocks_final.vtu");
-    io::write_state_contacts_vtu(s, dir / "vtk/contacts_final.vtu");
+    io::draw_failure(s.world(), dir / "failure.png", fo);
+    io::draw_failure(s.world(), dir / "failure.svg", fo);
+    io::write_state_blocks_vtu(s.world(), dir / "vtk/blocks_final.vtu");
+    io::write_state_contacts_vtu(s.world(), dir / "vtk/contacts_final.vtu");
     if (!frames.empty() && frames.back().first == double(r.steps)) frames.resize(frames.size() - 2);
     frames.push_back({double(r.steps), "vtk/blocks_final.vtu"});
     frames.push_back({double(r.steps), "vtk/contacts_final.vtu"});

@@ -22,17 +22,19 @@ namespace {
 class MovingPlaten {
 public:
     explicit MovingPlaten(Solver& s) : s_(s) {
-        auto& b = s.blocks();
-        auto& n = s.nodes();
-        for (int i = 0; i < b.count(); ++i)
-            if ((b.fixed[i] & 2) && b.fixed_velocity[i].y != 0.0) blocks_.push_back(i), sign_ = b.fixed_velocity[i].y > 0 ? 1 : -1;
-        for (int k = 0; k < n.count(); ++k)
-            if ((n.fixed[k] & 2) && n.fixed_velocity[k].y != 0.0) nodes_.push_back(k), sign_ = n.fixed_velocity[k].y > 0 ? 1 : -1;
+        const Loads& l = s.world().loads;
+        for (int i = 0; i < s.world().bodies.count(); ++i)
+            if ((l.block_fixed[i] & 2) && l.block_velocity[i].y != 0.0)
+                blocks_.push_back(i), sign_ = l.block_velocity[i].y > 0 ? 1 : -1;
+        for (int k = 0; k < s.world().nodes.count(); ++k)
+            if ((l.node_fixed[k] & 2) && l.node_velocity[k].y != 0.0)
+                nodes_.push_back(k), sign_ = l.node_velocity[k].y > 0 ? 1 : -1;
     }
     /// Vertical speed (m per step), in the loading direction.
     void set_speed(double v) {
-        for (int i : blocks_) s_.blocks().fixed_velocity[i].y = sign_ * v;
-        for (int k : nodes_) s_.nodes().fixed_velocity[k].y = sign_ * v;
+        Loads& l = s_.world().loads;
+        for (int i : blocks_) l.block_velocity[i].y = sign_ * v;
+        for (int k : nodes_) l.node_velocity[k].y = sign_ * v;
     }
 
 private:
@@ -44,23 +46,23 @@ private:
 /// Applies the biaxial confinement gradually with the platens held still, then lets
 /// the specimen settle; returns the step at which axial loading starts.
 long confine(Solver& s, MovingPlaten& platen) {
-    auto& b = s.blocks();
-    auto& n = s.nodes();
-    const auto block_load = b.applied;
-    const auto block_moment = b.applied_moment;
-    const auto node_load = n.applied;
+    Loads& l = s.world().loads;
+    const auto block_load = l.block_force;
+    const auto block_moment = l.block_moment;
+    const auto node_load = l.node_force;
     platen.set_speed(0.0);
     auto scale = [&](double f) {
-        for (int i = 0; i < b.count(); ++i) b.applied[i] = f * block_load[i], b.applied_moment[i] = f * block_moment[i];
-        for (int k = 0; k < n.count(); ++k) n.applied[k] = f * node_load[k];
+        for (std::size_t i = 0; i < block_load.size(); ++i)
+            l.block_force[i] = f * block_load[i], l.block_moment[i] = f * block_moment[i];
+        for (std::size_t k = 0; k < node_load.size(); ++k) l.node_force[k] = f * node_load[k];
     };
     constexpr long ramp = 3000, settle_max = 20000;
     for (long k = 1; k <= ramp; ++k) {
         scale(double(k) / double(ramp));
         s.step();
     }
-    for (long k = 0; k < settle_max && !(k > 200 && s.unbalanced_ratio() < 1e-5); ++k) s.step();
-    return s.steps();
+    for (long k = 0; k < settle_max && !(k > 200 && s.world().clock.ratio < 1e-5); ++k) s.step();
+    return s.world().clock.steps;
 }
 
 
@@ -68,7 +70,7 @@ long confine(Solver& s, MovingPlaten& platen) {
 /// compression) that unbonded contacts carry: broken joints and contacts formed
 /// during the run.
 double unbonded_compression_share(const Solver& s) {
-    const auto& c = s.contacts();
+    const auto& c = contacts(s.world());
     double all = 0.0, unbonded = 0.0;
     for (int i = 0; i < c.size(); ++i) {
         const double f = std::max(0.0, c.history[i].sn) * c.length[i];
@@ -89,7 +91,7 @@ public:
     Gauges(const Solver& s, const LabTestOptions& o)
         : s_(s), o_(o), brazilian_(o.kind == LabTestOptions::Kind::brazilian),
           sign_(o.kind == LabTestOptions::Kind::tension ? -1.0 : 1.0) {
-        const auto& b = s.blocks();
+        const auto& b = s.world().blocks;
         const double h = specimen_height(o), band = 0.5 * o.size;
         for (int i = 0; i < b.count(); ++i) {
             const Vec2 c = b.centroid0[i];
@@ -99,15 +101,15 @@ public:
         }
     }
     StressStrainPoint measure(double at_strain, double at_rate) const {
-        const double force = sign_ * s_.boundary_force("top").y;
+        const double force = sign_ * boundary_force(s_.world(), "top").y;
         StressStrainPoint p;
-        p.step = s_.steps();
+        p.step = s_.world().clock.steps;
         p.axial_strain = at_strain;
         p.axial_stress = brazilian_ ? 2.0 * force / (std::numbers::pi * o_.width) : force / o_.width;
         p.lateral_strain = (mean_ux(right_) - mean_ux(left_)) / o_.width;
-        p.cracks_tensile = s_.cracks(contact::JointState::broken_tension);
-        p.cracks_shear = s_.cracks(contact::JointState::broken_shear);
-        p.unbalanced_ratio = s_.unbalanced_ratio();
+        p.cracks_tensile = cracks(s_.world(), contact::JointState::broken_tension);
+        p.cracks_shear = cracks(s_.world(), contact::JointState::broken_shear);
+        p.unbalanced_ratio = s_.world().clock.ratio;
         p.strain_per_step = at_rate;
         return p;
     }
@@ -115,12 +117,13 @@ public:
 private:
     /// A deformable block moves with its nodes: the mean of its boundary nodes.
     double ux_of(int i) const {
-        const auto& b = s_.blocks();
-        if (!b.deformable[i]) return b.centroid[i].x - b.centroid0[i].x;
-        const auto& nodes = s_.nodes();
+        const World& w = s_.world();
+        const auto& b = w.blocks;
+        if (!b.deformable[i]) return w.bodies.state[i].centroid.x - b.centroid0[i].x;
+        const auto& nodes = w.nodes;
         double u = 0.0;
         for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
-            const int nd = b.vertex_node[v];
+            const int nd = w.vertices.node[v];
             u += nodes.position[nd].x - nodes.position0[nd].x;
         }
         return u / double(b.first[i + 1] - b.first[i]);
@@ -140,7 +143,7 @@ private:
 /// Crack orientation when each crack forms (later the fragments rotate): the
 /// angle of its joint from horizontal, 0–180°.
 void record_new_cracks(Solver& s, LabTestResult& r) {
-    auto& c = s.contacts();
+    auto& c = contacts(s.world());
     for (int i = 0; i < c.size(); ++i) {
         auto& hist = c.history[i];
         if (hist.broken == contact::JointState::intact || hist.counted) continue;
@@ -160,8 +163,8 @@ void record_new_cracks(Solver& s, LabTestResult& r) {
 class JointSetGauge {
 public:
     JointSetGauge(const Solver& s, const LabTestOptions& o) {
-        for (std::size_t k = 0; k < s.property_names().size(); ++k)
-            if (o.joint_set.on && s.property_names()[k] == "joint_set") property_ = int(k);
+        for (std::size_t k = 0; k < s.world().properties.names.size(); ++k)
+            if (o.joint_set.on && s.world().properties.names[k] == "joint_set") property_ = int(k);
     }
     void record(const Solver& s, const StressStrainPoint& p, LabTestResult& r) const {
         if (property_ < 0 || r.joint_slip_stress > 0.0) return;
@@ -172,7 +175,7 @@ public:
 
 private:
     double sliding(const Solver& s) const {
-        const auto& c = s.contacts();
+        const auto& c = contacts(s.world());
         double all = 0.0, slides = 0.0;
         for (int i = 0; i < c.size(); ++i) {
             if (c.property[i] != property_) continue;
@@ -194,16 +197,15 @@ private:
 std::size_t elastic_preload(Solver& s, MovingPlaten& platen, const LabTestOptions& o, const Gauges& gauges,
                             LabTestResult& r, double& strain,
                             const std::function<void(const StressStrainPoint&)>& progress) {
-    const auto& b = s.blocks();
-    const auto& c = s.contacts();
-    const auto& nd = s.nodes();
+    const auto& c = contacts(s.world());
+    const auto& nd = s.world().nodes;
     const std::vector<contact::JointHistory> before = c.history;
-    const auto centroid0 = b.centroid, position0 = nd.position;
-    const auto theta0 = b.theta;
+    const std::vector<contact::BodyState> bodies0 = s.world().bodies.state;
+    const auto position0 = nd.position;
     const StressStrainPoint origin = gauges.measure(0.0, 0.0);
     const double trial = 1e-6;
     platen.set_speed(trial * specimen_height(o));
-    s.move_supports(s.timestep());
+    move_supports(s.world(), s.world().clock.dt);
     strain = trial;
     // A specimen the confinement cracked can hold a block by one point or a
     // loose group (a trigon triangle at 71 MPa on Lac du Bonnet's bonds): the
@@ -211,29 +213,31 @@ std::size_t elastic_preload(Solver& s, MovingPlaten& platen, const LabTestOption
     // test: the explicit loading then starts from the trial displacement.
     bool solvable = true;
     try {
-        s.solve_elastic();
+        solve_elastic(s.world());
     } catch (const SingularSystemError&) {
         solvable = false;
         r.preload_skipped = true;
     }
     double lambda = solvable ? 1e6 : 0.0;
     for (int i = 0; i < c.size(); ++i)
-        lambda = std::min(lambda, contact::elastic_limit(s.laws()[c.property[i]], before[i], c.history[i], 1e6));
+        lambda = std::min(lambda, contact::elastic_limit(s.world().properties.laws[c.property[i]], before[i], c.history[i], 1e6));
     const double reach = o.preload_fraction * lambda;
     if (solvable && reach > 1.0 && lambda < 1e6) {
         // Every body on by (reach − 1) times its trial displacement: each joint
         // takes the same multiple of its trial increment (no row of joints next
         // to the platen takes the whole of it), then one more solve for the
         // geometric nonlinearity.
-        std::vector<Vec2> du(b.count()), dn(nd.count());
-        std::vector<double> dtheta(b.count());
-        for (int i = 0; i < b.count(); ++i)
-            du[i] = (reach - 1.0) * (b.centroid[i] - centroid0[i]), dtheta[i] = (reach - 1.0) * (b.theta[i] - theta0[i]);
+        const auto& bodies = s.world().bodies.state;
+        std::vector<Vec2> du(bodies.size()), dn(nd.count());
+        std::vector<double> dtheta(bodies.size());
+        for (std::size_t i = 0; i < bodies.size(); ++i)
+            du[i] = (reach - 1.0) * (bodies[i].centroid - bodies0[i].centroid),
+            dtheta[i] = (reach - 1.0) * (bodies[i].theta - bodies0[i].theta);
         for (int k = 0; k < nd.count(); ++k) dn[k] = (reach - 1.0) * (nd.position[k] - position0[k]);
-        s.move_bodies(du, dtheta, dn);
+        move_bodies(s.world(), du, dtheta, dn);
         strain = reach * trial;
         try {
-            s.solve_elastic(); // the geometric correction: without it the linear state stands
+            solve_elastic(s.world()); // the geometric correction: without it the linear state stands
         } catch (const SingularSystemError&) {
         }
     }
@@ -276,7 +280,7 @@ public:
         }
         double f = made <= 0 ? 1.1 : std::clamp(target_ / made, 0.5, 1.1);
         if (o_.servo.balance > 0 && cracks_now > cracks_at_start_) {
-            const double top = s.boundary_force("top").y, bottom = s.boundary_force("bottom").y;
+            const double top = boundary_force(s.world(), "top").y, bottom = boundary_force(s.world(), "bottom").y;
             const double mismatch = std::abs(top + bottom) / std::max(std::abs(top), 1e-300);
             if (mismatch > 0) f = std::min(f, std::clamp(o_.servo.balance / mismatch, 0.5, 1.1));
         }
@@ -421,14 +425,14 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     const auto blocks = meshing::generate_blocks(labtest_geometry(o));
     Solver s(blocks, labtest_analysis(o));
     if (!o.rough_platens && !uses_platen_blocks(o)) {
-        const auto& fixed = s.blocks().fixed;
+        const auto& fixed = s.world().loads.block_fixed;
         if (std::none_of(fixed.begin(), fixed.end(), [](auto f) { return (f & 1) != 0; }))
             throw std::runtime_error("smooth platens: no block on the bottom face's middle to hold the specimen "
                                      "horizontally; use --platens rough or a larger specimen");
     }
     LabTestResult r;
     r.blocks = blocks.block_count();
-    r.contacts = s.contacts().size();
+    r.contacts = contacts(s.world()).size();
     const double h = specimen_height(o);
     const bool brazilian = o.kind == LabTestOptions::Kind::brazilian;
     const Gauges gauges(s, o);
@@ -437,7 +441,7 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     // (applied at once it is a shock that cracks the specimen before any axial load).
     MovingPlaten platen(s);
     const long start = o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0 ? confine(s, platen) : 0;
-    const int cracks_at_start = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
+    const int cracks_at_start = cracks(s.world(), contact::JointState::broken_tension) + cracks(s.world(), contact::JointState::broken_shear);
     double strain = 0.0;
     const std::size_t preload_points =
         o.elastic_preload && !uses_platen_blocks(o) ? elastic_preload(s, platen, o, gauges, r, strain, progress) : 0;
@@ -445,11 +449,11 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     StopRules rules(o, cracks_at_start);
     platen.set_speed(servo.rate() * h);
     double ratio_max = 0.0;
-    while (s.steps() - start < o.stop.max_steps) {
+    while (s.world().clock.steps - start < o.stop.max_steps) {
         s.step();
         strain += servo.rate();
-        ratio_max = std::max(ratio_max, s.unbalanced_ratio());
-        if ((s.steps() - start) % o.record_every != 0) continue;
+        ratio_max = std::max(ratio_max, s.world().clock.ratio);
+        if ((s.world().clock.steps - start) % o.record_every != 0) continue;
         record_new_cracks(s, r);
         StressStrainPoint p = gauges.measure(strain, servo.rate());
         p.unbalanced_ratio = ratio_max;
@@ -464,21 +468,21 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         // Ctrl-C (or a scheduler's SIGTERM): a lab test has no checkpoint, so the
         // command stops at once and writes nothing (apps/cli.cpp: exit status 130).
         if (studies::stop_signal_received()) throw Interrupted("interrupted during a lab test");
-        if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
+        if (on_frame && o.frame_every > 0 && (s.world().clock.steps - start) % o.frame_every == 0) on_frame(s, p);
         if (rules.stop_after(s, p, r)) break;
     }
     // Out of steps while loading on: the peak is a lower bound too.
-    if (s.steps() - start >= o.stop.max_steps && r.loaded_past_max_strain && !rules.failed() && !r.curve.empty())
+    if (s.world().clock.steps - start >= o.stop.max_steps && r.loaded_past_max_strain && !rules.failed() && !r.curve.empty())
         r.still_loading = rules.still_at_peak(r.curve.back());
-    r.steps = s.steps();
+    r.steps = s.world().clock.steps;
     r.peak_stress = rules.peak();
     r.strain_at_peak = rules.strain_at_peak();
     if (brazilian) r.tensile_strength = rules.peak();
     if (!brazilian) measure_rock_mechanics(r, preload_points, o.kind == LabTestOptions::Kind::tension, rules.peak_step());
     if (o.kind != LabTestOptions::Kind::tension && !brazilian) measure_residual_strength(r, o.confinement);
     record_new_cracks(s, r);
-    r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
-    r.cracks_shear = s.cracks(contact::JointState::broken_shear);
+    r.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
+    r.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (on_finish) on_finish(s, r);
     return r;

@@ -37,48 +37,52 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
 } // namespace
 
 void check_run_health(const Solver& s) {
-    const double tol = s.detection_tolerance(), dt = s.timestep();
+    const World& w = s.world();
+    const double tol = w.detection.tolerance, dt = w.clock.dt;
+    const double step = double(w.clock.steps);
     // No allocation unless a check fails: it runs inside the loop.
     constexpr const char* advice =
         " Reduce solver.safety (the automatic time step is safety x the critical step) or a solver.timestep "
         "given explicitly, or, for a load applied by velocity, the velocity; check that stiffness and strength "
         "values are in SI units (Pa/m, Pa).";
-    if (!std::isfinite(s.unbalanced_ratio()) || !std::isfinite(s.kinetic_energy()))
-        throw NumericalError("the solution became NaN or infinite at step " + std::to_string(s.steps()) + "." + advice);
-    if (!(s.timestep() >= 1e-3 * s.initial_timestep()))
-        throw NumericalError(fmt("the time step collapsed at step %.0f, from %.3g s to %.3g s: ", double(s.steps()),
-                              s.initial_timestep(), s.timestep()) +
-                          "a contact far stiffer, or a block far lighter, than at the start (a sliver block left by a "
-                          "cut, or a runaway overlap). Look at the last output; raise the pattern's min_edge to remove "
-                          "slivers.");
-    const auto& b = s.blocks();
-    for (int i = 0; i < b.count(); ++i) {
-        if (b.removed[i] || b.deformable[i]) continue;
-        if (norm(b.velocity[i]) * dt > tol)
+    if (!std::isfinite(w.clock.ratio) || !std::isfinite(kinetic_energy(w)))
+        throw NumericalError("the solution became NaN or infinite at step " + std::to_string(w.clock.steps) + "." + advice);
+    if (!(w.clock.dt >= 1e-3 * w.clock.first_dt))
+        throw NumericalError(fmt("the time step collapsed at step %.0f, from %.3g s to %.3g s: ", step, w.clock.first_dt,
+                                 w.clock.dt) +
+                             "a contact far stiffer, or a block far lighter, than at the start (a sliver block left by a "
+                             "cut, or a runaway overlap). Look at the last output; raise the pattern's min_edge to remove "
+                             "slivers.");
+    const auto& removed = w.bodies.removed;
+    for (int i = 0; i < w.bodies.count(); ++i) {
+        if (removed[i] || w.blocks.deformable[i]) continue;
+        const double moved = norm(w.bodies.state[i].velocity) * dt;
+        if (moved > tol)
             throw NumericalError(fmt("runaway motion at step %.0f: block %.0f moves %.3g m in one step, more than the "
-                                  "detection tolerance, so contacts can no longer follow it. Either part of the "
-                                  "model is collapsing (a mechanism: look at the last output) or the step is "
-                                  "unstable.",
-                                  double(s.steps()), i, norm(b.velocity[i]) * dt) +
-                              advice);
+                                     "detection tolerance, so contacts can no longer follow it. Either part of the "
+                                     "model is collapsing (a mechanism: look at the last output) or the step is "
+                                     "unstable.",
+                                     step, i, moved) +
+                                 advice);
     }
-    const auto& n = s.nodes();
+    const auto& n = w.nodes;
     for (int k = 0; k < n.count(); ++k)
-        if (!b.removed[n.block[k]] && norm(n.velocity[k]) * dt > tol)
-            throw NumericalError(fmt("runaway motion at step %.0f: node %.0f moves %.3g m in one step.", double(s.steps()),
-                                  k, norm(n.velocity[k]) * dt) +
-                              advice);
-    if (s.steps() % 1000 != 0) return;
-    const auto& c = s.contacts();
+        if (!removed[n.block[k]] && norm(n.velocity[k]) * dt > tol)
+            throw NumericalError(fmt("runaway motion at step %.0f: node %.0f moves %.3g m in one step.", step, k,
+                                     norm(n.velocity[k]) * dt) +
+                                 advice);
+    if (w.clock.steps % 1000 != 0) return;
+    const auto& c = contacts(w);
+    const auto& vertex = w.vertices.position;
     for (int i = 0; i < c.size(); ++i) {
-        const Vec2 x = b.vertex[c.vertex_id[i]], p = b.vertex[c.edge_id[i]];
+        const Vec2 x = vertex[c.vertex_id[i]], p = vertex[c.edge_id[i]];
         const double gap = dot(x - p, c.normal[i]);
         const double elastic = std::max(0.0, -c.history[i].un);
         if (gap < -(tol + elastic))
             throw NumericalError(fmt("blocks overlap at step %.0f: a contact at (%.3g, %.3g) is pushed through its edge "
-                                  "by more than the detection tolerance.",
-                                  double(s.steps()), x.x, x.y) +
-                              advice);
+                                     "by more than the detection tolerance.",
+                                     step, x.x, x.y) +
+                                 advice);
     }
 }
 
@@ -103,8 +107,8 @@ namespace {
 
 /// summary.json's "opening": the wall's displacements and convergences, the
 /// cracked depth, the failed zone with its lobes, and hoop stress profiles.
-nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
-    const auto m = measure_opening(solver, rep.center, rep.springline, rep.crown);
+nlohmann::json opening_summary(const World& w, const ReportSpec& rep) {
+    const auto m = measure_opening(w, rep.center, rep.springline, rep.crown);
     nlohmann::json opening = {
         {"springline_displacement", {m.springline_displacement.x, m.springline_displacement.y}},
         {"crown_displacement", {m.crown_displacement.x, m.crown_displacement.y}},
@@ -116,7 +120,7 @@ nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
         {"cracks_crown_sector", m.cracks_crown_sector},
         {"springline_sector_tensile", m.tensile_springline_sector},
         {"springline_sector_shear", m.shear_springline_sector}};
-    const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
+    const auto zone = measure_failed_zone(w, rep.center, rep.springline, rep.crown);
     opening["failed_zone"] = {{"cell_m", zone.cell},
                               {"threshold_broken_fraction", zone.threshold},
                               {"sector_deg", 360.0 / double(zone.depth.size())},
@@ -138,20 +142,20 @@ nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
     if (zone.reaches_region_edge)
         opening["failed_zone"]["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
     // Hoop stress profiles from the wall outwards (compression positive, MPa).
-    const auto stress = solver.block_stresses();
+    const auto stress = block_stresses(w);
     const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
     nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
     for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
-        const double hs = hoop_stress_at(solver, stress, rep.center, rep.springline, f * a_s, 0.3);
-        const double hc = hoop_stress_at(solver, stress, rep.center, rep.crown, f * a_c, 0.3);
+        const double hs = hoop_stress_at(w, stress, rep.center, rep.springline, f * a_s, 0.3);
+        const double hc = hoop_stress_at(w, stress, rep.center, rep.crown, f * a_c, 0.3);
         spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
         crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
     }
     opening["hoop_stress_springline"] = spring;
     opening["hoop_stress_crown"] = crown;
-    if (solver.flow()) {
+    if (w.flow) {
         // The damaged zone as a path for water along the tunnel, rings of a tenth of the radius.
-        const auto k = measure_axial_permeability(solver, rep.center, rep.springline, rep.crown, 0.1 * std::min(a_s, a_c));
+        const auto k = measure_axial_permeability(w, rep.center, rep.springline, rep.crown, 0.1 * std::min(a_s, a_c));
         opening["axial_permeability"] = {{"intact_m2", k.intact},
                                          {"ring_m", k.ring},
                                          {"crown_m2", k.crown},
@@ -171,9 +175,8 @@ nlohmann::json opening_summary(const Solver& solver, const ReportSpec& rep) {
 
 /// Per installed set of each support type, the figures an engineer reads
 /// ("bolts": loads per bolt; "liners": thrust and moment per metre; …).
-void add_support_summaries(nlohmann::json& summary, const Solver& solver) {
-    for (const auto& support : solver.supports()) {
-        const auto sets = support->summary();
+void add_support_summaries(nlohmann::json& summary, const World& w) {
+    for (const auto& [name, sets] : support_summaries(w)) {
         if (sets.empty()) continue;
         nlohmann::json out = nlohmann::json::array();
         for (const auto& set : sets) {
@@ -184,7 +187,7 @@ void add_support_summaries(nlohmann::json& summary, const Solver& solver) {
             }
             out.push_back(entry);
         }
-        summary[support->name()] = out;
+        summary[name] = out;
     }
 }
 
@@ -194,8 +197,9 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
                            const meshing::BlockAssembly& blocks, const meshing::GenerationStats& generation,
                            const Solver& solver, const std::vector<StageReport>& reports, double wall_seconds,
                            bool interrupted, bool complete) {
+    const World& w = solver.world();
     int rigid = 0;
-    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver.blocks().deformable[i];
+    for (int i = 0; i < blocks.block_count(); ++i) rigid += !w.blocks.deformable[i];
     nlohmann::json stages = nlohmann::json::array();
     for (const auto& r : reports) {
         nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
@@ -209,37 +213,37 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         {"model", model_name},
         {"blocks", rigid},
         {"deformable_blocks", blocks.block_count() - rigid},
-        {"zones", solver.zones().size()},
-        {"nodes", solver.nodes().count()},
-        {"contacts", solver.contacts().size()},
-        {"steps", solver.steps()},
-        {"time", solver.time()},
-        {"timestep", solver.timestep()},
+        {"zones", w.zones.size()},
+        {"nodes", w.nodes.count()},
+        {"contacts", w.contacts.size()},
+        {"steps", w.clock.steps},
+        {"time", w.clock.time},
+        {"timestep", w.clock.dt},
         {"wall_seconds", wall_seconds},
         {"meshing_seconds", generation.seconds_regions + generation.seconds_patterns + generation.seconds_topology},
-        {"cracks", {{"tensile", solver.cracks(contact::JointState::broken_tension)},
-                    {"shear", solver.cracks(contact::JointState::broken_shear)}}},
-        {"unbalanced_ratio", solver.unbalanced_ratio()},
-        {"energy", {{"kinetic", solver.kinetic_energy()}, {"strain", solver.strain_energy()},
-                    {"dissipated", solver.dissipated_energy()}, {"external_work", solver.external_work()}}},
-        {"state_hash", std::to_string(solver.state_hash())},
+        {"cracks", {{"tensile", cracks(w, contact::JointState::broken_tension)},
+                    {"shear", cracks(w, contact::JointState::broken_shear)}}},
+        {"unbalanced_ratio", w.clock.ratio},
+        {"energy", {{"kinetic", kinetic_energy(w)}, {"strain", strain_energy(w)},
+                    {"dissipated", dissipated_energy(w)}, {"external_work", w.clock.work}}},
+        {"state_hash", std::to_string(state_hash(w))},
         {"interrupted", interrupted},
         // false: stopped by a health check or interrupted; the fields describe the
         // last good state, not the end of the model's stages.
         {"complete", complete},
         {"stages", stages}};
-    if (const JointFlow* flow = solver.flow()) {
-        const auto& st = flow->state();
+    if (w.flow) {
+        const JointFlow& flow = *w.flow;
+        const auto& st = flow.state;
         int conducting = 0;
-        for (int k = 0; k < flow->network().pipes(); ++k)
-            conducting += flow::conductance(flow->network(), flow->fluid(), st, k) > 0.0;
-        summary["flow"] = {{"mode", flow->spec().mode == FlowSpec::Mode::steady ? "steady" : "transient"},
-                           {"domains", flow->network().domains()},
-                           {"pipes", flow->network().pipes()},
+        for (int k = 0; k < flow.net.pipes(); ++k) conducting += flow::conductance(flow.net, flow.fluid, st, k) > 0.0;
+        summary["flow"] = {{"mode", flow.spec.mode == FlowSpec::Mode::steady ? "steady" : "transient"},
+                           {"domains", flow.net.domains()},
+                           {"pipes", flow.net.pipes()},
                            {"conducting_pipes", conducting},
-                           {"inflow", flow->inflow()},
+                           {"inflow", inflow(flow)},
                            {"max_pressure", *std::max_element(st.pressure.begin(), st.pressure.end())},
-                           {"steady_solves", flow->steady_solves()}};
+                           {"steady_solves", flow.solves}};
     }
     // The run's verdict: that of its last judged (solve or cycle) stage.
     for (auto r = reports.rbegin(); r != reports.rend(); ++r)
@@ -248,9 +252,9 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             summary["verdict"]["stage"] = r->name;
             break;
         }
-    add_support_summaries(summary, solver);
+    add_support_summaries(summary, w);
     const auto& rep = file.analysis.report;
-    if (rep.opening) summary["opening"] = opening_summary(solver, rep);
+    if (rep.opening) summary["opening"] = opening_summary(w, rep);
     return summary;
 }
 
@@ -266,7 +270,7 @@ class CallbackObserver : public StageObserver {
 public:
     CallbackObserver(const Model& m, const Model::Progress& p) : model_(m), progress_(p) {}
     void step_done(const Solver& s, const StageSpec&, long) override {
-        if (s.steps() % 100 == 0) check_run_health(s);
+        if (s.world().clock.steps % 100 == 0) check_run_health(s);
         poll(s);
     }
     void stage_done(const Solver&, const StageReport&) override {
@@ -274,7 +278,7 @@ public:
     }
     bool stop_requested() override { return stop_; }
     void poll(const Solver& s) {
-        if (progress_.callback && progress_.every > 0 && s.steps() % progress_.every == 0 &&
+        if (progress_.callback && progress_.every > 0 && s.world().clock.steps % progress_.every == 0 &&
             !progress_.callback(model_))
             stop_ = true;
     }
@@ -383,7 +387,7 @@ void Model::step(long n, const Progress& progress) {
     const auto t0 = std::chrono::steady_clock::now();
     for (long k = 0; k < n && !observer.stop_requested(); ++k) {
         solver_->step();
-        if (solver_->steps() % 100 == 0) check_run_health(*solver_);
+        if (solver_->world().clock.steps % 100 == 0) check_run_health(*solver_);
         observer.poll(*solver_);
     }
     run_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -401,7 +405,7 @@ void Model::checkpoint(const fs::path& file) const {
         put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged), put(o, r.verdict);
     }
     put(o, run_seconds_);
-    solver_->save_state(o);
+    save_state(solver_->world(), o);
     io::write_text_atomically(file, o.str());
 }
 
@@ -432,7 +436,7 @@ Model Model::resume(const fs::path& file, int threads) {
     }
     m.run_seconds_ = get<double>(in);
     try {
-        m.solver_->load_state(in);
+        load_state(m.solver_->world(), in);
     } catch (const std::runtime_error& e) {
         throw InputError(file.string(), 0, "", e.what());
     }
@@ -446,9 +450,10 @@ nlohmann::json Model::summary() const {
 
 void Model::write_vtk(const fs::path& dir) const {
     io::make_output_directory(dir);
-    io::write_state_blocks_vtu(*solver_, dir / "blocks.vtu");
-    io::write_state_contacts_vtu(*solver_, dir / "contacts.vtu");
-    io::write_pvd(dir / "result.pvd", {{solver_->time(), "blocks.vtu"}, {solver_->time(), "contacts.vtu"}});
+    const World& w = solver_->world();
+    io::write_state_blocks_vtu(w, dir / "blocks.vtu");
+    io::write_state_contacts_vtu(w, dir / "contacts.vtu");
+    io::write_pvd(dir / "result.pvd", {{w.clock.time, "blocks.vtu"}, {w.clock.time, "contacts.vtu"}});
 }
 
 } // namespace bbm::studies

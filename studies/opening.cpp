@@ -1,6 +1,7 @@
 #include "studies/opening.hpp"
 
 #include "core/joint_flow.hpp"
+#include "core/measures.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -10,26 +11,29 @@
 
 namespace bbm {
 
-OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown) {
+OpeningMeasures measure_opening(const World& w, Vec2 center, Vec2 springline, Vec2 crown) {
     OpeningMeasures m;
-    const auto& b = s.blocks();
-    const auto& n = s.nodes();
+    const auto& b = w.blocks;
+    const auto& n = w.nodes;
+    const auto& x = w.vertices;
+    const auto& removed = w.bodies.removed;
     // The material point (rigid vertex or node, of a block still there) that started nearest p.
     auto displacement_at = [&](Vec2 p) {
         double best = INFINITY;
         Vec2 u{};
         for (int i = 0; i < b.count(); ++i) {
-            if (b.removed[i] || b.deformable[i]) continue;
-            const Rotation rot = rotation(b.theta[i]);
+            if (removed[i] || b.deformable[i]) continue;
+            const auto& body = w.bodies.state[i];
+            const Rotation rot = rotation(body.theta);
             for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
-                const Vec2 x0 = b.centroid0[i] + b.local[v];
+                const Vec2 x0 = b.centroid0[i] + x.local[v];
                 if (norm(x0 - p) >= best) continue;
                 best = norm(x0 - p);
-                u = b.centroid[i] + rot(b.local[v]) - x0;
+                u = body.centroid + rot(x.local[v]) - x0;
             }
         }
         for (int k = 0; k < n.count(); ++k)
-            if (!b.removed[n.block[k]] && norm(n.position0[k] - p) < best)
+            if (!removed[n.block[k]] && norm(n.position0[k] - p) < best)
                 best = norm(n.position0[k] - p), u = n.position[k] - n.position0[k];
         return u;
     };
@@ -40,12 +44,12 @@ OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, V
     m.crown_convergence = -dot(m.crown_displacement, dc);
     const double rs = norm(springline - center), rc = norm(crown - center);
     const double cos30 = std::cos(30.0 * 3.141592653589793 / 180.0), cos15 = std::cos(15.0 * 3.141592653589793 / 180.0);
-    const auto& c = s.contacts();
+    const auto& c = contacts(w);
     std::vector<double> depth_s, depth_c;
     for (int i = 0; i < c.size(); ++i) {
         const auto mode = c.history[i].broken;
         if (mode != contact::JointState::broken_tension && mode != contact::JointState::broken_shear) continue;
-        const Vec2 r = b.vertex[c.vertex_id[i]] - center;
+        const Vec2 r = x.position[c.vertex_id[i]] - center;
         const double d = norm(r);
         if (d <= 0) continue;
         const double cs = dot(r, ds) / d, cc = dot(r, dc) / d;
@@ -108,13 +112,14 @@ struct CellJoints {
     std::vector<double> distance;
 };
 
-CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
-    const auto& b = s.blocks();
-    const auto& n = s.nodes();
-    const auto& c = s.contacts();
+CellJoints joints_per_cell(const World& w, PolarCells& g) {
+    const auto& b = w.blocks;
+    const auto& n = w.nodes;
+    const auto& removed = w.bodies.removed;
+    const auto& c = contacts(w);
     auto initial = [&](int v, int blk) {
-        const int node = b.vertex_node[v];
-        return node >= 0 ? n.position0[node] : b.centroid0[blk] + b.local[v];
+        const int node = w.vertices.node[v];
+        return node >= 0 ? n.position0[node] : b.centroid0[blk] + w.vertices.local[v];
     };
     CellJoints j;
     j.cell.assign(std::size_t(c.size()), -1), j.is_broken.assign(j.cell.size(), 0), j.distance.assign(j.cell.size(), 0.0);
@@ -135,7 +140,7 @@ CellJoints joints_per_cell(const Solver& s, PolarCells& g) {
     j.edge.assign(j.all.size(), 0);
     for (int i = 0; i < c.size(); ++i) {
         const int ba = c.vertex_block[i], bb = c.edge_block[i];
-        if (b.region[ba] == b.region[bb] || b.removed[ba] || b.removed[bb] || !(b.deformable[ba] || b.deformable[bb]))
+        if (b.region[ba] == b.region[bb] || removed[ba] || removed[bb] || !(b.deformable[ba] || b.deformable[bb]))
             continue;
         const auto [ring, sector] = g.of(initial(c.vertex_id[i], ba));
         if (ring >= 0 && ring < g.rings) j.edge[std::size_t(ring * g.sectors + sector)] = 1;
@@ -200,8 +205,8 @@ struct GridZone {
     }
 };
 
-GridZone zone_on_grid(const Solver& s, PolarCells grid, double threshold) {
-    CellJoints joints = joints_per_cell(s, grid); // counts the grid's rings
+GridZone zone_on_grid(const World& w, PolarCells grid, double threshold) {
+    CellJoints joints = joints_per_cell(w, grid); // counts the grid's rings
     GridZone z{grid, std::move(joints), {}, {}};
     const int sectors = z.grid.sectors, rings = z.grid.rings;
     // The wall in each sector: its innermost ring that holds rock (an opening that
@@ -232,13 +237,13 @@ std::vector<double> outermost_broken(const GridZone& z) {
 
 } // namespace
 
-FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
+FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec2 crown, double cell,
                                double threshold, int sectors) {
     FailedZone z;
     z.cell = cell, z.threshold = threshold, z.center = center;
     z.radius = std::min(norm(springline - center), norm(crown - center));
     z.depth.assign(std::size_t(sectors), 0.0), z.depth_cells.assign(std::size_t(sectors), 0.0);
-    const GridZone g0 = zone_on_grid(s, PolarCells{center, z.radius, cell, sectors}, threshold);
+    const GridZone g0 = zone_on_grid(w, PolarCells{center, z.radius, cell, sectors}, threshold);
     const CellJoints& j = g0.joints;
     const std::vector<int>& wall = g0.wall;
     const std::vector<std::uint8_t>& in_zone = g0.in_zone;
@@ -286,7 +291,7 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
     std::vector<std::vector<double>> depths(z.depth.size());
     for (int shift = 0; shift < grid_shifts; ++shift) {
         const GridZone g = shift == 0 ? g0
-                                      : zone_on_grid(s, PolarCells{center, z.radius - shift * cell / grid_shifts, cell, sectors},
+                                      : zone_on_grid(w, PolarCells{center, z.radius - shift * cell / grid_shifts, cell, sectors},
                                                      threshold);
         const auto outermost = outermost_broken(g);
         for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector)
@@ -324,12 +329,12 @@ FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Ve
     return z;
 }
 
-FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown) {
-    const auto& c = s.contacts();
+FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec2 crown) {
+    const auto& c = contacts(w);
     double length = 0.0;
     for (int i = 0; i < c.size(); ++i) length += c.length[i];
     const double cell = c.size() > 0 ? 4.0 * length / c.size() : 0.3;
-    return measure_failed_zone(s, center, springline, crown, cell);
+    return measure_failed_zone(w, center, springline, crown, cell);
 }
 
 std::vector<Vec2> FailedZone::outline() const {
@@ -379,24 +384,25 @@ std::vector<FailedZone::Lobe> FailedZone::lobes() const {
     return out;
 }
 
-double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,
+double hoop_stress_at(const World& w, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,
                       Vec2 towards, double r, double band) {
     const Vec2 dir = (towards - center) / norm(towards - center), p = center + r * dir;
-    const auto& b = s.blocks();
+    const auto& b = w.blocks;
+    const auto& removed = w.bodies.removed;
     double sum = 0.0, weight = 0.0;
     // σθθ = t·σ·t with t the tangent of the circle through x.
-    auto add = [&](Vec2 x, const std::array<double, 3>& st, double w) {
+    auto add = [&](Vec2 x, const std::array<double, 3>& st, double area) {
         if (norm(x - p) > band) return;
         const Vec2 rad = (x - center) / norm(x - center), t{-rad.y, rad.x};
-        sum += w * (st[0] * t.x * t.x + st[1] * t.y * t.y + 2.0 * st[2] * t.x * t.y);
-        weight += w;
+        sum += area * (st[0] * t.x * t.x + st[1] * t.y * t.y + 2.0 * st[2] * t.x * t.y);
+        weight += area;
     };
     for (int i = 0; i < b.count(); ++i)
-        if (!b.removed[i] && !b.deformable[i]) add(b.centroid[i], block_stress[i], b.area[i]);
-    const auto& z = s.zones();
-    const auto& n = s.nodes();
+        if (!removed[i] && !b.deformable[i]) add(w.bodies.state[i].centroid, block_stress[i], b.area[i]);
+    const auto& z = w.zones;
+    const auto& n = w.nodes;
     for (int k = 0; k < z.size(); ++k) {
-        if (b.removed[z.block[k]]) continue;
+        if (removed[z.block[k]]) continue;
         const auto& t = z.node[k];
         const auto g = fem::gradients(n.position[t[0]], n.position[t[1]], n.position[t[2]]);
         add((n.position[t[0]] + n.position[t[1]] + n.position[t[2]]) / 3.0, z.stress[k], g.area);
@@ -416,12 +422,13 @@ struct AxialNetwork {
     const JointFlow& flow;
     const flow::Network& net;
     const flow::State& st;
-    const Solver::Blocks& b;
+    const Blocks& b;
+    const std::vector<std::uint8_t>& removed;
     Vec2 center;
     double radius;
     /// L a³ / 12: what pipe p carries along the tunnel per unit gradient over μ.
     double transmissivity(int p) const {
-        const double a = flow::hydraulic_aperture(flow.fluid(), st.aperture[p]);
+        const double a = flow::hydraulic_aperture(flow.fluid, st.aperture[p]);
         return net.pipe_length[p] * a * a * a / 12.0;
     }
     Vec2 midpoint(int p) const {
@@ -438,7 +445,7 @@ void axial_profiles(const AxialNetwork& an, Vec2 springline, Vec2 crown, AxialPe
     for (int d = 0; d < net.domains(); ++d) {
         const double r = norm(net.domain_position[d] - an.center);
         farthest = std::max(farthest, r);
-        if (an.st.held[std::size_t(d)] && !an.flow.drained()[std::size_t(d)]) reach = std::min(reach, r);
+        if (an.st.held[std::size_t(d)] && !an.flow.drained[std::size_t(d)]) reach = std::min(reach, r);
     }
     if (!std::isfinite(reach)) reach = farthest;
     const int rings = std::max(0, int((reach - an.radius) / k.ring));
@@ -471,7 +478,7 @@ void damaged_zone(const AxialNetwork& an, double bond, AxialPermeability& k) {
     const auto& net = an.net;
     const double fractured_t = 10.0 * bond * bond * bond;
     auto fractured = [&](int p) {
-        const double a = flow::hydraulic_aperture(an.flow.fluid(), an.st.aperture[p]);
+        const double a = flow::hydraulic_aperture(an.flow.fluid, an.st.aperture[p]);
         return a > 0.0 && a * a * a >= fractured_t;
     };
     std::vector<std::vector<int>> pipes_at(std::size_t(net.domains()));
@@ -480,7 +487,7 @@ void damaged_zone(const AxialNetwork& an, double bond, AxialPermeability& k) {
     std::vector<std::uint8_t> reached(std::size_t(net.domains()), 0), in_zone(std::size_t(net.pipes()), 0);
     std::vector<int> stack;
     for (int d = 0; d < net.domains(); ++d)
-        if (an.flow.drained()[std::size_t(d)]) reached[std::size_t(d)] = 1, stack.push_back(d);
+        if (an.flow.drained[std::size_t(d)]) reached[std::size_t(d)] = 1, stack.push_back(d);
     while (!stack.empty()) {
         const int d = stack.back();
         stack.pop_back();
@@ -494,9 +501,8 @@ void damaged_zone(const AxialNetwork& an, double bond, AxialPermeability& k) {
     std::vector<std::uint8_t> bordering(std::size_t(an.b.count()), 0);
     auto border_area = [&](int p) {
         double area = 0.0;
-        const auto [ba, bb] = an.flow.pipe_blocks(p);
-        for (int blk : {ba, bb})
-            if (!an.b.removed[blk] && !bordering[std::size_t(blk)]) bordering[std::size_t(blk)] = 1, area += an.b.area[blk];
+        for (int blk : {an.flow.pipe_block_a[p], an.flow.pipe_block_b[p]})
+            if (!an.removed[blk] && !bordering[std::size_t(blk)]) bordering[std::size_t(blk)] = 1, area += an.b.area[blk];
         return area;
     };
     for (int p = 0; p < net.pipes(); ++p) {
@@ -507,7 +513,7 @@ void damaged_zone(const AxialNetwork& an, double bond, AxialPermeability& k) {
         k.edz_transmissivity += t;
         k.edz_area += border_area(p);
         k.edz_depth = std::max(k.edz_depth, norm(an.midpoint(p) - an.center) - an.radius);
-        k.parted_joints += an.st.aperture[p] >= an.flow.fluid().max_aperture;
+        k.parted_joints += an.st.aperture[p] >= an.flow.fluid.max_aperture;
     }
     k.edz_permeability = k.edz_area > 0 ? k.edz_transmissivity / k.edz_area : 0.0;
     // Largest first, ties by pipe number: the same on any thread count.
@@ -524,22 +530,21 @@ void damaged_zone(const AxialNetwork& an, double bond, AxialPermeability& k) {
 
 } // namespace
 
-AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown,
+AxialPermeability measure_axial_permeability(const World& w, Vec2 center, Vec2 springline, Vec2 crown,
                                              double ring) {
     AxialPermeability k;
     k.ring = ring;
-    const JointFlow* flow = s.flow();
-    if (!flow || !(ring > 0)) return k;
-    const AxialNetwork an{*flow, flow->network(), flow->state(), s.blocks(), center,
+    if (!w.flow || !(ring > 0)) return k;
+    const JointFlow& flow = *w.flow;
+    const AxialNetwork an{flow, flow.net, flow.state, w.blocks, w.bodies.removed, center,
                           std::min(norm(springline - center), norm(crown - center))};
     // Intact: every bond at its aperture, over the flow regions' rock.
-    const double bond = flow::hydraulic_aperture(flow->fluid(), flow->spec().bond_aperture);
+    const double bond = flow::hydraulic_aperture(flow.fluid, flow.spec.bond_aperture);
     double joint_length = 0.0, rock_area = 0.0;
     std::vector<std::uint8_t> wet(std::size_t(an.b.count()), 0);
     for (int p = 0; p < an.net.pipes(); ++p) {
         joint_length += an.net.pipe_length[p];
-        const auto [ba, bb] = flow->pipe_blocks(p);
-        wet[std::size_t(ba)] = wet[std::size_t(bb)] = 1;
+        wet[std::size_t(flow.pipe_block_a[p])] = wet[std::size_t(flow.pipe_block_b[p])] = 1;
     }
     for (int i = 0; i < an.b.count(); ++i)
         if (wet[std::size_t(i)]) rock_area += an.b.area[i];

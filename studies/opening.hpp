@@ -3,7 +3,7 @@
 // read off a solver's state after an excavation.
 #pragma once
 
-#include "core/solver.hpp"
+#include "core/world.hpp"
 
 #include <array>
 #include <vector>
@@ -24,7 +24,7 @@ struct OpeningMeasures {
     double failed_depth_springline = 0, failed_depth_crown = 0;
     int tensile_springline_sector = 0, shear_springline_sector = 0;
 };
-OpeningMeasures measure_opening(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
+OpeningMeasures measure_opening(const World& w, Vec2 center, Vec2 springline, Vec2 crown);
 
 /// The failed zone as engineers map it around an opening: the damaged rock that is
 /// connected to the wall. A polar grid about the centre — `sectors` equal sectors
@@ -84,11 +84,11 @@ struct FailedZone {
     };
     std::vector<Lobe> lobes() const;
 };
-FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown, double cell,
+FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec2 crown, double cell,
                                double threshold = 0.2, int sectors = 36);
 /// The failed zone with cells of four mean contact lengths (about one block: two
 /// contacts share each joint edge), as summary.json and failure.png give it.
-FailedZone measure_failed_zone(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown);
+FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec2 crown);
 
 /// The damaged zone as a path for water along the tunnel ([flow] models; AECL's
 /// connected-permeability tests at the Mine-by tunnel: docs/field.md, "Water in the
@@ -118,14 +118,14 @@ struct AxialPermeability {
 };
 /// Rings of `ring` metres out to the nearest held junction that is not the wall's
 /// (the interface with the dry far field). Zero figures in a dry model.
-AxialPermeability measure_axial_permeability(const Solver& s, Vec2 center, Vec2 springline, Vec2 crown,
+AxialPermeability measure_axial_permeability(const World& w, Vec2 center, Vec2 springline, Vec2 crown,
                                              double ring);
 
 /// Hoop stress (tension positive) at distance r from `center` along the direction
 /// `towards`: the area-weighted mean of the block-averaged stress of rigid blocks
 /// and of the zone stresses whose centroids lie within `band` of that point (the
 /// scatter of discrete blocks needs an average; SPEC §7). NaN if none is there.
-double hoop_stress_at(const Solver& s, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,
+double hoop_stress_at(const World& w, const std::vector<std::array<double, 3>>& block_stress, Vec2 center,
                       Vec2 towards, double r, double band);
 
 } // namespace bbm

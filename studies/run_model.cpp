@@ -114,23 +114,23 @@ class RunOutput : public StageObserver {
 public:
     RunOutput(const fs::path& out, const AnalysisSpec& an, const Solver& s, const RunOptions& o, std::string model,
               std::uint64_t model_hash)
-        : out_(out), settings_(an.solver), stages_(an.stages), recorder_(s, an.histories), options_(o),
+        : out_(out), settings_(an.solver), stages_(an.stages), recorder_(s.world(), an.histories), options_(o),
           model_(std::move(model)), model_hash_(model_hash) {
         make_output_directory(out_);
         fs::create_directories(out_ / "vtk");
     }
 
     void stage_started(const Solver& s, const StageSpec& st) override {
-        if (s.steps() == 0 && rows_.empty()) {
+        if (s.world().clock.steps == 0 && rows_.empty()) {
             record(s);
             snapshot(s);
         }
         (void)st;
     }
     void step_done(const Solver& s, const StageSpec& st, long k) override {
-        if (s.steps() % settings_.history_every == 0) record(s);
-        if (settings_.output_every > 0 && s.steps() % settings_.output_every == 0) snapshot(s);
-        if (s.steps() % 100 == 0) check_run_health(s);
+        if (s.world().clock.steps % settings_.history_every == 0) record(s);
+        if (settings_.output_every > 0 && s.world().clock.steps % settings_.output_every == 0) snapshot(s);
+        if (s.world().clock.steps % 100 == 0) check_run_health(s);
         if (options_.quiet) return;
         if (!progress_.due()) return;
         const auto now = std::chrono::steady_clock::now();
@@ -141,16 +141,16 @@ public:
         const long total = st.kind == K::cycle || st.kind == K::excavate || st.kind == K::pressurise ? st.steps
                                                                                                        : st.max_steps;
         progress_.line("  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s",
-                     st.name.c_str(), k, total, s.unbalanced_ratio(), s.cracks(contact::JointState::broken_tension),
-                        s.cracks(contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
+                     st.name.c_str(), k, total, s.world().clock.ratio, cracks(s.world(), contact::JointState::broken_tension),
+                        cracks(s.world(), contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
     }
     void at(const Solver& s, const StageCursor& c) override {
         cursor_ = c;
         if (c.step == 0) return;
-        if (options_.stop_at_step > 0 && s.steps() >= options_.stop_at_step) interrupted = -1;
+        if (options_.stop_at_step > 0 && s.world().clock.steps >= options_.stop_at_step) interrupted = -1;
         const auto& every = options_.checkpoint_every;
-        bool due = every.steps > 0 && s.steps() % every.steps == 0;
-        if (every.seconds > 0 && s.steps() % 16 == 0) {
+        bool due = every.steps > 0 && s.world().clock.steps % every.steps == 0;
+        if (every.seconds > 0 && s.world().clock.steps % 16 == 0) {
             const auto now = std::chrono::steady_clock::now();
             due = due || std::chrono::duration<double>(now - last_checkpoint_).count() >= every.seconds;
         }
@@ -188,7 +188,7 @@ public:
         h.model = model_, h.model_hash = model_hash_, h.threads = options_.threads;
         // A stop that came while a stage's end was written: that stage is done.
         const StageCursor cursor = int(reports_.size()) > cursor_.stage ? StageCursor{int(reports_.size()), false, 0} : cursor_;
-        h.step = s.steps(), h.cursor = cursor, h.wall_seconds = wall_seconds();
+        h.step = s.world().clock.steps, h.cursor = cursor, h.wall_seconds = wall_seconds();
         h.stage = cursor.stage < int(stages_.size()) ? stages_[cursor.stage].name : "";
         write_header(o, h);
         put(o, std::uint64_t(reports_.size()));
@@ -204,7 +204,7 @@ public:
         put(o, std::uint64_t(series_.size()));
         for (const auto& [t, name] : series_) put(o, t), put_string(o, name);
         put(o, last_snapshot_);
-        s.save_state(o);
+        save_state(s.world(), o);
         flush_history();
         write_text_atomically(out_ / "checkpoint.bin", o.str());
         last_checkpoint_ = std::chrono::steady_clock::now();
@@ -248,25 +248,25 @@ public:
     const std::vector<double>& times() const { return times_; }
     const HistoryRecorder& recorder() const { return recorder_; }
     void snapshot(const Solver& s) {
-        if (!series_.empty() && last_snapshot_ == s.steps()) return;
-        last_snapshot_ = s.steps();
+        const World& w = s.world();
+        if (!series_.empty() && last_snapshot_ == w.clock.steps) return;
+        last_snapshot_ = w.clock.steps;
         char name[64];
-        std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
-        write_state_blocks_vtu(s, out_ / name);
-        series_.push_back({s.time(), name});
-        std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", s.steps());
-        write_state_contacts_vtu(s, out_ / name);
-        series_.push_back({s.time(), name});
-        if (s.flow()) {
-            std::snprintf(name, sizeof name, "vtk/flow_%08ld.vtu", s.steps());
-            write_flow_vtu(s, out_ / name);
-            series_.push_back({s.time(), name});
+        std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", w.clock.steps);
+        write_state_blocks_vtu(w, out_ / name);
+        series_.push_back({w.clock.time, name});
+        std::snprintf(name, sizeof name, "vtk/contacts_%08ld.vtu", w.clock.steps);
+        write_state_contacts_vtu(w, out_ / name);
+        series_.push_back({w.clock.time, name});
+        if (w.flow) {
+            std::snprintf(name, sizeof name, "vtk/flow_%08ld.vtu", w.clock.steps);
+            write_flow_vtu(w, out_ / name);
+            series_.push_back({w.clock.time, name});
         }
-        for (const auto& support : s.supports()) {
-            if (support->tie_count() == 0) continue;
-            std::snprintf(name, sizeof name, "vtk/%s_%08ld.vtu", support->name(), s.steps());
-            write_support_vtu(support->lines(), out_ / name);
-            series_.push_back({s.time(), name});
+        for (const auto& [type, lines] : support_lines(w)) {
+            std::snprintf(name, sizeof name, "vtk/%s_%08ld.vtu", type.c_str(), w.clock.steps);
+            write_support_vtu(lines, out_ / name);
+            series_.push_back({w.clock.time, name});
         }
         // result.pvd holds every part; blocks.pvd, contacts.pvd (and bolts.pvd,
         // liners.pvd, … per installed support type) one each (for scripts that
@@ -294,9 +294,9 @@ public:
         write_text_atomically(out_ / "history.csv", csv.str());
     }
     void record(const Solver& s) {
-        if (!rows_.empty() && rows_.back().first == s.steps()) return;
-        rows_.push_back({s.steps(), recorder_.sample(s)});
-        times_.push_back(s.time());
+        if (!rows_.empty() && rows_.back().first == s.world().clock.steps) return;
+        rows_.push_back({s.world().clock.steps, recorder_.sample(s.world())});
+        times_.push_back(s.world().clock.time);
     }
 
 private:
@@ -417,17 +417,17 @@ nlohmann::json report_profile(const StepProfile& p, int contacts) {
                          "that ends it)\n  %-20s %10s %7s %14s\n",
                  p.steps, total, "stage", "seconds", "share", "us per step");
     nlohmann::json stages = nlohmann::json::object();
-    for (int k = 0; k < StepProfile::count; ++k) {
-        const double t = p.seconds[std::size_t(k)];
-        std::fprintf(stderr, "  %-20s %10.3f %6.1f%% %14.2f\n", StepProfile::names[std::size_t(k)], t,
-                     total > 0 ? 100.0 * t / total : 0.0, p.steps > 0 ? 1e6 * t / double(p.steps) : 0.0);
-        stages[StepProfile::names[std::size_t(k)]] = t;
+    double contact_seconds = 0.0;
+    for (std::size_t k = 0; k < step_stages.size(); ++k) {
+        const double t = p.seconds[k];
+        const std::string name(step_stages[k].name);
+        std::fprintf(stderr, "  %-20s %10.3f %6.1f%% %14.2f\n", name.c_str(), t, total > 0 ? 100.0 * t / total : 0.0,
+                     p.steps > 0 ? 1e6 * t / double(p.steps) : 0.0);
+        stages[name] = t;
+        if (name == "contacts") contact_seconds = t;
     }
-    const double contact_ns = p.steps > 0 && contacts > 0
-                                  ? 1e9 * p.seconds[StepProfile::contacts_and_zones] / double(p.steps) / contacts
-                                  : 0.0;
-    std::fprintf(stderr, "  contacts and zones per contact (at the end: %d contacts): %.1f ns per step\n", contacts,
-                 contact_ns);
+    const double contact_ns = p.steps > 0 && contacts > 0 ? 1e9 * contact_seconds / double(p.steps) / contacts : 0.0;
+    std::fprintf(stderr, "  contacts per contact (at the end: %d contacts): %.1f ns per step\n", contacts, contact_ns);
     return {{"steps", p.steps}, {"seconds", stages}, {"total_seconds", total}};
 }
 
@@ -465,7 +465,7 @@ FailurePlotOptions failure_plot_options(const io::ModelFile& model, const meshin
         for (Vec2 p : blocks.points) all.add(p);
         fo.window.add({std::max(all.lo.x, rep.center.x - 2.2 * r), std::max(all.lo.y, rep.center.y - 2.2 * r)});
         fo.window.add({std::min(all.hi.x, rep.center.x + 2.2 * r), std::min(all.hi.y, rep.center.y + 2.2 * r)});
-        const auto zone = measure_failed_zone(solver, rep.center, rep.springline, rep.crown);
+        const auto zone = measure_failed_zone(solver.world(), rep.center, rep.springline, rep.crown);
         if (zone.area > 0) fo.outline = zone.outline();
     }
     if (rep.window) fo.window = *rep.window;
@@ -478,16 +478,16 @@ FailurePlotOptions failure_plot_options(const io::ModelFile& model, const meshin
 /// the solver).
 void draw_pictures(const Solver& solver, const RunOutput& output, const RunOptions& opt, const FailurePlotOptions& fo) {
     auto svg_and_history = [&] {
-        draw_failure(solver, opt.out / "failure.svg", fo);
+        draw_failure(solver.world(), opt.out / "failure.svg", fo);
         draw_history(output, opt.out / "history.png");
     };
     if (opt.threads > 1) {
-        (void)solver.contacts();
+        (void)contacts(solver.world());
         auto other = std::async(std::launch::async, svg_and_history);
-        draw_failure(solver, opt.out / "failure.png", fo);
+        draw_failure(solver.world(), opt.out / "failure.png", fo);
         other.get();
     } else {
-        draw_failure(solver, opt.out / "failure.png", fo);
+        draw_failure(solver.world(), opt.out / "failure.png", fo);
         svg_and_history();
     }
 }
@@ -496,9 +496,9 @@ void draw_pictures(const Solver& solver, const RunOutput& output, const RunOptio
 void print_run_report(const Solver& solver, const nlohmann::json& summary, const io::ModelFile& model,
                       const RunOptions& opt, double seconds) {
     const auto& rep = model.analysis.report;
-    std::fprintf(stderr, "%ld steps in %.2f s; cracks %d tensile, %d shear\n", solver.steps(), seconds,
-                 solver.cracks(contact::JointState::broken_tension),
-                 solver.cracks(contact::JointState::broken_shear));
+    std::fprintf(stderr, "%ld steps in %.2f s; cracks %d tensile, %d shear\n", solver.world().clock.steps, seconds,
+                 cracks(solver.world(), contact::JointState::broken_tension),
+                 cracks(solver.world(), contact::JointState::broken_shear));
     if (rep.opening)
         std::fprintf(stderr, "opening: convergence %.2f mm at the springline, %.2f mm at the crown; cracks in the "
                              "±30° sectors %d (springline) vs %d (crown)\n",
@@ -521,30 +521,17 @@ void print_run_report(const Solver& solver, const nlohmann::json& summary, const
                          zone["region_edge_cells_damaged"].get<int>(), zone["region_edge_cells"].get<int>());
         }
     }
-    if (summary.contains("bolts"))
-        for (const auto& b : summary["bolts"])
-            std::fprintf(stderr, "bolts '%s': %d, largest load %.1f kN (bond %.1f kN/m), %d yielded, %d broken\n",
-                         b["name"].get<std::string>().c_str(), b["bolts"].get<int>(),
-                         b["max_axial_kN"].get<double>(), b["max_bond_kN_per_m"].get<double>(),
-                         b["yielded"].get<int>(), b["broken"].get<int>());
-    if (summary.contains("liners"))
-        for (const auto& l : summary["liners"])
-            std::fprintf(stderr, "liner '%s': thrust %.0f to %.0f kN/m, largest moment %.1f kNm/m, %d of %d "
-                                 "elements yielded, %d of %d interface nodes open\n",
-                         l["name"].get<std::string>().c_str(), l["min_thrust_kN_per_m"].get<double>(),
-                         l["max_thrust_kN_per_m"].get<double>(), l["max_moment_kNm_per_m"].get<double>(),
-                         l["yielded_elements"].get<int>(), l["elements"].get<int>(),
-                         l["open_interface_nodes"].get<int>(), l["nodes"].get<int>());
-    for (const auto& support : solver.supports()) {
-        if (std::string(support->name()) == "bolts" || std::string(support->name()) == "liners") continue;
-        for (const auto& set : support->summary()) {
+    // Each installed set of every support type, its figures as summary.json has them.
+    for (const auto& [type, sets] : support_summaries(solver.world()))
+        for (const auto& set : sets) {
             std::string figures;
-            for (const auto& f : set.figures)
-                figures += (figures.empty() ? "" : ", ") + f.key + " " +
-                           (f.count ? std::to_string(long(f.value)) : std::to_string(f.value));
-            std::fprintf(stderr, "%s '%s': %s\n", support->name(), set.name.c_str(), figures.c_str());
+            char value[64];
+            for (const auto& f : set.figures) {
+                std::snprintf(value, sizeof value, f.count ? "%.0f" : "%.4g", f.value);
+                figures += (figures.empty() ? "" : ", ") + f.key + " " + value;
+            }
+            std::fprintf(stderr, "%s '%s': %s\n", type.c_str(), set.name.c_str(), figures.c_str());
         }
-    }
     std::fprintf(stderr, "wrote %s/{result.pvd, history.csv, history.png, failure.png, summary.json}\n",
                  opt.out.string().c_str());
 }
@@ -614,11 +601,11 @@ int run_model(const RunOptions& opt) {
     if (opt.check_only) return 0;
     solver->profile().enabled = opt.profile;
     int rigid = 0;
-    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver->blocks().deformable[i];
+    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver->world().blocks.deformable[i];
     if (!opt.quiet)
         std::fprintf(stderr, "%s: %d rigid blocks, %d deformable blocks with %d zones, %d contacts; time step %.3g s (%s)\n",
-                     model_path.c_str(), rigid, blocks.block_count() - rigid, solver->zones().size(),
-                     solver->contacts().size(), solver->timestep(),
+                     model_path.c_str(), rigid, blocks.block_count() - rigid, solver->world().zones.size(),
+                     contacts(solver->world()).size(), solver->world().clock.dt,
                      model.analysis.solver.mode == SolverSpec::Mode::quasi_static ? "quasi-static" : "dynamic");
     RunOutput output(opt.out, model.analysis, *solver, opt, fs::absolute(model_path).lexically_normal().string(),
                      text_hash(read_file_text(model_path)));
@@ -627,7 +614,7 @@ int run_model(const RunOptions& opt) {
         const fs::path file = opt.out / "checkpoint.bin";
         try {
             output.restore(checkpoint, header);
-            solver->load_state(checkpoint);
+            load_state(solver->world(), checkpoint);
         } catch (const std::runtime_error& e) {
             // A checkpoint that does not fit this model or this bbm is bad input, not a crash.
             throw InputError(file.string(), 0, "", e.what());
@@ -637,7 +624,7 @@ int run_model(const RunOptions& opt) {
             std::fprintf(stderr,
                          "resuming %s at step %ld (stage %d '%s', step %ld in it; checkpoint format %u, written by bbm %s "
                          "on %d thread%s)\n",
-                         model_path.c_str(), solver->steps(), start.stage + 1, header.stage.c_str(), start.step,
+                         model_path.c_str(), solver->world().clock.steps, start.stage + 1, header.stage.c_str(), start.step,
                          header.format, header.bbm_version.c_str(), header.threads, header.threads == 1 ? "" : "s");
     }
     std::string health;
@@ -654,7 +641,7 @@ int run_model(const RunOptions& opt) {
     const int stop_signal = interrupted.load();
     if (stop_signal != 0) {
         output.write_checkpoint(*solver);
-        if (!opt.quiet) report_stop(stop_signal, solver->steps(), opt.out);
+        if (!opt.quiet) report_stop(stop_signal, solver->world().clock.steps, opt.out);
     }
     // The stages finished (before a resume too) and, if the run stopped inside one, that stage so far.
     std::vector<StageReport> reports = output.reports();
@@ -663,7 +650,7 @@ int run_model(const RunOptions& opt) {
     const double seconds = output.wall_seconds();
     nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, stop_signal != 0,
                                          health.empty() && stop_signal == 0);
-    if (opt.profile) summary["profile"] = report_profile(solver->profile(), solver->contacts().size());
+    if (opt.profile) summary["profile"] = report_profile(solver->profile(), contacts(solver->world()).size());
     FailurePlotOptions fo = failure_plot_options(model, blocks, *solver, model_path);
     fo.shade_pressure = opt.shade_pressure;
     if (!health.empty()) {

@@ -121,21 +121,23 @@ struct ShearBox {
     std::vector<std::string> names;
     std::vector<int> blocks;
     ShearBox(const Solver& s, const std::string& prefix) {
-        for (const auto& [name, ids] : s.boundary_blocks())
-            if (name.rfind(prefix, 0) == 0) names.push_back(name), blocks.insert(blocks.end(), ids.begin(), ids.end());
+        const Boundaries& b = s.world().boundaries;
+        for (std::size_t k = 0; k < b.names.size(); ++k)
+            if (b.names[k].rfind(prefix, 0) == 0)
+                names.push_back(b.names[k]), blocks.insert(blocks.end(), b.blocks[k].begin(), b.blocks[k].end());
     }
     Vec2 force(const Solver& s) const {
         Vec2 f{};
-        for (const auto& n : names) f += s.boundary_force(n);
+        for (const auto& n : names) f += boundary_force(s.world(), n);
         return f;
     }
     void set_velocity(Solver& s, Vec2 v) const {
-        for (int i : blocks) s.blocks().fixed_velocity[i] = v;
+        for (int i : blocks) s.world().loads.block_velocity[i] = v;
     }
     /// The box's displacement (a rigid body without rotation: any of its blocks).
     Vec2 displacement(const Solver& s) const {
-        const auto& b = s.blocks();
-        return blocks.empty() ? Vec2{} : b.centroid[blocks[0]] - b.centroid0[blocks[0]];
+        const World& w = s.world();
+        return blocks.empty() ? Vec2{} : w.bodies.state[blocks[0]].centroid - w.blocks.centroid0[blocks[0]];
     }
 };
 
@@ -181,7 +183,7 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
     r.seed = o.seed;
     r.normal_stress = o.normal_stress;
     r.blocks = assembly.block_count();
-    r.contacts = s.contacts().size();
+    r.contacts = contacts(s.world()).size();
     for (const auto& j : assembly.joints) r.plane_joints += j.tag == meshing::JointTag::real_joint;
     const ShearBox lower(s, "lower_"), upper(s, "upper_");
     if (lower.blocks.empty() || upper.blocks.empty())
@@ -215,21 +217,21 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
     for (long k = 0; k < settle_max; ++k) {
         servo(0.0, target(0.0));
         s.step();
-        if (k > 200 && std::abs(upper.force(s).y - target(0.0)) < 1e-4 * target(0.0) && s.unbalanced_ratio() < 1e-5) break;
+        if (k > 200 && std::abs(upper.force(s).y - target(0.0)) < 1e-4 * target(0.0) && s.world().clock.ratio < 1e-5) break;
     }
-    const long start = s.steps();
+    const long start = s.world().clock.steps;
     const Vec2 origin = upper.displacement(s);
     dilation_origin = origin.y;
     auto measure = [&] {
         ShearPoint p;
-        p.step = s.steps();
+        p.step = s.world().clock.steps;
         const Vec2 d = upper.displacement(s);
         p.displacement = d.x - origin.x;
         p.dilation = d.y - dilation_origin;
         p.shear_stress = 0.5 * (lower.force(s).x - upper.force(s).x) / w;
         p.normal_stress = upper.force(s).y / w;
-        p.cracks_tensile = s.cracks(contact::JointState::broken_tension);
-        p.cracks_shear = s.cracks(contact::JointState::broken_shear);
+        p.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
+        p.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
         return p;
     };
     r.curve.push_back(measure());
@@ -242,19 +244,19 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
         s.step();
         u = upper.displacement(s).x - origin.x;
         if (0.5 * (lower.force(s).x - upper.force(s).x) / w > peak.shear_stress) peak = measure();
-        if ((s.steps() - start) % o.record_every != 0) continue;
+        if ((s.world().clock.steps - start) % o.record_every != 0) continue;
         const ShearPoint p = measure();
         r.curve.push_back(p);
         const double t = target(p.dilation) / w;
         if (t > 0) r.normal_stress_error = std::max(r.normal_stress_error, std::abs(p.normal_stress - t) / t);
         if (progress) progress(p);
         if (studies::stop_signal_received()) throw Interrupted("interrupted during a shear test"); // as a lab test's
-        if (on_frame && o.frame_every > 0 && (s.steps() - start) % o.frame_every == 0) on_frame(s, p);
+        if (on_frame && o.frame_every > 0 && (s.world().clock.steps - start) % o.frame_every == 0) on_frame(s, p);
     }
     shear_figures(r, peak);
-    r.cracks_tensile = s.cracks(contact::JointState::broken_tension);
-    r.cracks_shear = s.cracks(contact::JointState::broken_shear);
-    r.steps = s.steps();
+    r.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
+    r.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
+    r.steps = s.world().clock.steps;
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (on_finish) on_finish(s, r);
     return r;
@@ -449,9 +451,9 @@ void write_run_files(const ShearTestResult& r, const Solver& s, const std::files
     std::snprintf(title, sizeof title, "direct shear, sigma_n %g MPa, seed %llu: peak %.3g MPa", r.normal_stress / 1e6,
                   static_cast<unsigned long long>(r.seed), r.peak_shear_stress / 1e6);
     fo.title = title;
-    io::draw_failure(s, dir / "failure.png", fo);
-    io::write_state_blocks_vtu(s, dir / "vtk/blocks_final.vtu");
-    io::write_state_contacts_vtu(s, dir / "vtk/contacts_final.vtu");
+    io::draw_failure(s.world(), dir / "failure.png", fo);
+    io::write_state_blocks_vtu(s.world(), dir / "vtk/blocks_final.vtu");
+    io::write_state_contacts_vtu(s.world(), dir / "vtk/contacts_final.vtu");
     frames.push_back({double(r.steps), "vtk/blocks_final.vtu"});
     frames.push_back({double(r.steps), "vtk/contacts_final.vtu"});
     io::write_pvd(dir / "result.pvd", frames);
@@ -578,9 +580,9 @@ int run_shear(ShearCli& v, bool quiet, bool check_only, ShearStudy* study) {
                 if (!write) return;
                 std::filesystem::create_directories(dir / "vtk");
                 char name[64];
-                std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.steps());
-                io::write_state_blocks_vtu(s, dir / name);
-                frames.push_back({double(s.steps()), name});
+                std::snprintf(name, sizeof name, "vtk/blocks_%08ld.vtu", s.world().clock.steps);
+                io::write_state_blocks_vtu(s.world(), dir / name);
+                frames.push_back({double(s.world().clock.steps), name});
             });
         if (!quiet) {
             std::lock_guard lock(print);

@@ -55,8 +55,8 @@ inline Outcome run_model(const io::ModelFile& model, const meshing::BlockAssembl
     Solver s(blocks, analysis);
     Silent quiet;
     run_stages(s, analysis.stages, quiet);
-    return {s.state_hash(), s.steps(), s.cracks(contact::JointState::broken_tension),
-            s.cracks(contact::JointState::broken_shear)};
+    return {state_hash(s.world()), s.world().clock.steps, cracks(s.world(), contact::JointState::broken_tension),
+            cracks(s.world(), contact::JointState::broken_shear)};
 }
 
 /// The example model files with stages (a model without is a mesh only).

@@ -29,10 +29,10 @@ struct SaveAt : StageObserver {
     std::vector<Saved> saved;
     explicit SaveAt(std::vector<long> s) : stops(std::move(s)) {}
     void at(const Solver& s, const StageCursor& c) override {
-        if (c.step == 0 || saved.size() == stops.size() || s.steps() != stops[saved.size()]) return;
+        if (c.step == 0 || saved.size() == stops.size() || s.world().clock.steps != stops[saved.size()]) return;
         std::ostringstream o(std::ios::binary);
-        s.save_state(o);
-        saved.push_back({s.steps(), c, o.str()});
+        save_state(s.world(), o);
+        saved.push_back({s.world().clock.steps, c, o.str()});
     }
 };
 
@@ -51,26 +51,26 @@ inline void check_exact_restart(RestartModel m, const std::vector<long>& stops, 
     SaveAt save(stops);
     run_stages(whole, m.analysis.stages, save);
     REQUIRE(save.saved.size() == stops.size()); // every stop is inside the run
-    const int tensile = whole.cracks(contact::JointState::broken_tension);
-    const int shear = whole.cracks(contact::JointState::broken_shear);
-    MESSAGE("uninterrupted: " << whole.steps() << " steps, " << tensile << " / " << shear
-                              << " tensile / shear cracks, " << whole.detection_totals().created
-                              << " contacts created, hash " << whole.state_hash());
+    const int tensile = cracks(whole.world(), contact::JointState::broken_tension);
+    const int shear = cracks(whole.world(), contact::JointState::broken_shear);
+    MESSAGE("uninterrupted: " << whole.world().clock.steps << " steps, " << tensile << " / " << shear
+                              << " tensile / shear cracks, " << whole.world().detection.totals.created
+                              << " contacts created, hash " << state_hash(whole.world()));
     for (const auto& saved : save.saved)
         for (int t : threads) {
             m.analysis.solver.threads = t;
             Solver resumed(m.blocks, m.analysis);
             std::istringstream in(saved.state, std::ios::binary);
-            resumed.load_state(in);
+            load_state(resumed.world(), in);
             StageObserver quiet;
             run_stages(resumed, m.analysis.stages, quiet, saved.cursor);
             INFO("stopped at step " << saved.step << " (stage " << saved.cursor.stage << "), resumed on " << t
-                                    << " thread(s): " << resumed.cracks(contact::JointState::broken_tension) << " / "
-                                    << resumed.cracks(contact::JointState::broken_shear) << " cracks");
-            CHECK(resumed.steps() == whole.steps());
-            CHECK(resumed.cracks(contact::JointState::broken_tension) == tensile);
-            CHECK(resumed.cracks(contact::JointState::broken_shear) == shear);
-            CHECK(resumed.state_hash() == whole.state_hash());
+                                    << " thread(s): " << cracks(resumed.world(), contact::JointState::broken_tension) << " / "
+                                    << cracks(resumed.world(), contact::JointState::broken_shear) << " cracks");
+            CHECK(resumed.world().clock.steps == whole.world().clock.steps);
+            CHECK(cracks(resumed.world(), contact::JointState::broken_tension) == tensile);
+            CHECK(cracks(resumed.world(), contact::JointState::broken_shear) == shear);
+            CHECK(state_hash(resumed.world()) == state_hash(whole.world()));
         }
 }
 

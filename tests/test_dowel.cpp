@@ -92,43 +92,43 @@ Sheared shear_dowel(double slip, int threads, long save_at = -1) {
     AnalysisSpec an = m.file.analysis;
     an.solver.threads = threads;
     auto s = std::make_unique<Solver>(m.blocks, an);
-    s->install_supports({"dowel"});
-    const int upper = s->block_at({0.0, 0.5});
+    install_supports(s->world(), {"dowel"});
+    const int upper = block_at(s->world(), {0.0, 0.5});
     REQUIRE(upper >= 0);
     const long ramp = 200;
-    s->blocks().fixed_velocity[upper] = {slip / ramp, 0.0};
-    const auto& D = s->support<DowelSupport>().state();
+    s->world().loads.block_velocity[upper] = {slip / ramp, 0.0};
+    const auto& D = support_state<Dowels>(s->world().supports);
     REQUIRE(D.element_count() == 121);
     const int joint = 60; // the element from y = −0.005 to 0.005
     double last = 0.0;
     for (long k = 0; k < 400000; ++k) {
-        if (k == ramp) s->blocks().fixed_velocity[upper] = {};
+        if (k == ramp) s->world().loads.block_velocity[upper] = {};
         if (k == save_at) { // continue from a checkpoint in a new solver
             std::stringstream state;
-            s->save_state(state);
+            save_state(s->world(), state);
             auto resumed = std::make_unique<Solver>(m.blocks, an);
-            resumed->install_supports({"dowel"});
-            resumed->load_state(state);
+            install_supports(resumed->world(), {"dowel"});
+            load_state(resumed->world(), state);
             s = std::move(resumed);
         }
         s->step();
         if (k > ramp && k % 2000 == 0) {
-            const auto& d = s->support<DowelSupport>().state();
+            const auto& d = support_state<Dowels>(s->world().supports);
             const double v = (d.moment_a[joint] + d.moment_b[joint]) / d.rest[joint];
             if (std::abs(v - last) < 1e-7 * std::abs(v)) break;
             last = v;
         }
     }
-    const auto& E = s->support<DowelSupport>().state();
+    const auto& E = support_state<Dowels>(s->world().supports);
     Sheared r;
-    r.steps = s->steps();
-    r.hash = s->state_hash();
+    r.steps = s->world().clock.steps;
+    r.hash = state_hash(s->world());
     r.shear = std::abs((E.moment_a[joint] + E.moment_b[joint]) / E.rest[joint]);
     for (int e = 0; e < E.element_count(); ++e)
         for (double mo : {E.moment_a[e], E.moment_b[e]})
             if (std::abs(mo) > r.max_moment) {
                 r.max_moment = std::abs(mo);
-                r.max_moment_at = std::abs(E.position[mo == E.moment_a[e] ? e : e + 1].y);
+                r.max_moment_at = std::abs(E.nodes.position[mo == E.moment_a[e] ? e : e + 1].y);
             }
     return r;
 }
@@ -191,25 +191,25 @@ TEST_CASE("a pretensioned dowel clamps two blocks: the joint carries the dowel's
                                     "bolts = [[[0.0, -0.505], [0.0, 0.505]]]\nface_plate = true\nend_anchor = true\n"
                                     "pretension = 50e3\n"));
     Solver s(m.blocks, m.file.analysis);
-    s.install_supports({"dowel"});
-    const auto& D = s.support<DowelSupport>().state();
+    install_supports(s.world(), {"dowel"});
+    const auto& D = support_state<Dowels>(s.world().supports);
     REQUIRE(D.element_count() == 101);
     for (double n : D.axial) CHECK(n == T); // installed with its pretension
-    const int upper = s.block_at({0.0, 0.5});
+    const int upper = block_at(s.world(), {0.0, 0.5});
     for (long k = 0; k < 200000; ++k) {
         s.step();
-        if (k > 1000 && s.unbalanced_ratio() < 1e-10) break;
+        if (k > 1000 && s.world().clock.ratio < 1e-10) break;
     }
     Vec2 joint{};
     double moment = 0.0;
-    contact::block_contact_force(s.contacts(), upper, joint, moment);
+    contact::block_contact_force(contacts(s.world()), upper, joint, moment);
     const double tension = D.axial[50]; // the element across the joint
     MESSAGE("pretension " << T << " N/m: tension at the joint " << tension << " N/m, joint normal force " << joint.y
-                          << " N/m, " << s.steps() << " steps");
+                          << " N/m, " << s.world().clock.steps << " steps");
     CHECK(joint.y == doctest::Approx(tension).epsilon(1e-4));
     CHECK(tension == doctest::Approx(T).epsilon(0.02));
     CHECK(tension < T);
-    const auto summary = s.support<DowelSupport>().summary();
+    const auto summary = Dowels::summary(support_state<Dowels>(s.world().supports));
     REQUIRE(summary.size() == 1);
     CHECK(summary[0].figure("max_axial_kN") == doctest::Approx(T / 1e3).epsilon(0.02));
 }

@@ -56,10 +56,9 @@ StageSpec solve_stage(double ratio, long max_steps) {
 /// Displacement of every rigid block centroid and every node, in one list.
 std::vector<Vec2> displacements(const Solver& s) {
     std::vector<Vec2> u;
-    const auto& b = s.blocks();
-    for (int i = 0; i < b.count(); ++i)
-        if (!b.deformable[i]) u.push_back(b.centroid[i] - b.centroid0[i]);
-    const auto& n = s.nodes();
+    for (int i = 0; i < s.world().bodies.count(); ++i)
+        if (!s.world().blocks.deformable[i]) u.push_back(s.world().bodies.state[i].centroid - s.world().blocks.centroid0[i]);
+    const auto& n = s.world().nodes;
     for (int k = 0; k < n.count(); ++k) u.push_back(n.position[k] - n.position0[k]);
     return u;
 }
@@ -88,13 +87,13 @@ TEST_CASE("fem: CST patch test — a gmsh mesh of a square reproduces a linear f
         z.block.push_back(0);
         z.density.push_back(2700);
     }
-    z.index_nodes(nn);
+    fem::index_zone_nodes(z, nn);
 
     SUBCASE("explicit kernel: constant strain in every zone, interior nodes in balance") {
         std::vector<Vec2> v(nn), f(nn);
         for (int k = 0; k < nn; ++k) v[k] = field(mesh.nodes[k]); // one step of Δt = 1
         const std::uint8_t keep = 0;
-        fem::zone_pass(z, mesh.nodes.data(), v.data(), 1.0, &keep);
+        fem::zone_pass(z, mesh.nodes.data(), v.data(), 1.0, &keep, 0, fem::zone_items(z));
         for (int k = 0; k < nn; ++k) f[k] = fem::node_zone_force(z, k);
         double strain_err = 0.0;
         for (const auto& e : z.strain)
@@ -154,8 +153,8 @@ TEST_CASE("fem: Lamé thick-walled cylinder — stresses within 2% on a fine mes
         Solver s(blocks, file.analysis);
         const auto reports = run(s, file.analysis.stages);
         REQUIRE(reports.size() == 1);
-        const auto& z = s.zones();
-        const auto& n = s.nodes();
+        const auto& z = s.world().zones;
+        const auto& n = s.world().nodes;
         constexpr int rings = 8;
         double err_r[rings] = {}, err_t[rings] = {}, weight[rings] = {}, sq = 0.0, area = 0.0, worst = 0.0;
         for (int k = 0; k < z.size(); ++k) {
@@ -201,14 +200,14 @@ TEST_CASE("fem: hybrid rigid + deformable model — explicit and implicit soluti
     const auto file = read_verification("hybrid_elastic.toml");
     const auto blocks = meshing::generate_blocks(file.geometry);
     Solver implicit(blocks, file.analysis);
-    REQUIRE(implicit.zones().size() > 100);
+    REQUIRE(implicit.world().zones.size() > 100);
     int rigid = 0;
-    for (int i = 0; i < implicit.blocks().count(); ++i) rigid += !implicit.blocks().deformable[i];
+    for (int i = 0; i < implicit.world().bodies.count(); ++i) rigid += !implicit.world().blocks.deformable[i];
     REQUIRE(rigid > 15);
     const auto rep = run(implicit, file.analysis.stages);
     REQUIRE(rep.size() == 1);
-    MESSAGE("implicit: " << rep[0].method << ", ratio after " << implicit.unbalanced_ratio());
-    CHECK(implicit.unbalanced_ratio() < 1e-6);
+    MESSAGE("implicit: " << rep[0].method << ", ratio after " << implicit.world().clock.ratio);
+    CHECK(implicit.world().clock.ratio < 1e-6);
 
     Solver expl(blocks, file.analysis);
     const auto r2 = run(expl, {solve_stage(1e-6, 400000)});
@@ -224,11 +223,11 @@ TEST_CASE("fem: hybrid rigid + deformable model — explicit and implicit soluti
     // One ParaView file holds rigid blocks and zones.
     const auto dir = std::filesystem::temp_directory_path() / "bbm_test_fem_vtu";
     std::filesystem::create_directories(dir);
-    io::write_state_blocks_vtu(implicit, dir / "state.vtu");
+    io::write_state_blocks_vtu(implicit.world(), dir / "state.vtu");
     vtkNew<vtkXMLUnstructuredGridReader> reader;
     reader->SetFileName((dir / "state.vtu").c_str());
     reader->Update();
-    CHECK(reader->GetOutput()->GetNumberOfCells() == rigid + implicit.zones().size());
+    CHECK(reader->GetOutput()->GetNumberOfCells() == rigid + implicit.world().zones.size());
     CHECK(reader->GetOutput()->GetCellData()->GetArray("strain") != nullptr);
 }
 
@@ -240,10 +239,9 @@ TEST_CASE("fem: a stack of rigid and deformable blocks carries the same stress t
     REQUIRE(rep[0].converged);
     // Normal force per interface (pair of regions), over its 1 m width.
     std::map<std::pair<int, int>, double> load;
-    const auto& c = s.contacts();
-    const auto& b = s.blocks();
+    const auto& c = contacts(s.world());
     for (int i = 0; i < c.size(); ++i) {
-        const int ra = b.region[c.vertex_block[i]], rb = b.region[c.edge_block[i]];
+        const int ra = s.world().blocks.region[c.vertex_block[i]], rb = s.world().blocks.region[c.edge_block[i]];
         load[{std::min(ra, rb), std::max(ra, rb)}] += c.history[i].sn * c.length[i];
     }
     REQUIRE(load.size() == 3);
@@ -251,9 +249,9 @@ TEST_CASE("fem: a stack of rigid and deformable blocks carries the same stress t
     // Top block settlement = series sum: 3 joints + 2 blocks of 1 m.
     const double expected = 10e6 * (3.0 / 50e9 + 2.0 / 20e9);
     int cap = -1;
-    for (int i = 0; i < b.count(); ++i)
-        if (s.region_names()[b.region[i]] == "cap") cap = i;
-    const double settlement = b.centroid0[cap].y - b.centroid[cap].y;
+    for (int i = 0; i < s.world().bodies.count(); ++i)
+        if (s.world().region_names[s.world().blocks.region[i]] == "cap") cap = i;
+    const double settlement = s.world().blocks.centroid0[cap].y - s.world().bodies.state[cap].centroid.y;
     MESSAGE("settlement " << settlement << " m, series sum " << expected << " m");
     CHECK(settlement == doctest::Approx(expected).epsilon(0.01));
 }
@@ -266,7 +264,7 @@ TEST_CASE("fem: deformability split f = 0.5 and 0.95 keeps the rigid-block model
         const auto blocks = meshing::generate_blocks(f.geometry);
         Solver s(blocks, f.analysis);
         run(s, f.analysis.stages);
-        return sigma * sigma * width * height / (2.0 * s.strain_energy());
+        return sigma * sigma * width * height / (2.0 * strain_energy(s.world()));
     };
     const double e_rigid = modulus(file);
     MESSAGE("rigid blocks: E = " << e_rigid / 1e9 << " GPa");
@@ -291,12 +289,12 @@ TEST_CASE("fem: a deformable block slides down a deformable plane at g (sin θ �
     const auto blocks = meshing::generate_blocks(file.geometry);
     Solver s(blocks, file.analysis);
     run(s, {file.analysis.stages[0]});
-    const auto& n = s.nodes();
+    const auto& n = s.world().nodes;
     int block = -1;
-    for (int i = 0; i < s.blocks().count(); ++i)
-        if (s.region_names()[s.blocks().region[i]] == "block") block = i;
+    for (int i = 0; i < s.world().bodies.count(); ++i)
+        if (s.world().region_names[s.world().blocks.region[i]] == "block") block = i;
     REQUIRE(block >= 0);
-    REQUIRE(s.blocks().deformable[block]);
+    REQUIRE(s.world().blocks.deformable[block]);
     auto mean_velocity = [&] {
         double m = 0.0;
         Vec2 p{};
@@ -310,7 +308,7 @@ TEST_CASE("fem: a deformable block slides down a deformable plane at g (sin θ �
     Vec2 v0{};
     for (int step = 1; step <= 30000; ++step) {
         s.step();
-        if (step == 2000) t0 = s.time(), v0 = mean_velocity(); // past the first elastic waves
+        if (step == 2000) t0 = s.world().clock.time, v0 = mean_velocity(); // past the first elastic waves
         double sunk = 0.0; // the base's mean depth into the plane (held: its face stays at y = 0)
         int base = 0;
         for (int k = 0; k < n.count(); ++k)
@@ -321,7 +319,7 @@ TEST_CASE("fem: a deformable block slides down a deformable plane at g (sin θ �
             }
         deepest_base = std::max(deepest_base, sunk / base);
     }
-    const double a = (mean_velocity().x - v0.x) / (s.time() - t0);
+    const double a = (mean_velocity().x - v0.x) / (s.world().clock.time - t0);
     const double expected = g * (std::sin(theta) - std::cos(theta) * std::tan(phi));
     MESSAGE("slid " << slid << " m; a = " << a << " m/s² against " << expected << "; deepest node "
                     << deepest * 1e6 << " µm into the plane, the base as a whole " << deepest_base * 1e6 << " µm; the mean elastic overlap σn/kn " << sigma_n / kn * 1e6 << " µm");
@@ -352,7 +350,7 @@ TEST_CASE("fem: a P-wave travels down a deformable column at the P-wave speed wi
     const auto el = fem::Elasticity::from_young(E, nu);
     const double c = std::sqrt(el.p_modulus() / rho), plateau = 1e6 / (rho * c);
     // Nodes nearest the axis at depths 5 and 15 m below the loaded top.
-    const auto& n = s.nodes();
+    const auto& n = s.world().nodes;
     auto nearest = [&](Vec2 p) {
         int best = 0;
         for (int k = 0; k < n.count(); ++k)
@@ -363,11 +361,11 @@ TEST_CASE("fem: a P-wave travels down a deformable column at the P-wave speed wi
     double t_shallow = -1, t_deep = -1;
     auto crossing = [&](int node, double& t, double prev_v, double prev_t) {
         const double v = -n.velocity[node].y;
-        if (t < 0 && v >= 0.5 * plateau) t = prev_t + (s.time() - prev_t) * (0.5 * plateau - prev_v) / (v - prev_v);
+        if (t < 0 && v >= 0.5 * plateau) t = prev_t + (s.world().clock.time - prev_t) * (0.5 * plateau - prev_v) / (v - prev_v);
     };
     double vs = 0, vd = 0;
-    while (t_deep < 0 && s.time() < 20.0 / c * 1.5) {
-        const double t0 = s.time();
+    while (t_deep < 0 && s.world().clock.time < 20.0 / c * 1.5) {
+        const double t0 = s.world().clock.time;
         s.step();
         crossing(shallow, t_shallow, vs, t0);
         crossing(deep, t_deep, vd, t0);
@@ -376,7 +374,7 @@ TEST_CASE("fem: a P-wave travels down a deformable column at the P-wave speed wi
     REQUIRE(t_deep > 0);
     const double distance = n.position0[shallow].y - n.position0[deep].y;
     const double speed = distance / (t_deep - t_shallow);
-    MESSAGE("P-wave speed " << speed << " m/s, analytic " << c << " m/s, dt " << s.timestep() << " s");
+    MESSAGE("P-wave speed " << speed << " m/s, analytic " << c << " m/s, dt " << s.world().clock.dt << " s");
     CHECK(speed == doctest::Approx(c).epsilon(0.02));
     test::record_check(test::Against::closed_form, "speed of a P-wave down a column of triangles",
                        "c = √(M / ρ) = " + test::figure(c, 4) + " m/s", "within 2%",
@@ -412,7 +410,7 @@ type = "elastic"
 )", "floating.toml");
     Solver s(meshing::generate_blocks(file.geometry), file.analysis);
     CHECK_THROWS_WITH_AS(run(s, file.analysis.stages), doctest::Contains("region 'loose'"), std::runtime_error);
-    CHECK_THROWS_WITH_AS(s.solve_elastic(), doctest::Contains("floats"), std::runtime_error);
+    CHECK_THROWS_WITH_AS(solve_elastic(s.world()), doctest::Contains("floats"), std::runtime_error);
 }
 
 TEST_CASE("fem: the interface of a bonded-block region with the elastic far field carries a uniform stress" * validation) {
@@ -535,9 +533,8 @@ max_steps = 3000
         const auto blocks = meshing::generate_blocks(file.geometry);
         Solver s(blocks, file.analysis);
         run(s, file.analysis.stages);
-        CHECK(s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear) == 0);
-        const auto& b = s.blocks();
-        const auto stress = s.block_stresses();
+        CHECK(cracks(s.world(), contact::JointState::broken_tension) + cracks(s.world(), contact::JointState::broken_shear) == 0);
+        const auto stress = block_stresses(s.world());
         // Rigid blocks: those touching the interface (a vertex within 1 mm of x = 8
         // m), and those inside; away from the corners and the symmetry plane.
         struct Band {
@@ -545,23 +542,23 @@ max_steps = 3000
             int count = 0;
         } edge, inside;
         double move = 0.0;
-        for (int i = 0; i < b.count(); ++i) {
-            if (b.deformable[i]) continue;
-            move = std::max(move, norm(b.centroid[i] - b.centroid0[i]));
-            if (std::abs(b.centroid0[i].y) > 7.0 || b.centroid0[i].x < 1.0) continue;
+        for (int i = 0; i < s.world().bodies.count(); ++i) {
+            if (s.world().blocks.deformable[i]) continue;
+            move = std::max(move, norm(s.world().bodies.state[i].centroid - s.world().blocks.centroid0[i]));
+            if (std::abs(s.world().blocks.centroid0[i].y) > 7.0 || s.world().blocks.centroid0[i].x < 1.0) continue;
             bool on_edge = false;
-            for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v)
-                on_edge = on_edge || std::abs(b.centroid0[i].x + b.local[v].x - 8.0) < 1e-3;
+            for (std::uint32_t v = s.world().blocks.first[i]; v < s.world().blocks.first[i + 1]; ++v)
+                on_edge = on_edge || std::abs(s.world().blocks.centroid0[i].x + s.world().vertices.local[v].x - 8.0) < 1e-3;
             Band& band = on_edge ? edge : inside;
-            band.area += b.area[i], band.sxx += b.area[i] * stress[i][0], band.syy += b.area[i] * stress[i][1];
+            band.area += s.world().blocks.area[i], band.sxx += s.world().blocks.area[i] * stress[i][0], band.syy += s.world().blocks.area[i] * stress[i][1];
             band.worst = std::max(band.worst, std::abs(stress[i][1] / -15e6 - 1.0));
-            band.min_area = std::min(band.min_area, b.area[i]);
+            band.min_area = std::min(band.min_area, s.world().blocks.area[i]);
             ++band.count;
         }
         for (Band* band : {&edge, &inside}) band->sxx /= band->area, band->syy /= band->area;
         // Zones of the far field along the interface (centroid within 0.5 m of it).
-        const auto& z = s.zones();
-        const auto& n = s.nodes();
+        const auto& z = s.world().zones;
+        const auto& n = s.world().nodes;
         double zone_area = 0, zone_sxx = 0, zone_syy = 0;
         for (int e = 0; e < z.size(); ++e) {
             const auto& t = z.node[e];

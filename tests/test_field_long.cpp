@@ -99,11 +99,11 @@ TEST_CASE("field: depth of failure against stress, the Mine-by model from 0.24 t
         struct Quiet : StageObserver {} q;
         const auto reports = run_stages(s, model.file.analysis.stages, q);
         const auto& rep = model.file.analysis.report;
-        const auto zone = measure_failed_zone(s, rep.center, rep.springline, rep.crown);
+        const auto zone = measure_failed_zone(s.world(), rep.center, rep.springline, rep.crown);
         const double roof = depth_near(zone, 104.0), floor = depth_near(zone, 284.0);
         const double ratio = factor * (3 * sigma1 - sigma3) / ucs;
         Level l{factor, ratio, (a + std::max(roof, floor)) / a, ratio < 0.4 ? 1.0 : 1.25 * ratio + 0.51,
-                s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear),
+                cracks(s.world(), contact::JointState::broken_tension) + cracks(s.world(), contact::JointState::broken_shear),
                 zone.reaches_region_edge, reports.back().verdict.kind};
         MESSAGE("stress x " << factor << ": sigma_max/UCS " << ratio << ", cracks " << l.cracks << ", roof " << roof
                             << " m, floor " << floor << " m, rf/a " << l.rf_a << " (trend " << l.trend << "), edge "

@@ -47,8 +47,8 @@ TEST_CASE("heterogeneous strengths: joints fall evenly into the classes, the sam
         p.seed = seed;
         Solver s(blocks, labtest_analysis(p));
         std::vector<int> props;
-        for (int i = 0; i < s.contacts().size(); ++i) props.push_back(s.contacts().property[i]);
-        return std::pair{props, s.property_names()};
+        for (int i = 0; i < contacts(s.world()).size(); ++i) props.push_back(contacts(s.world()).property[i]);
+        return std::pair{props, s.world().properties.names};
     };
     const auto [a, names] = classes_of(1);
     const auto [b, names_b] = classes_of(1);

@@ -1138,8 +1138,8 @@ TEST_CASE("bolts: a set, its installation, and its mistakes") {
                                            "relax_steps = 100\nsteps = 40\n\n[[stage]]\ntype = \"install\"\n"
                                            "supports = [\"rebar\"]\n"),
                                 "t.toml");
-    REQUIRE(mf.analysis.bolts.size() == 1);
-    const auto& b = mf.analysis.bolts[0];
+    REQUIRE(support_state<bbm::Bolts>(mf.analysis.supports).size() == 1);
+    const auto& b = support_state<bbm::Bolts>(mf.analysis.supports)[0];
     CHECK(b.name == "rebar");
     CHECK(b.bolts.size() == 1);
     CHECK(b.area == doctest::Approx(4.9087e-4).epsilon(1e-4));
@@ -1162,7 +1162,7 @@ TEST_CASE("bolts: a set, its installation, and its mistakes") {
                 "[[bolt]]", "bolt[0].bond_stiffness", "missing required key 'bond_stiffness'");
     check_error(with("[[bolt]]\nname = \"b\"\nbolts = [[[0.0, 0.0], [1.0, 0.0]]]\nbond_stiffness = 1e9\n"
                      "area = 5e-4\ndiameter = 0.025\n"),
-                "[[bolt]]", "bolt[0].diameter", "give the steel's 'area' or its 'diameter', not both");
+                "diameter = 0.025", "bolt[0].diameter", "give the steel's 'area' or its 'diameter', not both");
     check_error(with(set + "[[stage]]\ntype = \"install\"\nsupports = [\"rebars\"]\n"), "supports",
                 "stage[0].supports[0]", "unknown support 'rebars' (did you mean 'rebar'?)");
     check_error(with("[[stage]]\ntype = \"excavate\"\nregions = [\"a\"]\nrelax_steps = 100\nsteps = 200\n"),
@@ -1173,10 +1173,10 @@ TEST_CASE("liners: a ring along an opening, and its mistakes") {
     const std::string liner = "[[liner]]\nname = \"shotcrete\"\ncenter = [0.0, 0.0]\nradius = 4.0\nfrom = -90.0\n"
                               "to = 90.0\nthickness = 0.1\nsymmetric_ends = true\n";
     const auto mf = parse_model(with(liner + "\n[[stage]]\ntype = \"install\"\nsupports = [\"shotcrete\"]\n"), "t.toml");
-    REQUIRE(mf.analysis.liners.size() == 1);
-    CHECK(mf.analysis.liners[0].radius == 4.0);
-    CHECK(mf.analysis.liners[0].symmetric_ends);
-    CHECK(mf.analysis.liners[0].young == 30e9);
+    REQUIRE(support_state<bbm::Liners>(mf.analysis.supports).size() == 1);
+    CHECK(support_state<bbm::Liners>(mf.analysis.supports)[0].radius == 4.0);
+    CHECK(support_state<bbm::Liners>(mf.analysis.supports)[0].symmetric_ends);
+    CHECK(support_state<bbm::Liners>(mf.analysis.supports)[0].young == 30e9);
     check_error(with("[[liner]]\nname = \"l\"\ncenter = [0, 0]\nradius = 1.0\n"), "[[liner]]", "liner[0].thickness",
                 "missing required key 'thickness'");
     check_error(with("[[liner]]\nname = \"l\"\ncenter = [0, 0]\nradius = 1.0\nthickness = 0.1\nsymmetric_ends = true\n"),

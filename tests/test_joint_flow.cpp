@@ -90,7 +90,7 @@ pressure = )" + std::to_string(p) +
 
 /// Mean effective normal and shear stress of the joint's contacts, length-weighted.
 std::pair<double, double> joint_stresses(const Solver& s) {
-    const auto& c = s.contacts();
+    const auto& c = contacts(s.world());
     double sn = 0, tau = 0, length = 0;
     for (int i = 0; i < c.size(); ++i)
         sn += c.length[i] * c.history[i].sn, tau += c.length[i] * std::abs(c.history[i].tau), length += c.length[i];
@@ -106,7 +106,7 @@ TEST_CASE("a joint with water at pressure p slides at tau = (sigma - p) tan(phi)
         CAPTURE(p);
         const Built m = build(sliding_joint(sigma, p));
         Solver s(m.blocks, m.file.analysis);
-        REQUIRE(s.flow() != nullptr);
+        REQUIRE(s.world().flow);
         for (int k = 0; k < 6000; ++k) s.step();
         const auto [sn, tau] = joint_stresses(s);
         // The law's normal stress is the skeleton's: σ − p; the total on the
@@ -120,7 +120,7 @@ TEST_CASE("a joint with water at pressure p slides at tau = (sigma - p) tan(phi)
                            "τ = (σ − p) tan φ = " + test::figure(tau_exact / 1e6, 4) + " MPa", "within 0.1%",
                            test::figure(tau / 1e6, 5) + " MPa (" + test::percent(tau, tau_exact, 2) + ")",
                            std::abs(tau / tau_exact - 1.0) <= 1e-3 && std::abs(sn / (sigma - p) - 1.0) <= 1e-3);
-        const auto& c = s.contacts();
+        const auto& c = contacts(s.world());
         double total = 0, length = 0;
         for (int i = 0; i < c.size(); ++i) total += dot(contact::contact_force(c, i), c.normal[i]), length += c.length[i];
         CHECK(total / length == doctest::Approx(sigma).epsilon(1e-3));
@@ -214,10 +214,10 @@ type = "elastic"
 /// y-displacement of the nodes of `region`'s blocks on y = 0, by x.
 std::map<double, double> face_displacement(const Solver& s, const std::string& region) {
     std::map<double, double> out;
-    const auto& n = s.nodes();
-    const auto& names = s.region_names();
+    const auto& n = s.world().nodes;
+    const auto& names = s.world().region_names;
     for (int k = 0; k < n.count(); ++k) {
-        if (names[s.blocks().region[n.block[k]]] != region) continue;
+        if (names[s.world().blocks.region[n.block[k]]] != region) continue;
         if (std::abs(n.position0[k].y) > 1e-9 || std::abs(n.position0[k].x) > sneddon_c) continue;
         out[n.position0[k].x] = n.position[k].y - n.position0[k].y;
     }
@@ -245,7 +245,7 @@ TEST_CASE("a pressurised crack in elastic blocks opens as Sneddon's: w = 4 (1 - 
     run_stages(s, m.file.analysis.stages, quiet);
     // The water pushes on the crack's faces with p over its whole length, 2 c.
     double push = 0;
-    const auto& c = s.contacts();
+    const auto& c = contacts(s.world());
     for (int i = 0; i < c.size(); ++i) push += c.fluid_pressure[i] * c.length[i];
     CHECK(push == doctest::Approx(sneddon_p * 2 * sneddon_c).epsilon(1e-9));
     const auto lid = face_displacement(s, "lid"), lower = face_displacement(s, "lower");
@@ -280,15 +280,15 @@ TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far
     }
     {
         Solver s(m.blocks, m.analysis);
-        const JointFlow& flow = *s.flow();
-        const auto& net = flow.network();
+        const JointFlow& flow = *s.world().flow;
+        const auto& net = flow.net;
         const double rho_g = 1000.0 * 9.81;
         // Held at the interface with the far field: hydrostatic from the table at y = 100 m.
         int held = 0;
         for (int d = 0; d < net.domains(); ++d)
-            if (flow.state().held[d]) {
+            if (flow.state.held[d]) {
                 ++held;
-                CHECK(flow.state().pressure[d] == doctest::Approx(rho_g * (100.0 - net.domain_position[d].y)));
+                CHECK(flow.state.pressure[d] == doctest::Approx(rho_g * (100.0 - net.domain_position[d].y)));
             }
         CHECK(held > 100);
         StageObserver quiet;
@@ -296,13 +296,13 @@ TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far
         // After excavation the wall is drained and water flows into the tunnel.
         int drained = 0;
         for (int d = 0; d < net.domains(); ++d)
-            if (flow.drained()[d]) {
+            if (flow.drained[d]) {
                 ++drained;
-                CHECK(flow.state().pressure[d] == 0.0);
+                CHECK(flow.state.pressure[d] == 0.0);
             }
         CHECK(drained > 20);
-        CHECK(flow.inflow() > 0.0);
-        MESSAGE("inflow " << flow.inflow() << " m2/s per m of the half model, " << drained << " drained domains");
+        CHECK(inflow(flow) > 0.0);
+        MESSAGE("inflow " << inflow(flow) << " m2/s per m of the half model, " << drained << " drained domains");
     }
     test::check_exact_restart(m, {300, 1000}, {2});
 }
@@ -361,24 +361,24 @@ box = { min = [-0.01, 0.49], max = [0.01, 0.51] }
 pressure = 1e6
 )");
     Solver s(m.blocks, m.file.analysis);
-    const JointFlow& flow = *s.flow();
-    const flow::FluidSpec& f = flow.fluid();
+    const JointFlow& flow = *s.world().flow;
+    const flow::FluidSpec& f = flow.fluid;
     const double diffusivity = f.bulk_modulus * a0 * a0 / (12.0 * f.viscosity);
     const double target = 1.5 * 1.5 / diffusivity; // √(D t) = 1.5 m
-    const long steps = long(std::ceil(target / s.timestep()));
+    const long steps = long(std::ceil(target / s.world().clock.dt));
     for (long k = 0; k < steps; ++k) s.step();
-    const double t = flow.state().time, spread = std::sqrt(diffusivity * t);
-    CHECK(t == doctest::Approx(steps * s.timestep()));
-    const auto& net = flow.network();
+    const double t = flow.state.time, spread = std::sqrt(diffusivity * t);
+    CHECK(t == doctest::Approx(steps * s.world().clock.dt));
+    const auto& net = flow.net;
     double worst = 0.0;
     int compared = 0;
     for (int i = 0; i < net.domains(); ++i) {
         const Vec2 x = net.domain_position[i];
         if (std::abs(x.y - 0.5) > 1e-9 || x.x < 1e-9) continue;
-        worst = std::max(worst, std::abs(flow.state().pressure[i] - p0 * std::erfc(x.x / (2.0 * spread))));
+        worst = std::max(worst, std::abs(flow.state.pressure[i] - p0 * std::erfc(x.x / (2.0 * spread))));
         ++compared;
     }
-    MESSAGE("transient stage: " << steps << " dynamic steps of " << s.timestep() << " s, sqrt(D t) = " << spread
+    MESSAGE("transient stage: " << steps << " dynamic steps of " << s.world().clock.dt << " s, sqrt(D t) = " << spread
                                 << " m; largest difference from erfc " << worst / p0 * 100.0 << "% of p0 at "
                                 << compared << " domains");
     CHECK(compared > 30);
@@ -389,7 +389,7 @@ pressure = 1e6
                        compared > 30 && worst < 1e-3 * p0);
     // The water pushes on the fracture's faces, the blocks held: no contact has
     // moved, and the apertures are a0 still.
-    for (double a : flow.contact_apertures(s.contacts())) CHECK((a == 0.0 || a == doctest::Approx(a0)));
+    for (double a : contact_apertures(flow, contacts(s.world()))) CHECK((a == 0.0 || a == doctest::Approx(a0)));
 }
 
 TEST_CASE("a borehole's pressurise stages: breakdown, shut-in and re-opening ramps; the wall's water follows the "
@@ -413,10 +413,10 @@ TEST_CASE("a borehole's pressurise stages: breakdown, shut-in and re-opening ram
                 if (st.kind != StageSpec::Kind::pressurise || k % 10 != 0) return;
                 const double from = st.pressure == 0.0 ? 6.5e6 : 0.0;
                 const double p = from + (st.pressure - from) * double(k) / double(st.steps);
-                const JointFlow& flow = *s.flow();
-                for (int d = 0; d < flow.network().domains(); ++d)
-                    if (flow.drained()[d]) {
-                        CHECK(flow.state().pressure[d] == doctest::Approx(p));
+                const JointFlow& flow = *s.world().flow;
+                for (int d = 0; d < flow.net.domains(); ++d)
+                    if (flow.drained[d]) {
+                        CHECK(flow.state.pressure[d] == doctest::Approx(p));
                         ++checked;
                     }
             }

@@ -123,7 +123,7 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
     struct Frame { double strain, stress, axial, inclined; };
     std::vector<Frame> frames;
     const auto on_frame = [&](const Solver& s, const StressStrainPoint& p) {
-        const auto& c = s.contacts();
+        const auto& c = contacts(s.world());
         double axial = 0, inclined = 0;
         int na = 0, ni = 0;
         for (int i = 0; i < c.size(); ++i) {
@@ -315,7 +315,7 @@ TEST_CASE("smooth platens hold the bottom face's middle blocks horizontally") {
         o.rough_platens = false;
         const Solver s(meshing::generate_blocks(labtest_geometry(o)), labtest_analysis(o));
         int held_x = 0, held_y = 0;
-        for (auto f : s.blocks().fixed) held_x += (f & 1) ? 1 : 0, held_y += (f & 2) ? 1 : 0;
+        for (auto f : s.world().loads.block_fixed) held_x += (f & 1) ? 1 : 0, held_y += (f & 2) ? 1 : 0;
         CHECK(held_x >= 1);
         CHECK(held_x <= 4);      // a few middle blocks, not the face
         CHECK(held_y > held_x);  // both faces are held vertically

@@ -418,7 +418,7 @@ TEST_CASE("field: the Mine-by tunnel in rock calibrated on crack initiation notc
     struct Quiet : StageObserver {} q;
     const auto reports = run_stages(s, file.analysis.stages, q);
     const auto& rep = file.analysis.report;
-    const auto zone = measure_failed_zone(s, rep.center, rep.springline, rep.crown);
+    const auto zone = measure_failed_zone(s.world(), rep.center, rep.springline, rep.crown);
     const auto lobes = zone.lobes();
     auto off = [](double deg, double target) { return std::abs(std::remainder(deg - target, 360.0)); };
     // The notches: the largest lobe near each notch direction; the side walls':

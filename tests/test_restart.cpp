@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <cstring>
 
 using namespace bbm;
 
@@ -64,11 +65,11 @@ TEST_CASE("every field of the state list is saved, hashed and counted") {
     Solver solver(m.blocks, m.analysis);
     struct Quiet : StageObserver {} quiet;
     run_stages(solver, m.analysis.stages, quiet);
-    REQUIRE(solver.bolts().node_count() > 0);
-    REQUIRE(solver.liners().node_count() > 0);
-    REQUIRE(solver.nodes().count() > 0);
+    REQUIRE(support_state<Bolts>(solver.world().supports).node_count() > 0);
+    REQUIRE(support_state<Liners>(solver.world().supports).node_count() > 0);
+    REQUIRE(solver.world().nodes.count() > 0);
 
-    auto fields = solver.state_fields();
+    auto fields = state_fields(solver.world());
     std::set<std::string> names;
     for (const auto& f : fields) CHECK_MESSAGE(names.insert(f.name).second, "field listed twice: " << f.name);
     auto field = [&](const std::string& name) -> StateField& {
@@ -86,49 +87,50 @@ TEST_CASE("every field of the state list is saved, hashed and counted") {
 
     auto save = [&](const Solver& s) {
         std::ostringstream o(std::ios::binary);
-        s.save_state(o);
+        save_state(s.world(), o);
         return o.str();
     };
-    const std::uint64_t hash = solver.state_hash();
+    const std::uint64_t hash = state_hash(solver.world());
     const std::string checkpoint = save(solver);
     int perturbed = 0;
     for (auto& f : fields) {
-        if (f.bytes.empty() || !(f.uses & (field_use::saved | field_use::hashed))) continue;
+        if (f.empty() || !(f.uses & (field_use::saved | field_use::hashed))) continue;
         INFO(f.name);
-        std::byte& last = f.bytes[f.bytes.size() - 1 - (f.element_size - 1) / 2]; // inside the last element
+        std::byte& last = f.element(f.size() - 1)[(f.element_size - 1) / 2]; // inside the last element
         last ^= std::byte{1};
-        CHECK((solver.state_hash() != hash) == bool(f.uses & field_use::hashed));
+        CHECK((state_hash(solver.world()) != hash) == bool(f.uses & field_use::hashed));
         if (f.uses & field_use::saved) CHECK(save(solver) != checkpoint);
         last ^= std::byte{1};
         ++perturbed;
     }
     CHECK(perturbed > 80); // 91 in this model
-    CHECK(solver.state_hash() == hash);
+    CHECK(state_hash(solver.world()) == hash);
 
     // Loaded into a new solver of the same model, every saved field is restored.
     Solver resumed(m.blocks, m.analysis);
     std::istringstream in(checkpoint, std::ios::binary);
-    resumed.load_state(in);
-    CHECK(resumed.state_hash() == hash);
-    const auto restored = resumed.state_fields();
+    load_state(resumed.world(), in);
+    CHECK(state_hash(resumed.world()) == hash);
+    const auto restored = state_fields(resumed.world());
     REQUIRE(restored.size() == fields.size());
     for (std::size_t k = 0; k < fields.size(); ++k)
         if (fields[k].uses & field_use::saved) {
             INFO(fields[k].name);
-            CHECK(std::equal(fields[k].bytes.begin(), fields[k].bytes.end(), restored[k].bytes.begin(),
-                             restored[k].bytes.end()));
+            REQUIRE(fields[k].size() == restored[k].size());
+            for (std::size_t e = 0; e < fields[k].size(); ++e)
+                CHECK(std::memcmp(fields[k].element(e), restored[k].element(e), fields[k].element_size) == 0);
         }
 
-    // The memory report is the list's capacities by group (and the contact batches).
+    // The memory report is the list's capacities by group.
     std::array<std::size_t, 6> by_group{};
     for (const auto& f : fields) by_group[std::size_t(f.group)] += f.capacity_bytes;
-    const auto memory = solver.memory();
-    CHECK(memory.blocks == by_group[std::size_t(MemoryGroup::blocks)]);
-    CHECK(memory.vertices == by_group[std::size_t(MemoryGroup::vertices)]);
-    CHECK(memory.nodes == by_group[std::size_t(MemoryGroup::nodes)]);
-    CHECK(memory.zones == by_group[std::size_t(MemoryGroup::zones)]);
-    CHECK(memory.other == by_group[std::size_t(MemoryGroup::other)]);
-    CHECK(memory.contacts >= by_group[std::size_t(MemoryGroup::contacts)]);
+    const auto report = memory(solver.world());
+    CHECK(report.blocks == by_group[std::size_t(MemoryGroup::blocks)]);
+    CHECK(report.vertices == by_group[std::size_t(MemoryGroup::vertices)]);
+    CHECK(report.nodes == by_group[std::size_t(MemoryGroup::nodes)]);
+    CHECK(report.zones == by_group[std::size_t(MemoryGroup::zones)]);
+    CHECK(report.other == by_group[std::size_t(MemoryGroup::other)]);
+    CHECK(report.contacts == by_group[std::size_t(MemoryGroup::contacts)]);
 }
 
 // `bbm run --profile` (StepProfile): every step counted, every stage timed, and
@@ -142,15 +144,18 @@ TEST_CASE("the step's stages are timed under --profile without changing the answ
     struct Quiet : StageObserver {} quiet;
     run_stages(timed, m.analysis.stages, quiet);
     run_stages(plain, m.analysis.stages, quiet);
-    CHECK(timed.state_hash() == plain.state_hash());
+    CHECK(state_hash(timed.world()) == state_hash(plain.world()));
     const auto& p = timed.profile();
-    CHECK(p.steps == timed.steps());
+    CHECK(p.steps == timed.world().clock.steps);
     double total = 0.0;
     for (double t : p.seconds) {
         CHECK(t >= 0.0);
         total += t;
     }
-    CHECK(p.seconds[StepProfile::contacts_and_zones] > 0.0);
-    CHECK(p.seconds[StepProfile::contacts_and_zones] < total);
+    // The contacts' row, read off the table.
+    std::size_t contacts_row = 0;
+    while (step_stages[contacts_row].name != "contacts") ++contacts_row;
+    CHECK(p.seconds[contacts_row] > 0.0);
+    CHECK(p.seconds[contacts_row] < total);
     CHECK(plain.profile().steps == 0);
 }

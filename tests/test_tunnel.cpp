@@ -44,8 +44,8 @@ TunnelRun run_tunnel(const std::string& name, long max_steps = 0) {
     Solver s(blocks, file.analysis);
     Quiet q;
     const auto reports = run_stages(s, file.analysis.stages, q);
-    return {measure_opening(s, {0, 0}, {4, 0}, {0, 4}), s.cracks(contact::JointState::broken_tension),
-            s.cracks(contact::JointState::broken_shear), reports.back().verdict, s.steps()};
+    return {measure_opening(s.world(), {0, 0}, {4, 0}, {0, 4}), cracks(s.world(), contact::JointState::broken_tension),
+            cracks(s.world(), contact::JointState::broken_shear), reports.back().verdict, s.world().clock.steps};
 }
 
 // Kirsch, plane strain, infinite plate, vertical p = 15 MPa and horizontal 7.5 MPa
@@ -73,18 +73,18 @@ TEST_CASE("tunnel: elastic Voronoi model — hoop stress within 15% of Kirsch at
     Quiet q;
     const auto reports = run_stages(s, file.analysis.stages, q);
     REQUIRE(reports.back().converged);
-    CHECK(s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear) == 0);
+    CHECK(cracks(s.world(), contact::JointState::broken_tension) + cracks(s.world(), contact::JointState::broken_shear) == 0);
     // The model's vertical stress at the tunnel axis is 15 MPa plus the weight of
     // 20 m of rock: Kirsch scaled by that ratio.
     const double scale = (15e6 + 2700 * 9.81 * 20) / 15e6;
-    const auto stress = s.block_stresses();
+    const auto stress = block_stresses(s.world());
     const Vec2 c{0, 0};
     // The records' figures at 5, 6 and 8 m.
     std::string spring_ref, spring_got, spring_off, crown_ref, crown_got, crown_off;
     bool spring_held = true, crown_held = true;
     for (double r : {5.0, 6.0, 8.0}) {
-        const double spring = -hoop_stress_at(s, stress, c, {4, 0}, r, 0.5) / 1e6;
-        const double crown = -hoop_stress_at(s, stress, c, {0, 4}, r, 0.5) / 1e6;
+        const double spring = -hoop_stress_at(s.world(), stress, c, {4, 0}, r, 0.5) / 1e6;
+        const double crown = -hoop_stress_at(s.world(), stress, c, {0, 4}, r, 0.5) / 1e6;
         const double ks = scale * kirsch_hoop(r, true), kc = scale * kirsch_hoop(r, false);
         MESSAGE("r = " << r << " m: springline " << spring << " MPa (Kirsch " << ks << ", " << (spring / ks - 1) * 100
                        << "%), crown " << crown << " MPa (Kirsch " << kc << ", " << (crown / kc - 1) * 100 << "%)");
@@ -121,10 +121,10 @@ TEST_CASE("tunnel: a run resumed from a checkpoint ends in the same state as an 
     // A checkpoint of another model is refused with a reason.
     Solver first(blocks, file.analysis);
     std::stringstream checkpoint;
-    first.save_state(checkpoint);
+    save_state(first.world(), checkpoint);
     auto other = read_example("verification/stack.toml");
     Solver wrong(meshing::generate_blocks(other.geometry), other.analysis);
-    CHECK_THROWS_WITH_AS(wrong.load_state(checkpoint), doctest::Contains("different model"), std::runtime_error);
+    CHECK_THROWS_WITH_AS(load_state(wrong.world(), checkpoint), doctest::Contains("different model"), std::runtime_error);
 }
 
 TEST_CASE("tunnel: the trigon model fails at the side walls, not at the crown" * validation) {
@@ -209,17 +209,16 @@ TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and ex
     const auto file = read_example("tunnel_voronoi.toml");
     const auto blocks = meshing::generate_blocks(file.geometry);
     Solver s(blocks, file.analysis);
-    auto& c = s.contacts();
-    const auto& b = s.blocks();
+    auto& c = contacts(s.world());
     const double a = 4.0, pi = 3.141592653589793;
     for (int i = 0; i < c.size(); ++i) {
-        const Vec2 x = b.centroid0[c.vertex_block[i]] + b.local[c.vertex_id[i]];
+        const Vec2 x = s.world().blocks.centroid0[c.vertex_block[i]] + s.world().vertices.local[c.vertex_id[i]];
         const double r = norm(x), angle = std::atan2(x.y, x.x) * 180 / pi;
         const bool wall = r - a < 1.2 && std::abs(angle) < 20.0;
         const bool deep = r - a > 3.0 && r - a < 3.6 && std::abs(angle - 90.0) < 20.0;
         if (wall || deep) c.history[i].broken = contact::JointState::broken_tension, c.history[i].bonded = false;
     }
-    const auto z = measure_failed_zone(s, {0, 0}, {4, 0}, {0, 4});
+    const auto z = measure_failed_zone(s.world(), {0, 0}, {4, 0}, {0, 4});
     MESSAGE("cell " << z.cell << " m; depth springline " << z.depth_springline << " m, crown " << z.depth_crown
                     << " m; extent " << z.extent_springline_deg << " deg; area " << z.area << " m2");
     // Depth: the outermost broken contact point, so 1.2 m or less by the spacing
@@ -246,7 +245,7 @@ TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and ex
     CHECK(z.area >= 0.8 * sector_area);
     CHECK(z.area <= 2.0 * sector_area);
     // The deepest single crack (OpeningMeasures) sees the crown cluster.
-    const auto m = measure_opening(s, {0, 0}, {4, 0}, {0, 4});
+    const auto m = measure_opening(s.world(), {0, 0}, {4, 0}, {0, 4});
     CHECK(m.failed_depth_crown > 3.0);
     // Neither reaches the bonded region's edge at x = 8 m (its interface with the
     // elastic far field).
@@ -258,13 +257,13 @@ TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and ex
     // to 6 m): not the zone, but damage along the edge.
     auto crack = [&](auto where) {
         for (int i = 0; i < c.size(); ++i) {
-            const Vec2 x = b.centroid0[c.vertex_block[i]] + b.local[c.vertex_id[i]];
-            if (where(x) && c.history[i].bonded && b.region[c.vertex_block[i]] == b.region[c.edge_block[i]])
+            const Vec2 x = s.world().blocks.centroid0[c.vertex_block[i]] + s.world().vertices.local[c.vertex_id[i]];
+            if (where(x) && c.history[i].bonded && s.world().blocks.region[c.vertex_block[i]] == s.world().blocks.region[c.edge_block[i]])
                 c.history[i].broken = contact::JointState::broken_tension, c.history[i].bonded = false;
         }
     };
     crack([](Vec2 x) { return x.x > 7.3 && x.x < 8.0 && x.y > 2.0 && x.y < 6.0; });
-    const auto column = measure_failed_zone(s, {0, 0}, {4, 0}, {0, 4});
+    const auto column = measure_failed_zone(s.world(), {0, 0}, {4, 0}, {0, 4});
     MESSAGE("column along the edge: " << column.edge_cells_damaged << " of " << column.edge_cells << " edge cells damaged");
     CHECK_FALSE(column.reaches_region_edge);
     CHECK(column.edge_cells_damaged >= 3);
@@ -272,7 +271,7 @@ TEST_CASE("failed zone: the damaged rock connected to the wall, its depth and ex
     // The wall's zone carried on to the edge along the springline: it reaches it,
     // at x about 8 m (and, joined to the column there, takes the column in).
     crack([](Vec2 x) { return x.x > 4.0 && x.x < 8.0 && std::abs(x.y) < 0.8; });
-    const auto through = measure_failed_zone(s, {0, 0}, {4, 0}, {0, 4});
+    const auto through = measure_failed_zone(s.world(), {0, 0}, {4, 0}, {0, 4});
     MESSAGE("zone to the edge: depth " << through.depth_springline << " m, edge point (" << through.region_edge_point.x
                                        << ", " << through.region_edge_point.y << ")");
     CHECK(through.reaches_region_edge);
@@ -295,14 +294,14 @@ TEST_CASE("field: the Mine-by model carries its inclined in-situ stress round th
     Solver s(blocks, file.analysis);
     Quiet q;
     (void)run_stages(s, file.analysis.stages, q);
-    const auto stress = s.block_stresses();
+    const auto stress = block_stresses(s.world());
     const double a = 1.75, p1 = 60.0, p3 = 11.0, plunge = 14.0 * std::numbers::pi / 180.0;
     auto kirsch = [&](double r, double theta) { // compression positive, theta from +x
         const double q2 = a * a / (r * r);
         return 0.5 * (p1 + p3) * (1 + q2) - 0.5 * (p1 - p3) * (1 + 3 * q2 * q2) * std::cos(2 * (theta - plunge));
     };
     auto hoop = [&](double r, double theta) {
-        return -hoop_stress_at(s, stress, {0, 0}, {std::cos(theta), std::sin(theta)}, r, 0.25) / 1e6;
+        return -hoop_stress_at(s.world(), stress, {0, 0}, {std::cos(theta), std::sin(theta)}, r, 0.25) / 1e6;
     };
     for (double deg : {104.0, 284.0}) {
         std::string wanted, measured, off; // the record's figures at 2.5, 3 and 4 m

@@ -171,7 +171,7 @@ max_steps = 100000
     Silent quiet;
     const auto r = run_stages(s, m.file.analysis.stages, quiet);
     const auto& v = r.back().verdict;
-    INFO(describe(v) << ", stopped at step " << r.back().steps << ", time " << s.time() << " s");
+    INFO(describe(v) << ", stopped at step " << r.back().steps << ", time " << s.world().clock.time << " s");
     CHECK(v.kind == K::equilibrium_with_fragments);
     CHECK(v.fragments == 1);
     CHECK(v.fragment_blocks == 1);
@@ -182,7 +182,7 @@ max_steps = 100000
     CHECK_FALSE(r.back().converged);
     // It stopped at rest, before the block landed (it is still above the base).
     CHECK(r.back().steps < 100000);
-    CHECK(s.time() < std::sqrt(2.0 * 4.0 / 9.81));
+    CHECK(s.world().clock.time < std::sqrt(2.0 * 4.0 / 9.81));
 }
 
 TEST_CASE("verdict: a stage can wait for equilibrium where the ratio comes while the rock still cracks" * validation) {
@@ -209,7 +209,8 @@ TEST_CASE("verdict: a stage can wait for equilibrium where the ratio comes while
         CHECK(r.back().converged);
         kinds[mode] = r.back().verdict.kind;
         steps[mode] = r.back().steps;
-        cracks[mode] = s.cracks(contact::JointState::broken_tension) + s.cracks(contact::JointState::broken_shear);
+        cracks[mode] = bbm::cracks(s.world(), contact::JointState::broken_tension) +
+                       bbm::cracks(s.world(), contact::JointState::broken_shear);
     }
     CHECK(kinds[0] == K::failing);
     CHECK(kinds[1] == K::equilibrium);
@@ -240,9 +241,9 @@ steps = 4000
     Solver first(m.blocks, m.file.analysis);
     run_stages(first, m.file.analysis.stages, stop);
     std::stringstream saved;
-    first.save_state(saved);
+    save_state(first.world(), saved);
     Solver resumed(m.blocks, m.file.analysis);
-    resumed.load_state(saved);
+    load_state(resumed.world(), saved);
     const auto v = run_stages(resumed, m.file.analysis.stages, quiet, stop.cursor).back().verdict;
     INFO(describe(reference) << " / resumed: " << describe(v));
     CHECK(v.kind == reference.kind);

@@ -47,8 +47,8 @@ Borehole pressurise(std::uint64_t seed, double pressure) {
     Borehole b;
     const auto kind = reports.back().verdict.kind;
     b.broke = kind != Verdict::Kind::equilibrium && kind != Verdict::Kind::equilibrium_with_fragments;
-    const auto& c = s.contacts();
-    const auto& v = s.blocks().vertex;
+    const auto& c = contacts(s.world());
+    const auto& v = s.world().vertices.position;
     for (int i = 0; i < c.size(); ++i) {
         const auto state = contact::state_of(c.history[i]);
         if (state != contact::JointState::broken_tension && state != contact::JointState::broken_shear) continue;
@@ -129,9 +129,9 @@ namespace {
 
 /// Water stored in the joints, m³ per metre: what a pump reads as injected volume.
 double stored_water(const Solver& s) {
-    const auto* f = s.flow();
+    const JointFlow& f = *s.world().flow;
     double volume = 0.0;
-    for (int q = 0; q < f->network().pipes(); ++q) volume += f->state().aperture[q] * f->network().pipe_length[q];
+    for (int q = 0; q < f.net.pipes(); ++q) volume += f.state.aperture[q] * f.net.pipe_length[q];
     return volume;
 }
 
@@ -253,7 +253,7 @@ TEST_CASE("the Mine-by damaged zone for water: within 0.6 radii of the wall, mos
         StageObserver quiet;
         const auto reports = run_stages(s, file.analysis.stages, quiet);
         const auto& rep = file.analysis.report;
-        const auto k = measure_axial_permeability(s, rep.center, rep.springline, rep.crown, 0.1 * radius);
+        const auto k = measure_axial_permeability(s.world(), rep.center, rep.springline, rep.crown, 0.1 * radius);
         MESSAGE("seed " << seed << ": intact " << k.intact << " m2; damaged zone " << k.edz_joints << " joints, "
                         << k.edz_area << " m2, " << k.edz_depth << " m deep, k " << k.edz_permeability
                         << " m2; 90% of its transmissivity in " << k.core_joints << " joints bordering "

@@ -211,26 +211,32 @@ def test_state_fields_are_the_solvers_list():
 
 def test_bolt_arrays_of_the_bolted_tunnel():
     m = bbm.Model(str(SOURCE / "examples/support/tunnel_voronoi_bolted.toml"), threads=2)
-    assert m.bolts.node_count == 0  # installed by a stage
+    assert m.bolts.count == 0  # installed by a stage
     m.run()
     b = m.bolts
     assert b.set_names == ["rebar"]
-    assert b.position.shape == (b.node_count, 2)
-    assert b.axial_force.shape == (b.segment_count,) and b.state.shape == (b.segment_count,)
+    assert b.position.shape == (b.count, 2)
+    segments = len(b.segment_node)
+    drawn = b.lines  # per bolt, as bolts.pvd has them
+    assert drawn["axial_force_kN"].shape == (segments,) and b.state.shape == (segments,)
     # Loaded in tension by the converging wall, within the steel's yield (200 kN).
-    assert 10e3 < b.axial_force.max() <= 200e3 * (1 + 1e-9)
+    assert 10 < drawn["axial_force_kN"].max() <= 200 * (1 + 1e-9)
     assert np.abs(b.bond).max() > 0
+    assert b.summary[0]["name"] == "rebar" and b.summary[0]["yielded"] >= 0
+    # Every support type's fields are there, dowels too (none in this model).
+    assert m.dowels.count == 0 and "shear" in m.dowels.fields
 
 
 def test_liner_arrays_of_the_shotcreted_tunnel():
     m = bbm.Model(str(SOURCE / "examples/support/tunnel_voronoi_bolted_shotcrete.toml"), threads=2)
     m.run()
     l = m.liners
-    assert l.names == ["shotcrete"]
-    assert l.position.shape == (l.node_count, 2) and l.moment.shape == (l.element_count, 2)
+    assert l.set_names == ["shotcrete"]
+    elements = len(l.element_node)
+    assert l.position.shape == (l.count, 2) and l.moment_a.shape == (elements,)
     # The lining is in compression, within its 3 MN/m capacity, pressed on by the rock.
     assert 0 < l.thrust.min() and l.thrust.max() <= 3e6 * (1 + 1e-9)
-    assert l.interface_normal_stress.min() < 0
+    assert l.normal_stress.min() < 0
 
 
 def test_envelope_small_specimen():

@@ -1,0 +1,589 @@
+// The stages of a step (core/step.hpp) and the driver that walks them.
+#include "core/step.hpp"
+
+#include "core/measures.hpp"
+#include "core/supports/ties.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <omp.h>
+#include <utility>
+
+namespace bbm {
+
+contact::BlockView block_view(const World& w) {
+    return {w.bodies.state.data(),   w.vertices.position.data(), w.blocks.first.data(),
+            w.vertices.inv_edge_length.data(), w.blocks.deformable.data(), w.vertices.node.data(),
+            w.nodes.velocity.data(), w.vertices.corner.data()};
+}
+
+namespace {
+
+// --- shares -------------------------------------------------------------------
+
+/// [first, last) of `n` items split into equal contiguous parts (items that cost
+/// about the same: faces, zone items, nodes).
+Range equal_share(int n, const StepContext& ctx) {
+    return {int(std::int64_t(n) * ctx.thread / ctx.team), int(std::int64_t(n) * (ctx.thread + 1) / ctx.team)};
+}
+
+Range by_cost(const std::vector<double>& cost_before, const StepContext& ctx) {
+    const auto [first, last] = contact::team_share(cost_before, ctx.thread, ctx.team);
+    return {first, last};
+}
+
+// --- 0. placing the bodies ------------------------------------------------------
+
+void place_rigid_block(World& w, int i) {
+    const contact::BodyState& b = w.bodies.state[i];
+    const Rotation rot = rotation(b.theta);
+    const Vec2 c = b.centroid;
+    for (std::uint32_t v = w.blocks.first[i]; v < w.blocks.first[i + 1]; ++v)
+        w.vertices.position[v] = c + rot(w.vertices.local[v]);
+}
+
+void place_deformable_block(World& w, int i) {
+    // The polygon follows the boundary nodes; edge lengths change.
+    auto& x = w.vertices;
+    const std::uint32_t v0 = w.blocks.first[i], v1 = w.blocks.first[i + 1];
+    for (std::uint32_t v = v0; v < v1; ++v) x.position[v] = w.nodes.position[x.node[v]];
+    for (std::uint32_t v = v0; v < v1; ++v)
+        x.inv_edge_length[v] = 1.0 / norm(x.position[v + 1 == v1 ? v0 : v + 1] - x.position[v]);
+}
+
+void place_stage(World& w, const StepContext&, Range r) {
+    for (int i = r.first; i < r.last; ++i) {
+        if (w.blocks.deformable[i]) place_deformable_block(w, i);
+        else if (!w.bodies.removed[i]) place_rigid_block(w, i);
+    }
+}
+
+Range place_share(const World& w, const StepContext& ctx) { return by_cost(w.team.place_cost_before, ctx); }
+
+// --- 1. contact detection ---------------------------------------------------------
+
+/// One pass of the detector over the active blocks, by the whole team; then, on
+/// one thread, the bookkeeping and the index if contacts changed.
+void detection_pass(World& w) {
+    auto& d = w.detection;
+    contact::DetectionInput in{block_view(w), w.bodies.count(), w.bodies.removed.data(), d.active.data(),
+                               d.tolerance, w.properties.new_contact, w.clock.dt, &d.junctions, d.corner_radius,
+                               w.settings.new_contact_length == SolverSpec::NewContactLength::overlap};
+    const auto r = contact::detect(w.contacts, d.detector, in);
+#pragma omp single
+    {
+        for (int i = 0; i < w.bodies.count(); ++i) {
+            if (!d.active[i]) continue;
+            d.detected_at[i] = w.bodies.state[i].centroid, d.detected_theta[i] = w.bodies.state[i].theta;
+            if (w.blocks.deformable[i])
+                for (std::uint32_t v = w.blocks.first[i]; v < w.blocks.first[i + 1]; ++v)
+                    d.detected_vertex[v] = w.vertices.position[v];
+        }
+        d.totals.created += r.created;
+        d.totals.removed += r.removed;
+        d.totals.transferred += r.transferred;
+        d.totals.removed_tensile += r.removed_tensile;
+        d.totals.removed_shear += r.removed_shear;
+        // A contact passed to another edge of a deformable block loads that edge's
+        // nodes: the per-node index (and the faces of face_shear) must follow it,
+        // or its force would go on to the nodes it left, and a resumed run, which
+        // builds the index afresh, would part from the uninterrupted one.
+        const bool moved_on_nodes = d.detector.transferred_on_nodes > 0;
+        if (r.created > 0 || r.removed > 0 || moved_on_nodes) {
+            // New contacts are appended; once they are more than a sixteenth of all,
+            // renumber the contacts by block again (the loop's locality) — rarely
+            // enough that the renumbering costs little.
+            d.unsorted_contacts += r.created;
+            if (16 * d.unsorted_contacts > w.contacts.size()) {
+                contact::sort_contacts_by_blocks(w.contacts);
+                d.unsorted_contacts = 0;
+            }
+            reindex_contacts(w);
+            update_timestep(w);
+        }
+    }
+}
+
+void detection_stage(World& w, const StepContext&, Range) {
+    // Every few steps: which blocks have moved a quarter of the tolerance since
+    // their last pass? Only they (and their neighbours) are examined. A deformable
+    // block counts as moved when any of its boundary vertices has. The scan and
+    // the pass's search are shared by the team.
+    if (w.clock.steps % 4 != 0) return;
+    auto& d = w.detection;
+    const double limit = 0.25 * d.tolerance;
+    const int nb = w.bodies.count();
+#pragma omp single
+    d.any_active = 0;
+    bool any = false;
+#pragma omp for schedule(static) nowait
+    for (int i = 0; i < nb; ++i) {
+        bool moved = false;
+        if (w.bodies.removed[i]) {
+        } else if (w.blocks.deformable[i]) {
+            for (std::uint32_t v = w.blocks.first[i]; v < w.blocks.first[i + 1] && !moved; ++v)
+                moved = norm2(w.vertices.position[v] - d.detected_vertex[v]) >= limit * limit;
+        } else {
+            const auto& b = w.bodies.state[i];
+            moved = norm(b.centroid - d.detected_at[i]) + std::abs(b.theta - d.detected_theta[i]) * d.radius[i] >= limit;
+        }
+        d.active[i] = moved;
+        any = any || moved;
+    }
+    if (any) {
+#pragma omp atomic write
+        d.any_active = 1;
+    }
+#pragma omp barrier
+    if (d.any_active) detection_pass(w);
+}
+
+// --- water in the joints ------------------------------------------------------------
+
+void flow_stage(World& w, const StepContext&, Range) { advance_flow(*w.flow, w.contacts, w.clock.dt, w.clock.steps); }
+bool has_flow(const World& w) { return w.flow.has_value(); }
+
+// --- 2. rigid faces on deformable blocks: their mean slip ----------------------------
+
+void face_slip_stage(World& w, const StepContext&, Range r) {
+    contact::face_slip_pass(w.contacts, block_view(w), w.clock.dt, w.detection.corner_radius, r.first, r.last);
+}
+Range face_share(const World& w, const StepContext& ctx) { return equal_share(contact::face_count(w.contacts), ctx); }
+bool has_faces(const World& w) { return contact::face_count(w.contacts) > 0; }
+
+// --- 4. the supports: their forces and what their ties put on the rock -------------
+
+void support_stage(World& w, const StepContext&, Range) {
+    const SupportRock rock = support_rock(w);
+    std::size_t k = 0;
+    for_each_support(w.supports, [&](auto type, auto& state) {
+        using T = typename decltype(type)::type;
+        const int first = w.ties.first[k++];
+        if (T::tie_count(state) > 0) T::force_pass(state, rock, w.ties.reaction.data() + first, w.ties.moment.data() + first);
+    });
+}
+bool has_ties(const World& w) { return !w.ties.reaction.empty(); }
+
+// --- 2, 3. contacts and zones ---------------------------------------------------------
+
+/// A team times its shares of the contact and zone passes: balance_contact_pass()
+/// moves the contacts' split toward equal times.
+bool timed(const World& w, const StepContext& ctx) {
+    return ctx.team > 1 && int(w.team.pass_time.size()) == ctx.team;
+}
+
+void contact_stage(World& w, const StepContext& ctx, Range r) {
+    const double t0 = timed(w, ctx) ? omp_get_wtime() : 0.0;
+    contact::contact_pass(w.contacts, w.properties.laws, block_view(w), w.clock.dt, w.detection.corner_radius, r.first,
+                          r.last);
+    w.normals_stale = true;
+    if (timed(w, ctx)) w.team.pass_time[ctx.thread].contacts += omp_get_wtime() - t0;
+}
+Range contact_share(const World& w, const StepContext& ctx) {
+    const auto [first, last] = contact::contact_share(w.contacts, ctx.thread, ctx.team);
+    return {first, last};
+}
+
+void zone_stage(World& w, const StepContext& ctx, Range r) {
+    const double t0 = timed(w, ctx) ? omp_get_wtime() : 0.0;
+    fem::zone_pass(w.zones, w.nodes.position.data(), w.nodes.velocity.data(), w.clock.dt, w.bodies.removed.data(),
+                   r.first, r.last);
+    if (timed(w, ctx)) w.team.pass_time[ctx.thread].zones += omp_get_wtime() - t0;
+}
+Range zone_share(const World& w, const StepContext& ctx) { return equal_share(fem::zone_items(w.zones), ctx); }
+
+// --- 4. the gather: each body's forces with its loads ----------------------------------
+
+/// The support of the excavated rock now: relaxed linearly to the fraction kept
+/// (a fictitious support pressure, the convergence–confinement method's 1 − λ),
+/// or its mean and deviator each along a path (a face going by, theory.md §6.5):
+/// the factors on the whole in-situ support and on its deviatoric part besides.
+std::pair<double, double> relaxation_factors(const Loads& l) {
+    if (l.relax_block_force.empty() && l.relax_node_force.empty()) return {0.0, 0.0};
+    if (l.relax_path.empty())
+        return {l.relax_left > 0 ? l.relax_keep + (1.0 - l.relax_keep) * double(l.relax_left) / double(l.relax_total + 1)
+                                 : l.relax_keep,
+                0.0};
+    // Along the path: at t = k / (N + 1) on the k-th step of N (the linear
+    // relaxation's factor is 1 − t), then at its last row.
+    const auto& path = l.relax_path;
+    const double t = l.relax_left > 0 ? 1.0 - double(l.relax_left) / double(l.relax_total + 1) : 1.0;
+    std::size_t r = 3;
+    while (r + 3 < path.size() && path[r] < t) r += 3;
+    const double t0 = path[r - 3], t1 = path[r], s = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    const double k_mean = (1.0 - s) * path[r - 2] + s * path[r + 1];
+    const double k_deviator = (1.0 - s) * path[r - 1] + s * path[r + 2];
+    return {k_mean, k_deviator - k_mean};
+}
+
+/// The load factors of a gather, the same for every body of a step.
+struct GatherFactors {
+    double relax = 0.0, deviator = 0.0, pressure_scale = 1.0;
+    bool pressure = false, ties = false;
+    explicit GatherFactors(const World& w) {
+        // (Plain members, not a structured binding: clang 14 cannot use one in the loops.)
+        const std::pair<double, double> f = relaxation_factors(w.loads);
+        relax = f.first, deviator = f.second;
+        pressure = !w.loads.pressure_block_force.empty();
+        // 1 as excavated (x 1.0 is exact: the same bits as without a scale).
+        pressure_scale = w.loads.pressure_scale.empty() ? 1.0 : w.loads.pressure_scale[0];
+        ties = !w.ties.reaction.empty();
+    }
+};
+
+void gather_block_stage(World& w, const StepContext&, Range r) {
+    // One gather per block: its contacts' forces in a fixed order, plus gravity,
+    // boundary loads, relaxing and constant support pressures and the reactions
+    // of its support ties. Deformable blocks gather through their nodes.
+    const GatherFactors k(w);
+    const Vec2 g = w.settings.gravity;
+    const auto& l = w.loads;
+    const auto& t = w.ties;
+    for (int i = r.first; i < r.last; ++i) {
+        Vec2 f{};
+        double m = 0.0;
+        if (!w.blocks.deformable[i]) contact::block_contact_force(w.contacts, i, f, m);
+        f += l.block_force[i] + w.blocks.real_mass[i] * g;
+        m += l.block_moment[i];
+        if (k.relax != 0.0) f += k.relax * l.relax_block_force[i], m += k.relax * l.relax_block_moment[i];
+        if (k.deviator != 0.0)
+            f += k.deviator * l.deviator_block_force[i], m += k.deviator * l.deviator_block_moment[i];
+        if (k.pressure) f += k.pressure_scale * l.pressure_block_force[i], m += k.pressure_scale * l.pressure_block_moment[i];
+        if (k.ties)
+            for (int e = t.block_first[i]; e < t.block_first[i + 1]; ++e) {
+                const int tie = t.block_tie[e];
+                f += t.reaction[tie], m += t.moment[tie];
+            }
+        w.bodies.force[i] = f;
+        w.bodies.moment[i] = m;
+    }
+}
+Range gather_block_share(const World& w, const StepContext& ctx) { return by_cost(w.team.gather_cost_before, ctx); }
+
+void gather_node_stage(World& w, const StepContext&, Range r) {
+    const GatherFactors k(w);
+    const Vec2 g = w.settings.gravity;
+    const auto& l = w.loads;
+    const auto& t = w.ties;
+    for (int n = r.first; n < r.last; ++n) {
+        Vec2 f = contact::node_contact_force(w.contacts, n) + fem::node_zone_force(w.zones, n) + l.node_force[n] +
+                 w.nodes.real_mass[n] * g;
+        if (k.relax != 0.0) f += k.relax * l.relax_node_force[n];
+        if (k.deviator != 0.0) f += k.deviator * l.deviator_node_force[n];
+        if (k.pressure) f += k.pressure_scale * l.pressure_node_force[n];
+        if (k.ties)
+            for (int e = t.node_first[n]; e < t.node_first[n + 1]; ++e) {
+                const auto [tie, weight] = t.node_tie[e];
+                f += weight * t.reaction[tie];
+            }
+        w.nodes.force[n] = f;
+    }
+}
+Range node_share(const World& w, const StepContext& ctx) { return equal_share(w.nodes.count(), ctx); }
+
+// --- 5. damping and integration ----------------------------------------------------------
+
+/// Local damping against the velocity, branch-free (the sign of v is as good as
+/// random to the branch predictor): sign(v) is 0 at rest.
+inline double damped(double f, double v, double alpha) { return f - alpha * std::abs(f) * double((v > 0.0) - (v < 0.0)); }
+
+/// Translation of one body (rigid block or node): damped central difference with
+/// its prescribed components held; returns the work of its loads and of the
+/// supports on the prescribed components (reaction −F) over the step, and raises
+/// `unbalanced` to its largest free force component.
+inline double translate(std::uint8_t fx, Vec2& v, Vec2 f, Vec2 fixed_v, double mass, Vec2 load, double alpha, double dt,
+                        double& unbalanced) {
+    if (!(fx & 1)) unbalanced = std::max(unbalanced, std::abs(f.x));
+    if (!(fx & 2)) unbalanced = std::max(unbalanced, std::abs(f.y));
+    v.x = (fx & 1) ? fixed_v.x : v.x + damped(f.x, v.x, alpha) / mass * dt;
+    v.y = (fx & 2) ? fixed_v.y : v.y + damped(f.y, v.y, alpha) / mass * dt;
+    double work = dot(load, v) * dt;
+    if (fx & 1) work -= f.x * v.x * dt;
+    if (fx & 2) work -= f.y * v.y * dt;
+    return work;
+}
+
+double integrate_block(World& w, int i, double& unbalanced) {
+    if (w.bodies.removed[i] || w.blocks.deformable[i]) return 0.0;
+    const double alpha = w.settings.damping, dt = w.clock.dt;
+    const auto& l = w.loads;
+    const std::uint8_t fx = l.block_fixed[i];
+    contact::BodyState& b = w.bodies.state[i];
+    double work = translate(fx, b.velocity, w.bodies.force[i], l.block_velocity[i], w.bodies.mass[i],
+                            l.block_force[i] + w.blocks.real_mass[i] * w.settings.gravity, alpha, dt, unbalanced);
+    const double m = w.bodies.moment[i];
+    b.omega = (fx & 4) ? l.block_omega[i] : b.omega + damped(m, b.omega, alpha) / w.bodies.inertia[i] * dt;
+    work += (l.block_moment[i] - ((fx & 4) ? m : 0.0)) * b.omega * dt;
+    b.centroid += dt * b.velocity;
+    b.theta += dt * b.omega;
+    return work;
+}
+
+double integrate_node(World& w, int i, double& unbalanced) {
+    if (w.bodies.removed[w.nodes.block[i]]) return 0.0;
+    const auto& l = w.loads;
+    Vec2& v = w.nodes.velocity[i];
+    const double work = translate(l.node_fixed[i], v, w.nodes.force[i], l.node_velocity[i], w.nodes.mass[i],
+                                  l.node_force[i] + w.nodes.real_mass[i] * w.settings.gravity, w.settings.damping,
+                                  w.clock.dt, unbalanced);
+    w.nodes.position[i] += w.clock.dt * v;
+    return work;
+}
+
+void integrate_stage(World& w, const StepContext&, Range r) {
+    // The work and the largest unbalanced force per fixed chunk of bodies, summed
+    // over the chunks in order by the next row: the same bits on any thread count.
+    constexpr int chunk_size = Team::sum_chunk;
+    const int nb = w.bodies.count(), nn = w.nodes.count(), block_chunks = Team::chunks_of(nb);
+    for (int chunk = r.first; chunk < r.last; ++chunk) {
+        double work = 0.0, unbalanced = 0.0;
+        if (chunk < block_chunks) {
+            for (int i = chunk * chunk_size; i < std::min(nb, (chunk + 1) * chunk_size); ++i)
+                work += integrate_block(w, i, unbalanced);
+        } else {
+            const int c = chunk - block_chunks;
+            for (int i = c * chunk_size; i < std::min(nn, (c + 1) * chunk_size); ++i) work += integrate_node(w, i, unbalanced);
+        }
+        w.team.chunk_sums[chunk] = {work, unbalanced};
+    }
+}
+Range chunk_share(const World& w, const StepContext& ctx) { return by_cost(w.team.chunk_cost_before, ctx); }
+
+// --- 6. the convergence measure -------------------------------------------------------------
+
+} // namespace
+
+void sum_boundary_forces(World& w) {
+    const Vec2 g = w.settings.gravity;
+    auto& b = w.boundaries;
+    for (std::size_t k = 0; k < b.names.size(); ++k) {
+        Vec2 sum{};
+        for (int i : b.blocks[k]) sum += w.bodies.force[i] - w.loads.block_force[i] - w.blocks.real_mass[i] * g;
+        for (int i : b.nodes[k]) sum += w.nodes.force[i] - w.loads.node_force[i] - w.nodes.real_mass[i] * g;
+        b.force[k] = sum;
+    }
+}
+
+namespace {
+
+void ratio_stage(World& w, const StepContext&, Range) {
+    sum_boundary_forces(w);
+    double max_unbalanced = 0.0;
+    const int chunks = Team::chunks_of(w.bodies.count()) + Team::chunks_of(w.nodes.count());
+    for (int chunk = 0; chunk < chunks; ++chunk) {
+        w.clock.work += w.team.chunk_sums[chunk].work;
+        max_unbalanced = std::max(max_unbalanced, w.team.chunk_sums[chunk].unbalanced);
+    }
+    const SupportMotion motion{w.clock.dt, w.settings.damping, w.settings.gravity};
+    for_each_support(w.supports, [&](auto type, auto& state) {
+        using T = typename decltype(type)::type;
+        if (T::tie_count(state) > 0) max_unbalanced = std::max(max_unbalanced, T::integrate(state, motion, w.clock.work));
+    });
+    const double scale = force_scale(w);
+    w.clock.ratio = scale > 0.0 ? max_unbalanced / scale : 0.0;
+}
+
+// --- bookkeeping --------------------------------------------------------------------------
+
+void release_relaxation(Loads& l) {
+    const std::size_t rows = l.relax_path.size();
+    const bool kept = l.relax_keep != 0.0 || (rows > 0 && (l.relax_path[rows - 2] != 0.0 || l.relax_path[rows - 1] != 0.0));
+    if (l.relax_left > 0 && --l.relax_left == 0 && !kept) {
+        l.relax_block_force.clear();
+        l.relax_block_moment.clear();
+        l.relax_node_force.clear();
+        l.relax_path.clear();
+        l.deviator_block_force.clear();
+        l.deviator_block_moment.clear();
+        l.deviator_node_force.clear();
+    }
+}
+
+void balance_contact_pass(World& w) {
+    // Thread t ran the share s_t of the contacts' estimated cost in C_t seconds
+    // (ρ_t = C_t / s_t per unit share) and its equal part of the zones in Z_t.
+    // Equal times ρ_t s'_t + Z_t = K with Σ s'_t = 1 give
+    //   s'_t = (K − Z_t) / ρ_t,  K = (1 + Σ Z_t / ρ_t) / Σ 1 / ρ_t;
+    // the split moves half way there (the rates are local and the clock noisy).
+    // The arrays are sized when the world is built: a step allocates nothing.
+    const int team = w.settings.threads;
+    auto& split = w.contacts.team_split;
+    auto& pass_time = w.team.pass_time;
+    if (team < 2 || int(pass_time.size()) != team || int(split.size()) != team + 1) return;
+    double* rate = w.team.balance_scratch.data();
+    double* target = rate + team;
+    double inverse_rates = 0.0, zone_terms = 0.0;
+    bool measured = true;
+    for (int t = 0; t < team; ++t) {
+        const double share = split[t + 1] - split[t];
+        measured = measured && pass_time[t].contacts > 0.0 && share > 0.0;
+        rate[t] = pass_time[t].contacts / std::max(share, 1e-6);
+        if (rate[t] <= 0.0) continue;
+        inverse_rates += 1.0 / rate[t];
+        zone_terms += pass_time[t].zones / rate[t];
+    }
+    if (measured) {
+        const double level = (1.0 + zone_terms) / inverse_rates;
+        double total = 0.0;
+        for (int t = 0; t < team; ++t) total += target[t] = std::max(0.02, (level - pass_time[t].zones) / rate[t]);
+        double at = 0.0;
+        for (int t = 1; t < team; ++t) {
+            at += target[t - 1] / total;
+            split[t] = 0.5 * (split[t] + at);
+        }
+    }
+    std::fill(pass_time.begin(), pass_time.end(), Team::PassTime{});
+}
+
+void bookkeeping_stage(World& w, const StepContext&, Range) {
+    release_relaxation(w.loads);
+    w.clock.time += w.clock.dt;
+    ++w.clock.steps;
+    if (w.clock.steps % Team::balance_every == 0) balance_contact_pass(w);
+}
+
+} // namespace
+
+// The table. SPEC §5: 1 detection, 2 contact forces, 3 zone stresses, 4 loads
+// and the sums per body, 5 damping and integration, 6 the convergence measure.
+const std::array<Stage, 12> step_stages{{
+    {"vertices", "—", place_stage, Share::team, place_share, true},
+    {"detection", "1", detection_stage, Share::team},
+    {"flow", "—", flow_stage, Share::one_thread, nullptr, false, false, has_flow},
+    {"face slip", "2", face_slip_stage, Share::team, face_share, true, true, has_faces},
+    {"supports", "4", support_stage, Share::one_thread_nowait, nullptr, false, true, has_ties},
+    {"contacts", "2", contact_stage, Share::team, contact_share, false, true},
+    {"zones", "3", zone_stage, Share::team, zone_share, true, true},
+    {"gather blocks", "4", gather_block_stage, Share::team, gather_block_share, false, true},
+    {"gather nodes", "4", gather_node_stage, Share::team, node_share, true, true},
+    {"integrate", "5", integrate_stage, Share::team, chunk_share, true},
+    {"unbalanced", "6", ratio_stage, Share::one_thread},
+    {"bookkeeping", "—", bookkeeping_stage, Share::one_thread},
+}};
+
+namespace {
+
+/// One row by the calling thread of the team (or of a team of one).
+void run_row(const Stage& s, World& w, const StepContext& ctx, std::exception_ptr& error) {
+    switch (s.share) {
+    case Share::team: s.run(w, ctx, s.range ? s.range(w, ctx) : Range{}); break;
+    case Share::one_thread:
+#pragma omp single
+        {
+            // An exception may not leave the parallel region (it would end the
+            // program): kept, and thrown again once the region is over.
+            try {
+                s.run(w, ctx, {});
+            } catch (...) {
+                error = std::current_exception();
+            }
+        }
+        break;
+    case Share::one_thread_nowait:
+#pragma omp single nowait
+        {
+            try {
+                s.run(w, ctx, {});
+            } catch (...) {
+                error = std::current_exception();
+            }
+        }
+        break;
+    }
+    if (s.barrier) {
+#pragma omp barrier
+    }
+}
+
+} // namespace
+
+void run_step(World& w, StepProfile* profile) {
+    // One parallel region per step: each row a share of the team's work, or a
+    // serial part, with the barriers between them that the data flow needs. One
+    // thread runs the same code serially.
+    const bool timing = profile && profile->enabled;
+    std::exception_ptr error;
+#pragma omp parallel num_threads(w.settings.threads) if (w.settings.threads > 1)
+    {
+        const StepContext ctx{omp_get_thread_num(), omp_get_num_threads()};
+        const bool clock = timing && ctx.thread == 0;
+        if (clock) profile->last = omp_get_wtime();
+        for (std::size_t k = 0; k < step_stages.size(); ++k) {
+            const Stage& s = step_stages[k];
+            if (s.active && !s.active(w)) continue;
+            run_row(s, w, ctx, error);
+            if (clock) {
+                const double now = omp_get_wtime();
+                profile->seconds[k] += now - profile->last;
+                profile->last = now;
+            }
+        }
+        if (clock) ++profile->steps;
+    }
+    if (error) std::rethrow_exception(error);
+}
+
+void evaluate_forces(World& w) {
+    const StepContext ctx;
+    std::exception_ptr error;
+    for (const Stage& s : step_stages)
+        if (s.force && (!s.active || s.active(w))) run_row(s, w, ctx, error);
+    if (error) std::rethrow_exception(error);
+}
+
+void place_bodies(World& w) {
+    const StepContext ctx;
+    place_stage(w, ctx, {0, w.bodies.count()});
+}
+
+namespace {
+
+/// out[i] = the cost of items 0 … i−1, out[n] the total: the prefix a team is
+/// shared by (contact::team_share). Sized once; reused without allocating.
+template <class Cost>
+void fill_cost_before(std::vector<double>& out, int n, Cost cost) {
+    out.resize(std::size_t(n) + 1);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+        out[i] = sum;
+        sum += cost(i);
+    }
+    out[n] = sum;
+}
+
+} // namespace
+
+void reindex_contacts(World& w) {
+    const int nb = w.bodies.count(), nn = w.nodes.count();
+    const auto& deformable = w.blocks.deformable;
+    contact::rebuild_contact_index(w.contacts, int(w.properties.laws.size()), nb, deformable.data(), nn,
+                                   w.vertices.node.data());
+    // The gather's cost per block: its contacts and its own terms (about two).
+    const auto& c = w.contacts;
+    fill_cost_before(w.team.gather_cost_before, nb, [&](int i) {
+        return 2.0 + (deformable[i] ? 0.0 : double(c.block_first[i + 1] - c.block_first[i]));
+    });
+    // Placing a block and integrating it: excavated ones (often a contiguous run:
+    // the blocks are numbered along a curve) next to nothing, a deformable block's
+    // placement its boundary vertices, its integration its nodes' (the node chunks).
+    const auto& removed = w.bodies.removed;
+    auto live = [&](int i) { return removed[i] ? 0.05 : 1.0; };
+    fill_cost_before(w.team.place_cost_before, nb, [&](int i) {
+        return deformable[i] ? 0.5 * double(w.blocks.first[i + 1] - w.blocks.first[i]) : live(i);
+    });
+    const int block_chunks = Team::chunks_of(nb);
+    fill_cost_before(w.team.chunk_cost_before, block_chunks + Team::chunks_of(nn), [&](int chunk) {
+        double cost = 0.0;
+        if (chunk < block_chunks) {
+            for (int i = chunk * Team::sum_chunk; i < std::min(nb, (chunk + 1) * Team::sum_chunk); ++i)
+                cost += deformable[i] ? 0.05 : live(i);
+        } else {
+            const int k = chunk - block_chunks;
+            for (int n = k * Team::sum_chunk; n < std::min(nn, (k + 1) * Team::sum_chunk); ++n) cost += live(w.nodes.block[n]);
+        }
+        return cost;
+    });
+    contact::assign_face_groups(w.contacts, block_view(w), w.properties.face_shear);
+}
+
+} // namespace bbm
