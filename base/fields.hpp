@@ -90,7 +90,7 @@ struct PackedRecordTraits {
 
 /// A field as a part declares it.
 struct FieldInfo {
-    const char* name; ///< "<part>.<field>": "blocks.centroid", "contacts.history", "bolts.axial", …
+    const char* name; ///< "<part>.<field>": "blocks.centroid", "contacts.history", …
     MemoryGroup group;
     unsigned uses; ///< field_use bits
 };

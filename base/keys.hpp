@@ -28,9 +28,9 @@ enum class KeyKind {
     curve,   ///< an array of points [[alpha, beta], ...]
     point,   ///< [x, y]
     names,   ///< an array of names of other tables (regions)
-    segments, ///< an array of segments [[[x1, y1], [x2, y2]], ...] (bolts' heads and toes)
+    segments, ///< an array of segments [[[x1, y1], [x2, y2]], ...] (bars' two ends)
     numbers, ///< an array of numbers (a list of angles)
-    table,   ///< an inline table of its own keys (a ring of bolts)
+    table,   ///< an inline table of its own keys (a ring of bars)
     rows,    ///< an array of rows of numbers [[a, b, c], ...] (a path through a stage)
 };
 

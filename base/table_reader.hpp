@@ -56,14 +56,14 @@ public:
     /// [x, y], within the model's neighbourhood (ModelScale::near).
     virtual std::optional<Vec2> point(std::string_view key) = 0;
     /// [[[x1, y1], [x2, y2]], ...]: segments of non-zero length near the model;
-    /// `what` names them in messages ("bolts [[x1, y1], [x2, y2]] (head, toe)"),
+    /// `what` names them in messages ("bars [[x1, y1], [x2, y2]] (head, toe)"),
     /// `ends` their two ends ("head and toe").
     virtual std::optional<std::vector<std::array<Vec2, 2>>> segments(std::string_view key, std::string_view what,
                                                                      std::string_view ends) = 0;
     /// The inline table `key`, read by its own reader; null when absent.
     virtual std::unique_ptr<TableReader> table(std::string_view key, std::string_view what) = 0;
     [[noreturn]] virtual void fail(std::string_view key, const std::string& message) = 0;
-    /// "bolt set 'roof': ", for messages that would otherwise make the user count tables.
+    /// "<table> set 'roof': ", for messages that would otherwise make the user count tables.
     virtual std::string owner() const = 0;
     virtual const ModelScale& scale() const = 0;
 

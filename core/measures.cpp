@@ -24,7 +24,7 @@ contact::Contacts& contacts(World& w) {
 double force_scale(const World& w) {
     // The root-mean-square contact (and zone nodal) force. SPEC §5 says "mean
     // contact force magnitude"; RMS >= mean, and it needs no square root per contact.
-    // Supports add the elements that may be all that holds a block (a bolt's segments).
+    // Supports add the elements that may be all that holds a block (a bar's segments).
     const auto& z = w.zones;
     double terms = double(w.contacts.size()) + 3.0 * double(z.size());
     double squares = contact::contact_force_squares(w.contacts) + (z.size() > 0 ? fem::zone_force_squares(z) : 0.0);

@@ -111,7 +111,7 @@ struct HistorySpec {
 
 struct StageSpec {
     /// elastic: elastic equilibrium in one implicit sparse solve (SPEC §5), no keys.
-    /// install: puts the named support sets ([[bolt]]) in place, tied to the rock
+    /// install: puts the named support sets in place, tied to the rock
     /// as it is at that moment (after a partial relaxation: convergence–confinement).
     /// pressurise: the latest opening's pressure (excavated with one) ramped to
     /// `pressure` over `steps` steps (0: at once): a borehole's pressurisation

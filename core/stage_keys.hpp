@@ -80,8 +80,8 @@ inline constexpr StageKey stage_keys[] = {
                 "ramp's steps (0: at once; under steady flow the water is solved at every step of it)",
      .absent = "excavate: relax_steps; pressurise: 0"},
     {.key = "supports", .kind = KeyKind::names, .required = true, .only = "install",
-     .meaning = "Names of [[bolt]], [[dowel]] sets and [[liner]]s, not empty, no repeats: put in place, tied to the "
-                "rock where it is now and unstressed (theory.md §13); a bolt's head and toe must lie in rock"},
+     .meaning = "Names of support sets (the tables of any registered support type), not empty, no repeats: put in "
+                "place, tied to the rock where it is now and unstressed (theory.md §13); a bar's ends must lie in rock"},
 };
 #pragma GCC diagnostic pop
 

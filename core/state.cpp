@@ -16,10 +16,10 @@ namespace bbm {
 namespace {
 // "bbm-chp" and the format version as the last byte: 2 lacked the renumbering
 // count (a resumed run renumbered its contacts at another step: issue 27); 3 the
-// stage monitor's samples (a resumed run's verdict); 4 the installed bolts and liners; 5 a
+// stage monitor's samples (a resumed run's verdict); 4 the installed supports; 5 a
 // constant support pressure (excavate's `pressure`); 6 the same fields with a
-// hash of the bolts' and liners' kinematics; 7 the state hash over every saved
-// field (the state-field list); 8 the dowels' fields (core/dowels.hpp); 9 the
+// hash of the supports' kinematics; 7 the state hash over every saved field (the
+// state-field list); 8 a third support type's fields; 9 the
 // opening's pressure scale (a pressurise stage); A an excavation's support path;
 // B the same fields, with a fingerprint of every parameter of every property
 // and support set (A's hashed only the stiffnesses).

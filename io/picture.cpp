@@ -333,7 +333,7 @@ void draw_cracks(cairo_t* cr, const World& w, double px) {
 }
 
 /// Supports (core/supports/support.hpp), each line cell shaded by its headline force
-/// against the largest now. Bars (bolts, dowels): green (none) to purple, yielded
+/// against the largest now. Bars: green (none) to purple, yielded
 /// segments thicker, broken ones dashed black. Linings: a thick line along the
 /// wall, darker blue the higher its thrust. Returns their legend.
 std::string draw_supports(cairo_t* cr, const World& w, double px) {

@@ -523,7 +523,7 @@ void write_state_contacts_vtu(const World& w, const fs::path& file) {
 }
 
 namespace {
-/// A grid of line cells between structure nodes (bolts, liners): points at the
+/// A grid of line cells between structure nodes (supports, pipes): points at the
 /// nodes (z = 0), cell i from ends(i).first to ends(i).second.
 template <class Ends>
 vtkSmartPointer<vtkUnstructuredGrid> line_grid(const std::vector<Vec2>& nodes, vtkIdType n, Ends&& ends) {

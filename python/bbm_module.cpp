@@ -5,8 +5,8 @@
 // strings by bbm/__init__.py, with the program's own option definitions.
 //
 // Arrays: every field of the world's state list (core/world.hpp) is an attribute
-// of its group — model.blocks.centroid is "blocks.centroid", model.dowels.shear
-// "dowels.shear" — generated from the list (FieldGroup), so a field added to a
+// of its group — model.blocks.centroid is "blocks.centroid", a support type's
+// fields are model.<type>.<field> — generated from the list (FieldGroup), so a field added to a
 // part, or a support type added to the registry, is in Python with no line here.
 // Groups whose arrays never move once the model is built (blocks, nodes, zones)
 // hand out read-only numpy views of the world's memory, alive as long as the
@@ -407,11 +407,10 @@ PYBIND11_MODULE(_bbm, mod) {
         }, "n×2 displacements since the start, m (computed)");
 
     group_class<SupportArrays>(mod, "SupportArrays",
-                               "One registered support type (Model.bolts, Model.liners, Model.dowels, …; the "
-                               "registry of core/supports/registry.hpp): every field '<type>.*' of "
-                               "Model.state_fields() (position, axial, thrust, …, per metre of model) as a fresh "
-                               "copy, its drawn arrays per element and node (per bolt, as VTK has them) and its "
-                               "sets' figures (as summary.json has them)")
+                               "One registered support type (a property of Model per type of the registry, "
+                               "core/supports/registry.hpp): every field '<type>.*' of Model.state_fields() "
+                               "(per metre of model) as a fresh copy, its drawn arrays per element and node (as "
+                               "<type>.pvd has them) and its sets' figures (as summary.json has them)")
         .def_property_readonly("count", [](const SupportArrays& a) {
             py::object position = group_field(a, "position");
             return py::len(position);
@@ -433,8 +432,8 @@ PYBIND11_MODULE(_bbm, mod) {
                 for (const auto& [name, values] : lines.names) d[py::str(name)] = values;
             }
             return d;
-        }, "Its arrays as VTK has them (<type>.pvd): per element and per node, per bolt (times the out-of-plane "
-           "spacing) where the type reports so; 'cells' the element's two nodes; empty before an install")
+        }, "Its arrays as VTK has them (<type>.pvd): per element and per node (times the out-of-plane spacing "
+           "where the type reports per unit); 'cells' the element's two nodes; empty before an install")
         .def_property_readonly("summary", [](const SupportArrays& a) {
             py::list out;
             for (const auto& [type, sets] : support_summaries(world_of(a))) {

@@ -174,7 +174,7 @@ nlohmann::json opening_summary(const World& w, const ReportSpec& rep) {
 }
 
 /// Per installed set of each support type, the figures an engineer reads
-/// ("bolts": loads per bolt; "liners": thrust and moment per metre; …).
+/// (each type's figures: core/supports/).
 void add_support_summaries(nlohmann::json& summary, const World& w) {
     for (const auto& [name, sets] : support_summaries(w)) {
         if (sets.empty()) continue;

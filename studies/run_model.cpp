@@ -268,8 +268,8 @@ public:
             write_support_vtu(lines, out_ / name);
             series_.push_back({w.clock.time, name});
         }
-        // result.pvd holds every part; blocks.pvd, contacts.pvd (and bolts.pvd,
-        // liners.pvd, … per installed support type) one each (for scripts that
+        // result.pvd holds every part; blocks.pvd, contacts.pvd (and <type>.pvd
+        // per installed support type) one each (for scripts that
         // style them apart, examples/paraview_view.py).
         write_pvd(out_ / "result.pvd", series_);
         // One series per part: "vtk/<part>_<step>.vtu" goes to <part>.pvd.
@@ -634,7 +634,7 @@ int run_model(const RunOptions& opt) {
     } catch (const NumericalError& e) {
         health = e.what();
     } catch (const InputError& e) {
-        // Found by a stage (a bolt installed where there is no rock): the model's line.
+        // Found by a stage (a support installed where there is no rock): the model's line.
         if (!e.file().empty()) throw;
         throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
     }
@@ -671,6 +671,58 @@ int run_model(const RunOptions& opt) {
 
 namespace {
 
+/// Per registered support type, its compare columns (core/supports/support.hpp)
+/// over its sets in a run's summary.json: counts summed, loads their largest;
+/// none when the run had no set of the type installed.
+std::vector<std::optional<std::vector<double>>> support_columns(const nlohmann::json& j) {
+    std::vector<std::optional<std::vector<double>>> out;
+    for_each_support_type([&](auto type) {
+        using T = typename decltype(type)::type;
+        const std::string name(T::name);
+        if (!j.contains(name) || j[name].empty()) {
+            out.emplace_back();
+            return;
+        }
+        std::vector<double> values;
+        for (const CompareColumn& c : T::compare) {
+            double v = 0.0;
+            for (const auto& set : j[name]) {
+                const double x = set.value(std::string(c.figure), 0.0);
+                v = c.sum ? v + x : std::max(v, x);
+            }
+            values.push_back(v);
+        }
+        out.emplace_back(std::move(values));
+    });
+    return out;
+}
+
+/// The support columns' CSV header (`<type>_<figure>`) and Markdown headings.
+std::string support_csv_header() {
+    std::string h;
+    for_each_support_type([&](auto type) {
+        using T = typename decltype(type)::type;
+        for (const CompareColumn& c : T::compare) h += "," + std::string(T::name) + "_" + std::string(c.figure);
+    });
+    return h;
+}
+std::string support_markdown_header() {
+    std::string h;
+    for_each_support_type([&](auto type) {
+        using T = typename decltype(type)::type;
+        std::string cell = std::string(T::name) + ":";
+        for (std::size_t k = 0; k < T::compare.size(); ++k) cell += (k ? ", " : " ") + std::string(T::compare[k].heading);
+        h += " " + cell + " |";
+    });
+    return h;
+}
+
+std::string number_text(double v, bool count) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, count ? "%.0f" : "%.1f", v);
+    return buf;
+}
+
 /// What `bbm compare` tabulates of one run, read from its summary.json.
 struct ComparedRun {
     nlohmann::json j, op;
@@ -678,10 +730,7 @@ struct ComparedRun {
     double crack_rate = 0.0, rock_ratio = 0.0, zone_springline = 0.0, zone_crown = 0.0;
     int fragments = 0;
     bool at_edge = false;
-    // Support, over its sets: how many bolts, the largest load, how many yielded or broke.
-    int bolts = 0, yielded = 0, broken = 0;
-    double bolt_load = 0.0, liner_thrust = 0.0, liner_moment = 0.0;
-    bool lined = false;
+    std::vector<std::optional<std::vector<double>>> supports; ///< per registered type (support_columns)
 
     explicit ComparedRun(const fs::path& summary) {
         std::ifstream f(summary);
@@ -694,55 +743,58 @@ struct ComparedRun {
         const auto zone = op.contains("failed_zone") ? op["failed_zone"] : nlohmann::json::object();
         zone_springline = zone.value("depth_springline", 0.0), zone_crown = zone.value("depth_crown", 0.0);
         at_edge = zone.value("reaches_region_edge", false) || zone.value("region_edge_cells_damaged", 0) >= 2;
-        if (j.contains("bolts"))
-            for (const auto& b : j["bolts"]) {
-                bolts += b["bolts"].get<int>(), yielded += b["yielded"].get<int>(), broken += b["broken"].get<int>();
-                bolt_load = std::max(bolt_load, b["max_axial_kN"].get<double>());
-            }
-        lined = j.contains("liners");
-        if (lined)
-            for (const auto& l : j["liners"]) {
-                liner_thrust = std::max(liner_thrust, l["max_thrust_kN_per_m"].get<double>());
-                liner_moment = std::max(liner_moment, l["max_moment_kNm_per_m"].get<double>());
-            }
+        supports = support_columns(j);
     }
     double opening(const char* k) const { return op.contains(k) ? op[k].get<double>() : 0.0; }
+
+    /// The support types' CSV cells (0 for a type the run has not) and Markdown cells ("-").
+    std::string support_cells(bool markdown) const {
+        std::string out;
+        std::size_t t = 0;
+        for_each_support_type([&](auto type) {
+            using T = typename decltype(type)::type;
+            const auto& values = supports[t++];
+            if (markdown) {
+                std::string cell;
+                for (std::size_t k = 0; values && k < T::compare.size(); ++k)
+                    cell += (k ? ", " : "") + number_text((*values)[k], T::compare[k].sum);
+                out += " " + (values ? cell : std::string("-")) + " |";
+            } else {
+                for (std::size_t k = 0; k < T::compare.size(); ++k)
+                    out += "," + number_text(values ? (*values)[k] : 0.0, T::compare[k].sum);
+            }
+        });
+        return out;
+    }
 
     std::string csv_row(const std::string& name) const {
         char row[1024];
         std::snprintf(row, sizeof row,
-                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d,%.1f,%d,%d,%.1f,"
-                      "%.2f,%d\n",
+                      "%s,%d,%d,%d,%d,%ld,%.2f,%d,%d,%.3f,%.3f,%.3f,%.3f,%d,%d,%.3f,%.3f,%s,%.3f,%d,%.3e,%d",
                       name.c_str(), j["blocks"].get<int>(), j["deformable_blocks"].get<int>(), j["zones"].get<int>(),
                       j["contacts"].get<int>(), j["steps"].get<long>(), j["wall_seconds"].get<double>(),
                       j["cracks"]["tensile"].get<int>(), j["cracks"]["shear"].get<int>(),
                       1e3 * opening("springline_convergence"), 1e3 * opening("crown_convergence"),
                       opening("failed_depth_springline"), opening("failed_depth_crown"),
                       int(opening("cracks_springline_sector")), int(opening("cracks_crown_sector")), zone_springline,
-                      zone_crown, kind.c_str(), crack_rate, fragments, rock_ratio, bolts, bolt_load, yielded, broken,
-                      liner_thrust, liner_moment, int(at_edge));
-        return row;
+                      zone_crown, kind.c_str(), crack_rate, fragments, rock_ratio, int(at_edge));
+        return row + support_cells(false) + "\n";
     }
 
     std::string markdown_row(const std::string& name) const {
-        char liner_cell[96] = "-";
-        if (lined) std::snprintf(liner_cell, sizeof liner_cell, "%.0f, %.1f", liner_thrust, liner_moment);
-        char bolt_cell[96] = "-";
-        if (bolts > 0) std::snprintf(bolt_cell, sizeof bolt_cell, "%d: %.0f (%d / %d)", bolts, bolt_load, yielded, broken);
         const std::string shown = name + (j.value("interrupted", false) ? " (interrupted: bbm run --resume)" : "");
         char row[1024];
         std::snprintf(row, sizeof row,
                       "| %s | %d | %d | %ld | %.1f | %d | %d | %.2f | %.2f | %.2f | %.2f | %d / %d | %.2f / %.2f%s | %s | %.2f | %d | "
-                      "%.2e | %s | %s |\n",
+                      "%.2e |",
                       shown.c_str(), j["blocks"].get<int>(), j["zones"].get<int>(), j["steps"].get<long>(),
                       j["wall_seconds"].get<double>(), j["cracks"]["tensile"].get<int>(),
                       j["cracks"]["shear"].get<int>(), 1e3 * opening("springline_convergence"),
                       1e3 * opening("crown_convergence"), opening("failed_depth_springline"),
                       opening("failed_depth_crown"), int(opening("cracks_springline_sector")),
                       int(opening("cracks_crown_sector")), zone_springline, zone_crown,
-                      at_edge ? " (damage at the region's edge)" : "", kind.c_str(), crack_rate, fragments, rock_ratio,
-                      bolt_cell, liner_cell);
-        return row;
+                      at_edge ? " (damage at the region's edge)" : "", kind.c_str(), crack_rate, fragments, rock_ratio);
+        return row + support_cells(true) + "\n";
     }
 };
 
@@ -812,13 +864,14 @@ int compare_models(const std::vector<std::string>& models, const fs::path& out, 
     csv << "model,blocks,deformable_blocks,zones,contacts,steps,wall_seconds,cracks_tensile,cracks_shear,"
            "springline_convergence_mm,crown_convergence_mm,failed_depth_springline_m,failed_depth_crown_m,"
            "cracks_springline_sector,cracks_crown_sector,failed_zone_depth_springline_m,failed_zone_depth_crown_m,"
-           "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio,bolts,bolt_max_axial_kN,bolts_yielded,"
-           "bolts_broken,liner_max_thrust_kN_per_m,liner_max_moment_kNm_per_m,damage_at_region_edge\n";
+           "verdict,cracks_per_1000_steps_at_end,fragments,rock_mass_ratio,damage_at_region_edge"
+        << support_csv_header() << "\n";
     md << "| model | rigid blocks | zones | steps | wall s | tensile | shear | springline mm | crown mm | "
           "crack depth (90%) springline m | crack depth (90%) crown m | sector cracks springline / crown | "
-          "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio | "
-          "bolts: largest load kN (yielded / broken) | liner: thrust kN/m, moment kNm/m |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "failed zone springline / crown m | verdict | cracks / 1000 steps at the end | fragments | rock-mass ratio |"
+       << support_markdown_header() << "\n|";
+    for (std::size_t k = 0; k < 17 + support_type_count; ++k) md << "---|";
+    md << "\n";
     bool stopped = false;
     const auto codes = run_compared_models(models, out, threads, quiet, stopped);
     // The rocks' envelopes after the models (each spreads its own runs over the ranks).

@@ -67,7 +67,7 @@ namespace {
 /// A summary value by dotted path ("opening.failed_depth_springline"); NaN if absent.
 double summary_value(const nlohmann::json& s, const std::string& path) {
     // "opening.failed_zone.depth_springline"; an array element by index,
-    // "bolts[0].max_axial_kN" or "bolts.0.max_axial_kN".
+    // "stages[2].steps" or "stages.2.steps".
     std::string p = path;
     for (std::size_t at; (at = p.find('[')) != std::string::npos;) {
         const auto close = p.find(']', at);
@@ -189,7 +189,7 @@ struct SweepTable {
     nlohmann::json table = nlohmann::json::array();
     int failed = 0;
     /// Series of the plot: one per seed offset and per value of the other swept keys
-    /// (a sweep over bolt length and bolt count draws one line per count); the mean
+    /// (a sweep over two keys draws one line per value of the second); the mean
     /// over seeds per value of the other keys.
     std::map<std::pair<std::string, long>, io::Series> by_seed;
     std::map<std::string, std::map<double, std::pair<double, int>>> mean; // others -> x -> (sum, count)

@@ -1,5 +1,5 @@
 // bbm core: the corotational Euler–Bernoulli beam element shared by the support
-// types that bend (liners, dowels).
+// support types that bend.
 //
 // An element between nodes a and b (positions, rotations θa, θb) of rest length
 // l0 and initial chord angle β0 carries

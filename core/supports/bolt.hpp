@@ -208,6 +208,10 @@ struct Bolts {
     /// bond_kN_per_m (grout force along the bolt, per bolt) and slip (plastic grout
     /// slip, m). Field data state_names, set_names.
     static SupportLines lines(const State& s);
+    static constexpr std::array<CompareColumn, 4> compare{{{"bolts", "bolts", true},
+                                                           {"max_axial_kN", "largest load kN", false},
+                                                           {"yielded", "yielded", true},
+                                                           {"broken", "broken", true}}};
 };
 
 template <class S, class V>

@@ -96,6 +96,10 @@ struct Dowels {
     /// moment_kNm (the larger end moment, per bolt), state (0 elastic, 1 yielded,
     /// 2 broken), set, dowel; point data bond_kN_per_m, transverse_kN_per_m, slip.
     static SupportLines lines(const State& s);
+    static constexpr std::array<CompareColumn, 4> compare{{{"dowels", "dowels", true},
+                                                           {"max_shear_kN", "largest shear kN", false},
+                                                           {"max_axial_kN", "largest tension kN", false},
+                                                           {"broken_elements", "elements broken", true}}};
 };
 
 template <class S, class V>

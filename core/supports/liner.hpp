@@ -182,6 +182,9 @@ struct Liners {
     /// sign), liner, yielded (bit 0 thrust, bit 1 bending); point data
     /// interface_normal_MPa (tension positive), interface_open. Field data liner_names.
     static SupportLines lines(const State& s);
+    static constexpr std::array<CompareColumn, 3> compare{{{"max_thrust_kN_per_m", "thrust kN/m", false},
+                                                           {"max_moment_kNm_per_m", "moment kNm/m", false},
+                                                           {"yielded_elements", "elements yielded", true}}};
 };
 
 template <class S, class V>

@@ -1,5 +1,5 @@
 // bbm core: what every support type shares — structural elements tied to the rock
-// (bolts, liners, dowels, yielding bolts) — and what a type must declare to be one.
+// — and what a type must declare to be one (registry.hpp lists the types).
 //
 // A support type owns its nodes and elements in flat arrays (its State, plain
 // data) and is tied to the rock at its nodes ("ties"): each tie sits in a rigid
@@ -7,9 +7,9 @@
 // support is installed. A type is a struct of static members and one row of the
 // registry (core/supports/registry.hpp); the rest of the program iterates the
 // registry and names no type. What a type declares:
-//   name, table          its plural ("bolts": the state list's prefix,
-//                        summary.json's key, the VTK files' stem) and its
-//                        model-file table ("bolt": [[bolt]]);
+//   name, table          its plural (the state list's prefix, summary.json's
+//                        key, the VTK files' stem) and its model-file table
+//                        (`table` = "x": [[x]] tables);
 //   Spec, State          one table's values, and the installed state;
 //   keys, read(...)      its keys (base/keys.hpp: units, bounds, meaning; the
 //                        reference) and its reader (base/table_reader.hpp);
@@ -25,9 +25,9 @@
 //   parameters           its sets' properties, for the model fingerprint;
 //   visit_fields         its arrays in the state list (saved, hashed, counted);
 //   after_load           per-step scratch sized again after a checkpoint;
-//   summary, lines       its figures per set (summary.json, `bbm compare`) and
-//                        its polylines with named arrays (VTK, the picture,
-//                        Python).
+//   summary, lines       its figures per set (summary.json) and its polylines
+//                        with named arrays (VTK, the picture, Python);
+//   compare              the figures `bbm compare` tabulates, over its sets.
 // The solver calls them once per type per step (a compile-time loop over the
 // registry, no virtual call at all) and gathers the ties' reactions in tie
 // order, a fixed order on any thread count. The node integration, the masses and
@@ -127,6 +127,14 @@ struct SupportSetSummary {
     }
 };
 
+/// A figure of a type's sets that `bbm compare` tabulates: summed over the sets
+/// (a count) or their largest, with its heading in the Markdown table.
+struct CompareColumn {
+    std::string_view figure;
+    std::string_view heading;
+    bool sum = false;
+};
+
 /// A support drawn as line cells over its nodes, with named arrays (VTK output,
 /// the picture, Python's views).
 struct SupportLines {
@@ -191,7 +199,7 @@ inline double plastic_return(double trial, double limit, double stiffness, doubl
     return clamped;
 }
 /// A bar's unit axis at node k of the bar whose nodes are [first, last]: along its
-/// neighbours (bolts, dowels).
+/// neighbours (the types of bars).
 inline Vec2 bar_axis(const std::vector<Vec2>& position, int k, int first, int last) {
     const Vec2 axis = position[std::min(k + 1, last)] - position[std::max(k - 1, first)];
     return axis / norm(axis);

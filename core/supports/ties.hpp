@@ -25,7 +25,7 @@ void install_supports(World& w, const std::vector<std::string>& names);
 /// support types in registry order (after an install, a load).
 void index_support_ties(World& w);
 
-/// The figures of every installed set of every type, by type name ("bolts", …).
+/// The figures of every installed set of every type, by type name (its `name`).
 std::vector<std::pair<std::string, std::vector<SupportSetSummary>>> support_summaries(const World& w);
 
 /// The lines of every type that has nodes, by type name, for VTK and pictures.
