@@ -20,14 +20,15 @@
 #include "bbm_version.hpp" // generated: cmake/write_version.cmake
 #include "base/error.hpp"
 #include "io/model_input.hpp"
-#include "studies/cli_checks.hpp"
-#include "studies/commands.hpp"
-#include "studies/envelope.hpp"
-#include "studies/model_rock.hpp"
-#include "studies/ranks.hpp"
-#include "studies/run_model.hpp"
-#include "studies/shear.hpp"
-#include "studies/sweep.hpp"
+#include "apps/checks.hpp"
+#include "studies/model/mesh_command.hpp"
+#include "apps/flags.hpp"
+#include "studies/lab/envelope.hpp"
+#include "studies/model/compare_envelopes.hpp"
+#include "studies/cluster/ranks.hpp"
+#include "studies/model/run_model.hpp"
+#include "studies/lab/shear.hpp"
+#include "studies/model/sweep.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -70,7 +71,7 @@ int run_cli(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     mesh->add_option("-o,--out", mesh_command.out, "Output directory (created if missing)")->capture_default_str();
     mesh->add_flag("-q,--quiet", quiet, "Print nothing but errors");
-    mesh->add_option("--max-elements", mesh_command.max_elements, studies::max_elements_help)->check(cli::positive());
+    mesh->add_option("--max-elements", mesh_command.max_elements, cli::max_elements_help)->check(cli::positive());
     mesh->add_option("--window", mesh_command.window, "Part of the model drawn in blocks.png: XMIN YMIN XMAX YMAX (m)")
         ->expected(4);
 
@@ -99,7 +100,7 @@ int run_cli(int argc, char** argv) {
     run->add_flag("--resume", run_options.resume,
                   "Continue the run whose checkpoint is in --out (the model file is the checkpoint's; exit 0 if the "
                   "run had already finished)");
-    run->add_option("--max-elements", run_options.max_elements, studies::max_elements_help)->check(cli::positive());
+    run->add_option("--max-elements", run_options.max_elements, cli::max_elements_help)->check(cli::positive());
     run->add_flag("--profile", run_options.profile,
                   "Time each stage of the step (detection, contacts and zones, gather, integration...): a table on "
                   "stderr at the end, and \"profile\" in summary.json");
@@ -177,14 +178,14 @@ int run_cli(int argc, char** argv) {
         ->check(cli::positive());
     compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
 
-    studies::CalibrateCli calibrate_values;
+    studies::CalibrateValues calibrate_values;
     auto* calibrate_cmd = app.add_subcommand(
         "calibrate", "Find kn, ks, tensile strength and cohesion that give target E, nu, UCS and direct tensile "
                      "strength (means over --realizations seeds of UCS and tension tests), and the friction angle "
                      "too given a biaxial strength (--target-biaxial, --target-confinement). Prints the iterations, "
                      "writes DIR/joint_property.toml (a [[joint_property]] for a model file) and calibration.json. "
                      "Exit status 4 if not converged.");
-    studies::add_calibrate_options(calibrate_cmd, calibrate_values, quiet);
+    cli::add_calibrate_options(calibrate_cmd, calibrate_values, quiet);
 
     studies::EnvelopeOptions envelope_values;
     auto* envelope_cmd = app.add_subcommand(
@@ -193,16 +194,16 @@ int run_cli(int argc, char** argv) {
                     "each; fits Hoek-Brown (sigma_ci, mi) and Mohr-Coulomb (c, phi) to the peaks, and reports "
                     "sigma_ci and sigma_cd at each confinement. Writes envelope.json, envelope.csv and envelope.png "
                     "in --out.");
-    studies::add_envelope_options(envelope_cmd, envelope_values, quiet);
+    cli::add_envelope_options(envelope_cmd, envelope_values, quiet);
 
-    studies::ShearCli shear_values;
+    studies::ShearValues shear_values;
     auto* shear_cmd = app.add_subcommand(
         "shear", "Direct shear test of a joint across a bonded-block specimen, persistent or with rock bridges "
                  "(--persistence, --bridges), under constant normal load or constant normal stiffness "
                  "(--normal-stiffness), at one or more normal stresses (--normal-stress 2e6,5e6,10e6). Writes "
                  "summary.json (peak and residual strength, dilation, Coulomb fits), shear.csv, shear_stress.png, "
                  "dilation.png and per run failure.png and result.pvd in --out.");
-    studies::add_shear_options(shear_cmd, shear_values, quiet);
+    cli::add_shear_options(shear_cmd, shear_values, quiet);
 
     // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
     const std::pair<const char*, const char*> labtests[] = {
@@ -214,13 +215,13 @@ int run_cli(int argc, char** argv) {
         {"biaxial", "Compression with a constant lateral stress (same options as ucs)."},
         {"brazilian", "Brazilian test: a disc of diameter --width loaded across a diameter; reports the indirect "
                       "tensile strength 2P/(pi D)."}};
-    std::vector<std::pair<CLI::App*, studies::LabTestCli>> labtest_commands;
+    std::vector<std::pair<CLI::App*, studies::LabTestValues>> labtest_commands;
     labtest_commands.reserve(4);
     for (const auto& [name, help] : labtests) {
         const auto kind = studies::labtest_kind(name);
         labtest_commands.emplace_back(app.add_subcommand(name, help), studies::labtest_defaults(kind));
         auto& [command, values] = labtest_commands.back();
-        studies::add_labtest_options(command, values, quiet);
+        cli::add_labtest_options(command, values, quiet);
         if (kind == LabTestOptions::Kind::biaxial)
             command->add_option("--confinement", values.o.confinement, "Lateral stress (Pa, compression positive)")
                 ->required()
@@ -260,7 +261,7 @@ int run_cli(int argc, char** argv) {
         if (*envelope_cmd) return studies::run_envelope(envelope_values, quiet, check_only);
         if (*shear_cmd) return studies::run_shear(shear_values, quiet, check_only);
         if (*calibrate_cmd) {
-            studies::note_given_joint_values(*calibrate_cmd, calibrate_values);
+            cli::note_given_joint_values(*calibrate_cmd, calibrate_values);
             return studies::run_calibrate(calibrate_values, quiet, check_only);
         }
         if (*sweep) {
@@ -273,7 +274,7 @@ int run_cli(int argc, char** argv) {
             if (check_only) {
                 for (const auto& m : compare_models) {
                     const auto model = io::read_model(m);
-                    if (compare_envelope.enabled) (void)studies::labtest_of_model(model, m);
+                    if (compare_envelope.enabled) (void)io::rock_of_model(model, m);
                 }
                 return 0;
             }
@@ -310,7 +311,7 @@ int bbm_cli_main(int argc, char** argv) {
     // a checkpoint, not kill it (again after MPI, which may install its own).
     studies::catch_stop_signals();
     // Under mpirun (or srun) the independent runs of a study are spread over the
-    // ranks (studies/ranks.hpp); otherwise nothing changes.
+    // ranks (studies/cluster/ranks.hpp); otherwise nothing changes.
     studies::Ranks::start(&argc, &argv);
     studies::catch_stop_signals();
     const int status = run_cli(argc, argv);

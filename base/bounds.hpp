@@ -1,6 +1,6 @@
 // bbm base: the allowed values of a number and how to say them ("in [0, 90)
 // degrees", "> 0 Pa"), shared by the model-file reader (io/reader.hpp, its Range)
-// and the command-line flags (studies/cli_checks.hpp), so that a key and the flag
+// and the command-line flags (apps/checks.hpp), so that a key and the flag
 // made from it accept the same values and refuse them in the same words.
 #pragma once
 

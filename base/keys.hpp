@@ -4,8 +4,8 @@
 // A table of these per section (contact/joint_keys.hpp for [[joint_property]],
 // core/material_keys.hpp for [[material]], core/flow_keys.hpp for [flow]) is what the
 // reader checks a file by, what
-// the command-line flags of the same values are made from (studies/commands.hpp,
-// add_key_flags) and what the key reference in docs/reference/ is generated from,
+// the command-line flags of the same values are made from (studies/lab/commands.hpp,
+// apps/flags.hpp add_key_flags; those marked `flag` are a lab test's rock's) and what the key reference in docs/reference/ is generated from,
 // so the three cannot drift apart.
 #pragma once
 
@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace bbm {
@@ -52,6 +53,14 @@ struct Key {
     /// The field of a number, integer or boolean key.
     double (*get)(const Spec&) = nullptr;
     void (*set)(Spec&, double) = nullptr;
+    /// A lab test's rock takes it as a flag (`--<key>`, and a Python keyword):
+    /// said in its declaration, not by a list of the command's.
+    bool flag = false;
+    /// The flag's name when not `--<key>` (a pattern's `type` is `--pattern`).
+    std::string_view flag_name;
+    /// The field of a curve key: points [[x, y], ...].
+    const std::vector<std::pair<double, double>>& (*get_curve)(const Spec&) = nullptr;
+    void (*set_curve)(Spec&, std::vector<std::pair<double, double>>) = nullptr;
 };
 
 /// A table's declaration of a key; nullptr if there is none.
@@ -135,6 +144,11 @@ inline std::string key_flag(std::string_view key, std::string_view prefix = "") 
 }
 
 } // namespace bbm
+
+/// The get and set of a curve key's field.
+#define BBM_CURVE_FIELD(Spec, field)                                                                   \
+    .get_curve = [](const Spec& s) -> const std::vector<std::pair<double, double>>& { return s.field; }, \
+    .set_curve = [](Spec& s, std::vector<std::pair<double, double>> v) { s.field = std::move(v); }
 
 /// The get and set of a key's field, for a table's rows.
 #define BBM_KEY_FIELD(Spec, field)                                                                   \

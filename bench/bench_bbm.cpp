@@ -14,8 +14,8 @@
 // Usage: bench_bbm [--out results.json] [--quick | --answers-only] (from the
 // repository root, or with BBM_SOURCE_DIR set). --quick: sizes up to 40,000 and no
 // time to answer; --answers-only: the time to answer alone.
-#include "studies/run_model.hpp"
-#include "studies/labtest.hpp"
+#include "studies/model/run_model.hpp"
+#include "studies/lab/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <nlohmann/json.hpp>
@@ -69,7 +69,7 @@ Scene scene(int blocks) {
     g.regions.push_back(r);
     Scene s;
     s.blocks = meshing::generate_blocks(g);
-    s.analysis.joint_properties.push_back(LabTestOptions::paper_ucs().joint);
+    s.analysis.joint_properties.push_back(paper_rock().bonds);
     s.analysis.joint_assignments.push_back({"bond", {}, {}});
     BoundarySpec bottom;
     bottom.name = "bottom";
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
         const fs::path tmp = fs::temp_directory_path() / "bbm_bench_answers";
         auto labtest = [](meshing::PatternSpec::Kind pattern, double kn, double ks) {
             auto o = LabTestOptions::paper_ucs();
-            o.pattern = pattern, o.joint.kn = kn, o.joint.ks = ks, o.threads = 2, o.frame_every = 0;
+            o.rock.pattern.kind = pattern, o.rock.bonds.kn = kn, o.rock.bonds.ks = ks, o.threads = 2, o.frame_every = 0;
             const auto t0 = clock_type::now();
             const auto r = run_labtest(o);
             std::printf("    peak %.2f MPa, E %.2f GPa\n", r.peak_stress / 1e6, r.E / 1e9);

@@ -7,7 +7,7 @@
 // (docs/notes/2026-11-28-calibration-history.md, What the programs do, Output).
 //
 //   side_by_side_probe [width (m)] [max strain] [trials] [seed] [seed] ...
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -21,10 +21,10 @@ namespace {
 LabTestOptions deformable(std::uint64_t seed, double width, double max_strain) {
     auto o = LabTestOptions::paper_ucs();
     o.width = width, o.height = 2.0 * width;
-    o.material.deformable_fraction = 0.95;
+    o.rock.material.deformable_fraction = 0.95;
     o.stop.max_strain = max_strain;
     o.threads = 1;
-    o.seed = seed;
+    o.rock.pattern.seed = seed;
     return o;
 }
 

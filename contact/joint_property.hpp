@@ -5,17 +5,17 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 namespace bbm {
 
-/// One joint property set (SPEC §4). Which law is used follows `law`.
+/// One joint property set (SPEC §4). Which law is used follows `law`: the name of
+/// one of contact::JointLaw's laws (contact/joint_law.hpp, the registry).
 struct JointPropertySpec {
-    /// In the order of the alternatives of contact::JointLaw (joint_law.hpp checks).
-    enum class Law { elastic, coulomb, softening, barton_bandis };
     std::string name;
-    Law law = Law::softening;
+    std::string law = "softening";
     double kn = 0.0;              ///< normal stiffness, Pa/m (> 0)
     double ks = 0.0;              ///< shear stiffness, Pa/m (> 0)
     /// Between a rigid block and a deformable one: the contacts of the rigid
@@ -68,7 +68,25 @@ struct JointPropertySpec {
     double weibull_modulus = 0.0;
     int strength_classes = 16;
     std::uint64_t strength_seed = 1;
+    /// The values of keys a law declares in its own file (a law added by the
+    /// recipe keeps its parameters here, not as fields of this struct), by key.
+    std::vector<std::pair<std::string, double>> values;
 };
+
+/// A law-declared value (JointPropertySpec::values), or `absent` if not given.
+inline double law_value(const JointPropertySpec& j, std::string_view key, double absent) {
+    for (const auto& [k, v] : j.values)
+        if (k == key) return v;
+    return absent;
+}
+inline void set_law_value(JointPropertySpec& j, std::string_view key, double v) {
+    for (auto& [k, x] : j.values)
+        if (k == key) {
+            x = v;
+            return;
+        }
+    j.values.emplace_back(std::string(key), v);
+}
 
 /// The strength factors of the classes of a heterogeneous set: the Weibull
 /// quantiles at (k + ½)/n, k = 0..n−1, scaled to mean 1.

@@ -94,7 +94,7 @@ public:
     /// every run, thread count and restart.
     int strength_class(int prop, std::size_t joint) {
         const JointPropertySpec& base = specs_[prop];
-        if (!(base.weibull_modulus > 0.0) || base.law == JointPropertySpec::Law::elastic) return prop;
+        if (!(base.weibull_modulus > 0.0) || base.law == "elastic") return prop;
         const int classes = std::max(1, base.strength_classes);
         std::uint64_t z = base.strength_seed * 0x9E3779B97F4A7C15ull + joint + 0x632BE59BD9B4E019ull;
         z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull; // splitmix64's finaliser
@@ -140,7 +140,7 @@ public:
         if (!name.empty()) return find(name, "solver.new_contact_property");
         JointPropertySpec unbonded;
         unbonded.name = "unbonded (built-in)";
-        unbonded.law = JointPropertySpec::Law::coulomb;
+        unbonded.law = "coulomb";
         unbonded.kn = unbonded.ks = 0.0;
         for (const auto& l : laws_) {
             unbonded.kn = std::max(unbonded.kn, contact::normal_stiffness(l));
@@ -496,9 +496,12 @@ void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAsse
         std::vector<int> blocks, nodes;
         if (bc.kind == BoundarySpec::Kind::velocity) apply_velocity_boundary(w, bc, blocks, nodes);
         else apply_stress_boundary(w, bc, a, covered, blocks, nodes);
-        w.boundaries.names.push_back(bc.name);
-        w.boundaries.blocks.push_back(blocks);
-        w.boundaries.nodes.push_back(nodes);
+        auto& b = w.boundaries;
+        b.names.push_back(bc.name);
+        b.block_list.insert(b.block_list.end(), blocks.begin(), blocks.end());
+        b.block_first.push_back(int(b.block_list.size()));
+        b.node_list.insert(b.node_list.end(), nodes.begin(), nodes.end());
+        b.node_first.push_back(int(b.node_list.size()));
     }
     w.boundaries.force.assign(w.boundaries.names.size(), {});
 }

@@ -20,17 +20,17 @@ using MaterialKey = Key<MaterialSpec>;
 inline constexpr MaterialKey material_keys[] = {
     {.key = "name", .kind = KeyKind::text, .required = true, .meaning = "The material's name, referred to by [[region]]"},
     {.key = "density", .bounds = above(0, " kg/m³"), .meaning = "Density of the blocks", .absent = "2700",
-     BBM_KEY_FIELD(MaterialSpec, density)},
+     BBM_KEY_FIELD(MaterialSpec, density), .flag = true},
     {.key = "young", .bounds = above(0, pascals),
      .meaning = "Young's modulus E of the rock (of the rock mass: the blocks get E / deformable_fraction); "
                 "required by deformable blocks",
-     .absent = "none: rigid blocks only", BBM_KEY_FIELD(MaterialSpec, young)},
+     .absent = "none: rigid blocks only", BBM_KEY_FIELD(MaterialSpec, young), .flag = true},
     {.key = "poisson", .bounds = below(0, 0.5, ""), .meaning = "Poisson's ratio ν of the deformable blocks; needs young",
-     .absent = "0.2", BBM_KEY_FIELD(MaterialSpec, poisson)},
+     .absent = "0.2", BBM_KEY_FIELD(MaterialSpec, poisson), .flag = true},
     {.key = "deformable_fraction", .bounds = below(0, 1, ""),
      .meaning = "Fraction f of the deformation the deformable blocks take: blocks get young / f, the joints of the "
                 "material's regions kn / (1 − f) and ks / (1 − f) (SPEC §6); 0 = not split; needs young",
-     .absent = "0", BBM_KEY_FIELD(MaterialSpec, deformable_fraction)},
+     .absent = "0", BBM_KEY_FIELD(MaterialSpec, deformable_fraction), .flag = true},
 };
 #pragma GCC diagnostic pop
 

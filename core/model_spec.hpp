@@ -148,7 +148,7 @@ struct StageSpec {
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;
-/// studies/opening.hpp).
+/// studies/model/opening.hpp).
 struct ReportSpec {
     bool opening = false;           ///< measure the opening (center, springline, crown given)
     Vec2 center{}, springline{}, crown{};

@@ -358,8 +358,14 @@ void sum_boundary_forces(World& w) {
     auto& b = w.boundaries;
     for (std::size_t k = 0; k < b.names.size(); ++k) {
         Vec2 sum{};
-        for (int i : b.blocks[k]) sum += w.bodies.force[i] - w.loads.block_force[i] - w.blocks.real_mass[i] * g;
-        for (int i : b.nodes[k]) sum += w.nodes.force[i] - w.loads.node_force[i] - w.nodes.real_mass[i] * g;
+        for (int e = b.block_first[k]; e < b.block_first[k + 1]; ++e) {
+            const int i = b.block_list[e];
+            sum += w.bodies.force[i] - w.loads.block_force[i] - w.blocks.real_mass[i] * g;
+        }
+        for (int e = b.node_first[k]; e < b.node_first[k + 1]; ++e) {
+            const int i = b.node_list[e];
+            sum += w.nodes.force[i] - w.loads.node_force[i] - w.nodes.real_mass[i] * g;
+        }
         b.force[k] = sum;
     }
 }

@@ -239,14 +239,21 @@ struct Boundaries {
         Vec2 offset;
     };
     std::vector<std::string> names;
-    std::vector<std::vector<int>> blocks, nodes; ///< per boundary
-    std::vector<Vec2> force;                     ///< per boundary, last step (N/m)
+    /// Boundary k's blocks block_list[block_first[k] .. block_first[k + 1]) (CSR), and its nodes likewise.
+    std::vector<int> block_first{0}, block_list, node_first{0}, node_list;
+    std::vector<Vec2> force; ///< per boundary, last step (N/m)
     std::vector<HeldPoint> held;
 };
 template <part_of<Boundaries> P, class V>
 void visit_fields(P& b, V&& v) {
-    v(FieldInfo{"boundaries.force", MemoryGroup::other, field_use::evolving}, b.force);
-    v(FieldInfo{"boundaries.held", MemoryGroup::other, field_use::rebuilt}, b.held);
+    using G = MemoryGroup;
+    constexpr unsigned M = field_use::model, R = field_use::rebuilt;
+    v(FieldInfo{"boundaries.force", G::other, field_use::evolving}, b.force);
+    v(FieldInfo{"boundaries.block_first", G::other, M}, b.block_first);
+    v(FieldInfo{"boundaries.block_list", G::other, M}, b.block_list);
+    v(FieldInfo{"boundaries.node_first", G::other, M}, b.node_first);
+    v(FieldInfo{"boundaries.node_list", G::other, M}, b.node_list);
+    v(FieldInfo{"boundaries.held", G::other, R}, b.held);
 }
 
 /// Time and the step's measures.
@@ -302,6 +309,19 @@ void visit_fields(P& d, V&& v) {
     v(FieldInfo{"detection.unsorted_contacts", G::other, E}, d.unsorted_contacts);
     v(FieldInfo{"detection.radius", G::blocks, R}, d.radius);
     v(FieldInfo{"detection.junctions", G::other, R}, d.junctions);
+    // The broad phase's grid and the pass's scratch (contact::Detector): not saved,
+    // a grid rebuilt offers a superset of the same pairs.
+    auto& g = d.detector;
+    v(FieldInfo{"detection.pieces", G::blocks, R}, g.pieces);
+    v(FieldInfo{"detection.block_piece", G::blocks, R}, g.block_piece);
+    v(FieldInfo{"detection.stored", G::blocks, R}, g.stored);
+    v(FieldInfo{"detection.cell_first", G::other, R}, g.cell_first);
+    v(FieldInfo{"detection.cell_piece", G::other, R}, g.cell_piece);
+    v(FieldInfo{"detection.drop", G::contacts, R}, g.drop);
+    v(FieldInfo{"detection.active_blocks", G::blocks, R}, g.active_blocks);
+    v(FieldInfo{"detection.candidates", G::other, R}, g.candidates);
+    v(FieldInfo{"detection.order", G::other, R}, g.order);
+    v(FieldInfo{"detection.accepted", G::other, R}, g.accepted);
 }
 
 /// The supports' ties to the rock, numbered through the support types in

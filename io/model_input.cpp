@@ -413,25 +413,17 @@ void check_heterogeneity_keys(const Ctx& c, const toml::table& t, const Path& p,
         if (t.contains(key)) c.fail(*t.get(key), p.key(key), "goes with weibull_modulus > 0");
 }
 
-/// Every key a [[joint_property]] may have (contact/joint_keys.hpp).
-constexpr auto all_joint_keys = key_names(contact::joint_keys);
-
-
 JointPropertySpec read_joint_property(Ctx& c, const toml::table& t, const Path& p, Names& names) {
-    check_keys(c, t, p, all_joint_keys);
+    const Keys all = contact::joint_key_names();
+    check_keys(c, t, p, all);
     JointPropertySpec j;
-    using Law = JointPropertySpec::Law;
     j.name = read_name(c, t, p, names);
-    j.law = static_cast<Law>(choice(c, t, p, "law", contact::law_names, "joint law"));
-    const auto law = static_cast<std::size_t>(j.law);
-    const auto keys = contact::law_keys(j.law);
-    check_keys(c, t, p, keys, all_joint_keys, article(contact::law_names[law]) + " joint property");
-    for (const std::string_view key : keys) {
-        const contact::JointKey& k = *contact::find_joint_key(key);
-        if (k.kind == contact::KeyKind::number || k.kind == contact::KeyKind::integer) read_declared_key(c, t, p, k, j);
-        else if (k.kind == contact::KeyKind::boolean) j.face_shear = boolean(c, t, p, key).value_or(false);
-        else if (key == "tension_softening") j.tension_softening = read_curve(c, t, p, key);
-        else if (key == "shear_softening") j.shear_softening = read_curve(c, t, p, key);
+    j.law = std::string(contact::law_names[choice(c, t, p, "law", contact::law_names, "joint law")]);
+    const std::vector<std::string_view> keys = contact::law_key_names(j.law);
+    check_keys(c, t, p, keys, all, article(j.law) + " joint property");
+    for (const contact::JointKey* k : contact::law_keys(j.law)) {
+        if (k->set) read_declared_key(c, t, p, *k, j);
+        else if (k->set_curve) k->set_curve(j, read_curve(c, t, p, k->key));
     }
     // The rules between keys, by law (the flags keep the same ones).
     if (const auto problem = contact::check_joint_property(j)) {
@@ -812,13 +804,9 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     return mf;
 }
 
-RockFile parse_rock(std::string_view text, const std::string& name) {
+RockSpec parse_rock(std::string_view text, const std::string& name, RockSpec rock) {
     toml::table doc = parse_toml(text, name);
-    RockFile rock;
-    if (doc.contains("region")) {
-        rock.model = parse_model(text, name);
-        return rock;
-    }
+    if (doc.contains("region")) return rock_of_model(parse_model(text, name), name, std::move(rock));
     ModelSource source;
     source.file = name;
     Ctx c;
@@ -836,7 +824,7 @@ RockFile parse_rock(std::string_view text, const std::string& name) {
         c.fail(joints.empty() ? 0 : properties.lines[1], root.key("joint_property"),
                "a rock file holds the bonds as one [[joint_property]] table (what bbm calibrate writes), found " +
                    std::to_string(joints.size()) + "; a full model file (with its [[region]]s) is read as its rock");
-    rock.joint = joints.front();
+    rock.bonds = joints.front();
     Names materials{"material", "materials", "material", {}, {}};
     std::vector<MaterialSpec> found;
     read_tables(c, doc, "material", [&](const toml::table& t, const Path& p, std::size_t) {
@@ -845,12 +833,35 @@ RockFile parse_rock(std::string_view text, const std::string& name) {
     if (found.size() > 1)
         c.fail(materials.lines[1], root.key("material").at(1), "a rock file holds at most one [[material]], found " +
                                                                    std::to_string(found.size()));
-    if (!found.empty()) rock.material = found.front();
+    // Its blocks: the density; meshed blocks' share f of the deformation and their elasticity.
+    if (!found.empty()) {
+        const MaterialSpec& m = found.front();
+        rock.material.density = m.density;
+        rock.material.deformable_fraction = m.deformable_fraction;
+        if (m.deformable_fraction > 0.0) rock.material.young = m.young, rock.material.poisson = m.poisson;
+    }
     return rock;
 }
 
-RockFile read_rock(const std::string& path) {
-    return parse_rock(file_text(path), path);
+std::vector<std::pair<double, double>> parse_curve(std::string_view text, const std::string& flag) {
+    const std::string doc_text = "curve = " + std::string(text);
+    try {
+        const toml::table doc = parse_toml(doc_text, flag);
+        ModelSource source;
+        source.file = flag;
+        Ctx c;
+        c.file = flag;
+        c.source = &source;
+        return read_curve(c, doc, Path{}, "curve");
+    } catch (const InputError& e) {
+        // The flag, and the point within its curve: not a line of a one-line text.
+        const std::string point = e.key().starts_with("curve") ? e.key().substr(5) : std::string();
+        throw InputError(flag, 0, point, e.message());
+    }
+}
+
+RockSpec read_rock(const std::string& path, RockSpec base) {
+    return parse_rock(file_text(path), path, std::move(base));
 }
 
 ModelFile read_model(const std::string& path) {

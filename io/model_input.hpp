@@ -20,6 +20,7 @@
 
 #include "base/error.hpp"
 #include "core/model_spec.hpp"
+#include "core/rock.hpp"
 #include "meshing/spec.hpp"
 
 #include <map>
@@ -65,18 +66,36 @@ ModelFile read_model(const std::string& path);
 /// The same from text; `name` stands for the file name in messages (for tests).
 ModelFile parse_model(std::string_view text, const std::string& name);
 
-/// A rock as `--rock FILE` gives it to the lab tests, calibrate, envelope and
-/// shear: one [[joint_property]] (the bonds) and at most one [[material]] —
-/// what `bbm calibrate` writes (joint_property.toml) — read by the model file's
-/// own readers (the same keys, bounds and messages); or a whole model file, whose
-/// rock is then its bonded region (`model`; studies/model_rock.hpp).
-struct RockFile {
-    JointPropertySpec joint;
-    std::optional<MaterialSpec> material;
-    std::optional<ModelFile> model; ///< a model file given as the rock
-};
-RockFile read_rock(const std::string& path);
-RockFile parse_rock(std::string_view text, const std::string& name);
+/// A rock (core/rock.hpp) as `--rock FILE` gives it to the lab tests, calibrate,
+/// envelope and shear: a rock file — one [[joint_property]] (the bonds) and at
+/// most one [[material]] (the blocks' density; meshed blocks' deformable_fraction,
+/// young, poisson), what `bbm calibrate` writes — read by the model file's own
+/// readers (the same keys, bounds and messages); or a whole model file, whose rock
+/// is its bonded region (rock_of_model). What the file does not give keeps `base`'s.
+RockSpec read_rock(const std::string& path, RockSpec base = paper_rock());
+RockSpec parse_rock(std::string_view text, const std::string& name, RockSpec base = paper_rock());
+
+/// The rock of a model file (read from `file`, named in errors): its first region
+/// with a block pattern (not `single`) — the pattern, size and its measure, Lloyd
+/// iterations and seed; the joint property the [[joint_assignment]] rules give the
+/// joints between two of its blocks (in order, a later match overriding an
+/// earlier one, as the solver applies them); its material's density and, for
+/// meshed blocks, the deformable fraction, modulus, Poisson's ratio and triangle
+/// size. What a specimen cannot carry is refused with an InputError naming the
+/// file and the key: trigon regions whose radial and peripheral joints get
+/// different properties, meshed blocks whose material has no deformable fraction,
+/// a rotated lattice, bricks of another aspect or bond, a given shortest edge.
+RockSpec rock_of_model(const ModelFile& model, const std::string& file, RockSpec base = paper_rock());
+
+/// A softening curve written as a model file writes it, "[[1.7, 0.5], [4.0, 0]]"
+/// (a flag's value), checked by the reader's rules; errors name `flag` and the point.
+std::vector<std::pair<double, double>> parse_curve(std::string_view text, const std::string& flag);
+
+/// A [[joint_property]] table's text for a set, from its law's key declarations:
+/// every key the law reads that differs from its default, numbers exact
+/// (shortest round-trip text). parse_rock reads it back to the same set.
+std::string joint_property_toml(const JointPropertySpec& j);
+
 
 /// The text of a model file with keys set (`set`: full key as in messages,
 /// "joint_property[0].tensile" or "region[1].pattern.size", and a TOML value) and

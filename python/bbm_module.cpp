@@ -16,10 +16,10 @@
 // stresses) are the groups' properties. The GIL is released while the loop
 // runs; a callback, or Ctrl-C every 1,000 steps, takes it back.
 #include "base/error.hpp"
-#include "studies/commands.hpp"
-#include "studies/envelope.hpp"
-#include "studies/model.hpp"
-#include "studies/shear.hpp"
+#include "apps/flags.hpp"
+#include "studies/lab/envelope.hpp"
+#include "studies/model/model.hpp"
+#include "studies/lab/shear.hpp"
 
 #include <nlohmann/json.hpp>
 #include <pybind11/functional.h>
@@ -595,7 +595,7 @@ PYBIND11_MODULE(_bbm, mod) {
             };
         {
             py::gil_scoped_release release;
-            study = studies::run_labtest_args(command, args, quiet, on_frame);
+            study = cli::run_labtest_args(command, args, quiet, on_frame);
         }
         if (failure) throw std::move(*failure);
         py::list curves;
@@ -624,7 +624,7 @@ PYBIND11_MODULE(_bbm, mod) {
         std::string json;
         {
             py::gil_scoped_release release;
-            json = studies::run_envelope_args(args, quiet).summary_json;
+            json = cli::run_envelope_args(args, quiet).summary_json;
         }
         return py::module_::import("json").attr("loads")(json);
     });
@@ -632,7 +632,7 @@ PYBIND11_MODULE(_bbm, mod) {
         studies::ShearStudy study;
         {
             py::gil_scoped_release release;
-            study = studies::run_shear_args(args, quiet);
+            study = cli::run_shear_args(args, quiet);
         }
         // Every run's curve as numpy arrays, in the order of summary["runs"].
         py::list curves;
@@ -658,7 +658,7 @@ PYBIND11_MODULE(_bbm, mod) {
         std::string json;
         {
             py::gil_scoped_release release;
-            json = studies::run_calibrate_args(args, quiet);
+            json = cli::run_calibrate_args(args, quiet);
         }
         return py::module_::import("json").attr("loads")(json);
     });

@@ -6,7 +6,7 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
@@ -218,11 +218,11 @@ inline void check_lab_tests_on(std::initializer_list<int> threads) {
         {"ucs", small(Kind::ucs)},     {"tension", small(Kind::tension)},
         {"biaxial", small(Kind::biaxial)}, {"brazilian", small(Kind::brazilian)}};
     auto deformable = small(Kind::ucs);
-    deformable.material.deformable_fraction = 0.5;
+    deformable.rock.material.deformable_fraction = 0.5;
     tests.push_back({"ucs, deformable blocks f = 0.5", deformable});
     auto trigon = small(Kind::ucs);
-    trigon.pattern = meshing::PatternSpec::Kind::trigon;
-    trigon.joint.kn = 162e9, trigon.joint.ks = 68e9;
+    trigon.rock.pattern.kind = meshing::PatternSpec::Kind::trigon;
+    trigon.rock.bonds.kn = 162e9, trigon.rock.bonds.ks = 68e9;
     tests.push_back({"ucs, trigon", trigon});
     RecordedStates recorded;
     for (auto& test_case : tests)

@@ -8,7 +8,7 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "meshing/blocks.hpp"
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 
 #include <doctest/doctest.h>
 

@@ -1,7 +1,7 @@
 // Lab-test specimens shared by the fast and the long test suites.
 #pragma once
 
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 
 namespace bbm::test {
 
@@ -9,15 +9,15 @@ namespace bbm::test {
 /// stiffnesses, kn 162 and ks 68 GPa/m.
 inline LabTestOptions paper_trigon_ucs() {
     auto o = LabTestOptions::paper_ucs();
-    o.pattern = meshing::PatternSpec::Kind::trigon;
-    o.joint.kn = 162e9, o.joint.ks = 68e9;
+    o.rock.pattern.kind = meshing::PatternSpec::Kind::trigon;
+    o.rock.bonds.kn = 162e9, o.rock.bonds.ks = 68e9;
     return o;
 }
 
 /// The same, sized by equal area (the specimens issue 12 found locking).
 inline LabTestOptions area_trigon_ucs() {
     auto o = paper_trigon_ucs();
-    o.size_measure = meshing::PatternSpec::SizeMeasure::area;
+    o.rock.pattern.size_measure = meshing::PatternSpec::SizeMeasure::area;
     return o;
 }
 

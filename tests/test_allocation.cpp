@@ -5,7 +5,7 @@
 // before (amortised growth), not per step.
 #include "io/model_input.hpp"
 #include "core/stages.hpp"
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 #include "core/solver.hpp"
 
 #include <doctest/doctest.h>

@@ -4,9 +4,9 @@
 // friction angle. The full calibrations (paper's specimen, fresh seeds) are long
 // tests (test_long.cpp).
 #include "base/error.hpp"
-#include "studies/calibrate.hpp"
-#include "studies/residual_friction.hpp"
-#include "studies/commands.hpp"
+#include "studies/calibration/calibrate.hpp"
+#include "studies/lab/residual_friction.hpp"
+#include "apps/flags.hpp"
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
@@ -56,7 +56,7 @@ TEST_CASE("calibrate: the confined targets are checked before any run") {
     std::ofstream(record) << "sigma3_MPa,sigma1_MPa\n0,20\n5,15\n";
     auto refused = [](const std::vector<std::string>& args, const std::string& what) {
         INFO(what);
-        CHECK_THROWS_WITH_AS((void)run_calibrate_args(args, true), doctest::Contains(what.c_str()), InputError);
+        CHECK_THROWS_WITH_AS((void)cli::run_calibrate_args(args, true), doctest::Contains(what.c_str()), InputError);
     };
     // sigma1 below the UCS target at sigma3 = 5 MPa (the record's line 3).
     refused({"--target-record", record}, "must exceed the UCS target");
@@ -276,14 +276,14 @@ TEST_CASE("calibrate: the elastic measure of deformable blocks puts the blocks' 
     // --deformable-fraction` could not steer.
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0;
-    const auto rigid = elastic_measure(o.joint, o);
+    const auto rigid = elastic_measure(o.rock.bonds, o);
     REQUIRE(rigid.E > 0.0);
     for (const double f : {0.5, 0.95}) {
-        o.material.deformable_fraction = f;
-        o.material.young = 2.0 * rigid.E;
-        o.material.poisson = 0.25;
-        const auto m = elastic_measure(o.joint, o);
-        const double plane_strain = o.material.young / (1.0 - o.material.poisson * o.material.poisson);
+        o.rock.material.deformable_fraction = f;
+        o.rock.material.young = 2.0 * rigid.E;
+        o.rock.material.poisson = 0.25;
+        const auto m = elastic_measure(o.rock.bonds, o);
+        const double plane_strain = o.rock.material.young / (1.0 - o.rock.material.poisson * o.rock.material.poisson);
         const double series = 1.0 / (f / plane_strain + (1.0 - f) / rigid.E);
         INFO("f " << f << ": E " << m.E / 1e9 << " GPa (series " << series / 1e9 << ", rigid " << rigid.E / 1e9
                   << "), nu " << m.nu << " (rigid " << rigid.nu << ")");

@@ -11,7 +11,7 @@
 // wait for a core instead of spinning against each other.
 #include "io/model_input.hpp"
 #include "core/stages.hpp"
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 #include "core/solver.hpp"
 #include "tests/determinism.hpp"
 #include "tests/restart.hpp"
@@ -86,6 +86,6 @@ TEST_CASE("a run stopped on 1 thread and resumed on 2 or 3 ends in the same stat
     file.analysis.stages.back().max_steps = 6000; // failure stage cut: 9,000 steps in all
     test::check_exact_restart({meshing::generate_blocks(file.geometry), file.analysis}, {1901, 5969}, {2, 3});
     auto o = LabTestOptions::paper_ucs();
-    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.material.deformable_fraction = 0.95;
+    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.rock.material.deformable_fraction = 0.95;
     test::check_exact_restart(test::labtest_model(o, 13000), {7000, 10500}, {2, 3});
 }

@@ -8,7 +8,7 @@
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
 #include "meshing/dfn.hpp"
-#include "studies/sweep.hpp"
+#include "studies/model/sweep.hpp"
 
 #include <doctest/doctest.h>
 #include "tests/validation.hpp"

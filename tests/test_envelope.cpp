@@ -2,8 +2,11 @@
 // exactly on synthetic points and as least squares on scattered ones, the record
 // reader's errors, and a small envelope end to end; the rock of a model file as a
 // specimen (bbm compare --envelope).
-#include "studies/envelope.hpp"
-#include "studies/model_rock.hpp"
+#include "apps/flags.hpp"
+#include "studies/lab/envelope.hpp"
+#include "studies/model/compare_envelopes.hpp"
+#include "io/model_input.hpp"
+#include "base/error.hpp"
 
 #include <doctest/doctest.h>
 #include "tests/validation.hpp"
@@ -117,7 +120,7 @@ TEST_CASE("envelope: a strength record is read in MPa with its header, and a bad
 }
 
 TEST_CASE("envelope of a small Voronoi specimen: strength rises with confinement, the fits and ratios are reported" * validation) {
-    EnvelopeStudy study = run_envelope_args(
+    EnvelopeStudy study = cli::run_envelope_args(
         {"--width", "2", "--height", "4", "--confinements", "2e6,5e6", "--threads", "1", "--realizations", "1"}, true);
     const auto& runs = study.runs;
     REQUIRE(runs.size() == 4); // ucs, tension, two biaxial
@@ -163,31 +166,30 @@ std::string read_text(const std::string& file) {
 
 TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks become the specimen's") {
     const std::string dir = std::string(BBM_SOURCE_DIR) + "/examples/";
-    const auto rigid = labtest_of_model(io::read_model(dir + "compare_rigid_deformable/rigid.toml"), "rigid.toml");
-    CHECK(rigid.pattern == "voronoi");
-    CHECK(rigid.o.size == 0.3);
-    CHECK(rigid.o.seed == 7);
-    CHECK(rigid.o.material.deformable_fraction == 0.0);
-    CHECK(rigid.o.joint.kn == 96.6e9);
-    CHECK(rigid.o.joint.ks == 40.3e9);
-    CHECK(rigid.o.joint.tensile == 3.0e6);
-    CHECK(rigid.o.joint.cohesion == 9.5e6);
-    CHECK(rigid.o.joint.friction == 25.0);
-    CHECK(rigid.o.joint.tension_softening == std::vector<std::pair<double, double>>{{1.7, 0.5}, {4.0, 0.0}});
-    CHECK(rigid.o.joint.shear_softening == std::vector<std::pair<double, double>>{{1.3, 0.5}, {2.1, 0.0}});
-    CHECK(rigid.tension_softening.empty()); // the model's curves are kept as they are
+    const auto rigid = io::rock_of_model(io::read_model(dir + "compare_rigid_deformable/rigid.toml"), "rigid.toml");
+    CHECK(rigid.pattern.kind == meshing::PatternSpec::Kind::voronoi);
+    CHECK(rigid.pattern.size == 0.3);
+    CHECK(rigid.pattern.seed == 7);
+    CHECK(rigid.material.deformable_fraction == 0.0);
+    CHECK(rigid.bonds.kn == 96.6e9);
+    CHECK(rigid.bonds.ks == 40.3e9);
+    CHECK(rigid.bonds.tensile == 3.0e6);
+    CHECK(rigid.bonds.cohesion == 9.5e6);
+    CHECK(rigid.bonds.friction == 25.0);
+    CHECK(rigid.bonds.tension_softening == std::vector<std::pair<double, double>>{{1.7, 0.5}, {4.0, 0.0}});
+    CHECK(rigid.bonds.shear_softening == std::vector<std::pair<double, double>>{{1.3, 0.5}, {2.1, 0.0}});
 
     const auto f095 =
-        labtest_of_model(io::read_model(dir + "compare_rigid_deformable/deformable_f095.toml"), "deformable_f095.toml");
-    CHECK(f095.o.material.deformable_fraction == 0.95);
-    CHECK(f095.o.material.young == 22.4e9);
-    CHECK(f095.o.material.poisson == 0.2);
-    CHECK(f095.o.mesh_size == 0.15);
-    CHECK(f095.o.joint.kn == 96.6e9); // the split (kn / (1 - f)) is the lab test's, as the model's
+        io::rock_of_model(io::read_model(dir + "compare_rigid_deformable/deformable_f095.toml"), "deformable_f095.toml");
+    CHECK(f095.material.deformable_fraction == 0.95);
+    CHECK(f095.material.young == 22.4e9);
+    CHECK(f095.material.poisson == 0.2);
+    CHECK(f095.mesh_size == 0.15);
+    CHECK(f095.bonds.kn == 96.6e9); // the split (kn / (1 - f)) is the lab test's, as the model's
 
-    const auto trigon = labtest_of_model(io::read_model(dir + "tunnel_trigon.toml"), "tunnel_trigon.toml");
-    CHECK(trigon.pattern == "trigon");
-    CHECK(trigon.o.joint.name == "bond");
+    const auto trigon = io::rock_of_model(io::read_model(dir + "tunnel_trigon.toml"), "tunnel_trigon.toml");
+    CHECK(trigon.pattern.kind == meshing::PatternSpec::Kind::trigon);
+    CHECK(trigon.bonds.name == "bond");
 
     // What a specimen's pattern cannot carry is refused, naming the key: a given shortest edge.
     std::string edited = read_text(dir + "compare_rigid_deformable/rigid.toml");
@@ -195,7 +197,7 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
     REQUIRE(edited.find(voronoi) != std::string::npos);
     edited.replace(edited.find(voronoi), voronoi.size(), "pattern = { type = \"voronoi\", size = 0.3, seed = 7, min_edge = 0.01 }");
     try {
-        (void)labtest_of_model(io::parse_model(edited, "min_edge.toml"), "min_edge.toml");
+        (void)io::rock_of_model(io::parse_model(edited, "min_edge.toml"), "min_edge.toml");
         FAIL("expected an InputError");
     } catch (const InputError& e) {
         CHECK(std::string(e.what()).find("region[1].pattern.min_edge") != std::string::npos);
@@ -206,7 +208,7 @@ TEST_CASE("the rock of a model: the bonded region's pattern, joints and blocks b
                              "\n[[joint_assignment]]\nproperty = \"unbonded\"\ntags = [\"radial\"]\n";
     const auto two_bonds = io::parse_model(text, "two_bonds.toml");
     try {
-        (void)labtest_of_model(two_bonds, "two_bonds.toml");
+        (void)io::rock_of_model(two_bonds, "two_bonds.toml");
         FAIL("expected an InputError");
     } catch (const InputError& e) {
         CHECK(std::string(e.what()).find("two_bonds.toml") != std::string::npos);
@@ -224,7 +226,7 @@ TEST_CASE("compare --envelope and envelope --model measure a model's rock exactl
     options.confinements = {2e6};
     const std::string table = compare_envelopes({model}, out, 1, true, options);
     // The same rock by hand: the paper's joints on Voronoi blocks of 0.3 m, the model's seed 7.
-    const EnvelopeStudy direct = run_envelope_args(
+    const EnvelopeStudy direct = cli::run_envelope_args(
         {"--width", "1.5", "--height", "3", "--seed", "7", "--confinements", "2e6", "--threads", "1", "--realizations", "1"},
         true);
     const auto by_hand = nlohmann::json::parse(direct.summary_json);
@@ -234,7 +236,7 @@ TEST_CASE("compare --envelope and envelope --model measure a model's rock exactl
     CHECK(measured["ucs"]["mean"].get<double>() > 10e6);
     // bbm envelope --model: the same rock from the model file.
     const auto from_model = nlohmann::json::parse(
-        run_envelope_args({"--model", model, "--width", "1.5", "--height", "3", "--confinements", "2e6", "--threads", "1"}, true)
+        cli::run_envelope_args({"--model", model, "--width", "1.5", "--height", "3", "--confinements", "2e6", "--threads", "1"}, true)
             .summary_json);
     CHECK(from_model["ucs"]["mean"].get<double>() == by_hand["ucs"]["mean"].get<double>());
     CHECK(from_model["specimen"]["model"].get<std::string>() == model);

@@ -6,10 +6,10 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
-#include "studies/labtest.hpp"
-#include "studies/labtest_values.hpp"
-#include "studies/model_rock.hpp"
-#include "studies/opening.hpp"
+#include "studies/lab/labtest.hpp"
+#include "studies/lab/labtest_values.hpp"
+#include "studies/model/compare_envelopes.hpp"
+#include "studies/model/opening.hpp"
 #include "tests/model_text.hpp"
 #include "tests/validation_record.hpp"
 
@@ -171,11 +171,12 @@ TEST_CASE("block size: the Mine-by models at 0.12, 0.06 and 0.045 m hold the sam
         const std::string path = std::string(BBM_SOURCE_DIR) + "/examples/field/" + sz.file;
         const auto model = io::read_model(path);
         auto specimen = [&](LabTestOptions::Kind kind) {
-            studies::LabTestCli c = studies::labtest_of_model(model, path, studies::labtest_defaults(kind));
-            c.o.width = 2.4, c.o.height = 4.8, c.o.seed = 2001;
+            studies::LabTestValues c = studies::labtest_defaults(kind);
+            c.o.rock = io::rock_of_model(model, path, c.o.rock);
+            c.o.width = 2.4, c.o.height = 4.8, c.o.rock.pattern.seed = 2001;
             if (kind == LabTestOptions::Kind::tension) c.o.platen_friction = -1.0;
             studies::prepare_labtest(c, kind);
-            CHECK(c.o.size == sz.size);
+            CHECK(c.o.rock.pattern.size == sz.size);
             return c.o;
         };
         jobs.emplace_back([o = specimen(LabTestOptions::Kind::ucs), &sz] { sz.ucs = run_labtest(o); });

@@ -7,7 +7,7 @@
 #include "core/solver.hpp"
 #include "io/model_input.hpp"
 #include "meshing/blocks.hpp"
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 
 #include <doctest/doctest.h>
 #include "tests/validation.hpp"
@@ -39,12 +39,12 @@ TEST_CASE("heterogeneous strengths: class factors of mean 1 and the Weibull law'
 TEST_CASE("heterogeneous strengths: joints fall evenly into the classes, the same way every time") {
     LabTestOptions o = LabTestOptions::paper_ucs();
     o.width = 6.0, o.height = 12.0;
-    o.joint.weibull_modulus = 3.0;
-    o.joint.strength_classes = 8;
+    o.rock.bonds.weibull_modulus = 3.0;
+    o.rock.bonds.strength_classes = 8;
     const auto blocks = meshing::generate_blocks(labtest_geometry(o));
     auto classes_of = [&](std::uint64_t seed) {
         LabTestOptions p = o;
-        p.seed = seed;
+        p.rock.pattern.seed = seed;
         Solver s(blocks, labtest_analysis(p));
         std::vector<int> props;
         for (int i = 0; i < contacts(s.world()).size(); ++i) props.push_back(contacts(s.world()).property[i]);
@@ -74,7 +74,7 @@ TEST_CASE("heterogeneous strengths: a weaker rock that cracks earlier (4 x 8 m, 
     o.width = 4.0, o.height = 8.0;
     o.threads = 2;
     const auto uniform = run_labtest(o);
-    o.joint.weibull_modulus = 2.0;
+    o.rock.bonds.weibull_modulus = 2.0;
     const auto heterogeneous = run_labtest(o);
     // Stiffness untouched (the preload ends at another load: 5e-6 from geometric nonlinearity).
     CHECK(heterogeneous.E == doctest::Approx(uniform.E).epsilon(1e-4));

@@ -2,13 +2,16 @@
 // through their points, fracture energies equal the areas under the curves,
 // unloading is elastic with the initial stiffness, damage persists.
 #include "contact/joint_law.hpp"
-#include "studies/labtest.hpp"
+#include "core/rock.hpp"
 
 #include "tests/softening_reference.hpp"
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 #include <numbers>
 
 using namespace bbm;
@@ -17,9 +20,7 @@ using namespace bbm::contact;
 namespace {
 
 /// The paper's Voronoi calibration (SPEC §8).
-JointPropertySpec paper_bond() { return LabTestOptions::paper_ucs().joint; }
-
-double tan_deg(double d) { return std::tan(d * std::numbers::pi / 180.0); }
+JointPropertySpec paper_bond() { return paper_rock().bonds; }
 
 
 } // namespace
@@ -204,7 +205,7 @@ TEST_CASE("softening law with a confined friction: the bonded cap steepens above
     }
     // A Coulomb law ignores it: the key is the softening law's.
     auto q = p;
-    q.law = JointPropertySpec::Law::coulomb;
+    q.law = "coulomb";
     const CoulombLaw coulomb(q);
     CHECK(coulomb.friction(150e6) == doctest::Approx(150e6 * tan_deg(5)));
 }
@@ -254,7 +255,7 @@ TEST_CASE("brittle softening (no post-peak points) and the Coulomb law") {
     CHECK(h.broken == JointState::broken_tension);
 
     JointPropertySpec c;
-    c.law = JointPropertySpec::Law::coulomb;
+    c.law = "coulomb";
     c.kn = 1e9;
     c.ks = 1e9;
     c.friction = 30;
@@ -271,48 +272,112 @@ TEST_CASE("brittle softening (no post-peak points) and the Coulomb law") {
     CHECK(s.tau == 0.0);
 }
 
-TEST_CASE("Barton-Bandis joint: peak, dilation, post-peak mobilisation of JRC and its bounds") {
+namespace {
+
+/// Barton (1982), "Modelling rock joint behaviour from in situ block tests":
+/// JRC_mob / JRC against δ / δp, the mobilised angle φr + (JRC_mob/JRC) i with
+/// i = JRC log10(JCS/σn); −φr/i at δ = 0 (φ_mob = 0).
+double barton_mobilised_deg(double r, double residual, double i) {
+    constexpr std::array<std::pair<double, double>, 8> table{
+        {{0.3, 0.0}, {0.6, 0.75}, {1.0, 1.0}, {2.0, 0.85}, {4.0, 0.70}, {10.0, 0.5}, {100.0, 0.0}, {1e9, 0.0}}};
+    if (r < 0.3) return residual * r / 0.3;
+    for (std::size_t k = 0; k + 1 < table.size(); ++k)
+        if (r < table[k + 1].first) {
+            const auto [r0, f0] = table[k];
+            const auto [r1, f1] = table[k + 1];
+            return residual + i * (f0 + (f1 - f0) * (r - r0) / (r1 - r0));
+        }
+    return residual;
+}
+
+/// A joint sheared at a held normal stress: (shear displacement, τ) every step.
+std::vector<std::pair<double, double>> shear_at_constant_normal_stress(const contact::BartonBandisLaw& bb, double kn,
+                                                                      double sn, double du, double to,
+                                                                      contact::JointHistory* end = nullptr) {
+    contact::JointHistory h;
+    h.bonded = false;
+    std::vector<std::pair<double, double>> curve;
+    for (double u = 0.0; u < to; u += du) {
+        const double dun = (h.upn - sn / kn) - h.un; // keep σn = kn (upn − un) at sn
+        bb.update(h, dun, du);
+        curve.emplace_back(h.us, h.tau);
+    }
+    if (end) *end = h;
+    return curve;
+}
+
+} // namespace
+
+TEST_CASE("Barton-Bandis joint: Barton's mobilisation curve before and after the peak, its peak displacement") {
+    // A 0.2 m joint of JRC 7, JCS 100 MPa, φr 30°, ks 43 GPa/m as a new user would
+    // give it: δp = (L/500)(JRC/L)^0.33 = 1.3 mm (Barton & Bandis 1982), where
+    // elastic to the peak it would have peaked at τp/ks = 0.02-0.16 mm.
     JointPropertySpec p;
-    p.law = JointPropertySpec::Law::barton_bandis;
+    p.law = "barton_bandis";
+    p.kn = 100e9, p.ks = 43e9;
+    p.friction = 30.0, p.jrc = 7.0, p.jcs = 100e6, p.joint_length = 0.2;
+    const contact::JointLaw law = contact::make_law(p);
+    const auto& bb = std::get<contact::BartonBandisLaw>(law);
+    CHECK_FALSE(contact::starts_bonded(law));
+    CHECK(p.law == "barton_bandis");
+    const double deg = std::numbers::pi / 180.0;
+    const double dp = 0.2 / 500.0 * std::pow(7.0 / 0.2, 0.33);
+    CHECK(dp == doctest::Approx(1.30e-3).epsilon(0.01));
+    CHECK(bb.peak_displacement == doctest::Approx(dp).epsilon(1e-12));
+
+    for (double sn : {0.8e6, 9e6}) {
+        CAPTURE(sn);
+        const double i = 7.0 * std::log10(100e6 / sn);
+        const double du = dp / 4000;
+        const auto curve = shear_at_constant_normal_stress(bb, p.kn, sn, du, 12.0 * dp);
+        // The peak where Barton has it, at δp (within two increments), and its value.
+        const auto peak = *std::max_element(curve.begin(), curve.end(),
+                                            [](const auto& a, const auto& b) { return a.second < b.second; });
+        CHECK(peak.first == doctest::Approx(dp).epsilon(2.0 / 4000));
+        CHECK(peak.second == doctest::Approx(sn * std::tan((30.0 + i) * deg)).epsilon(1e-3));
+        // The whole curve: τ(δ) = σn tan φ_mob(δ/δp) at every step, within the
+        // lag of one increment (its slope times du).
+        double worst = 0.0;
+        for (const auto& [u, tau] : curve) {
+            const double expected = sn * std::tan(barton_mobilised_deg(u / dp, 30.0, i) * deg);
+            worst = std::max(worst, std::abs(tau - expected) / (sn * std::tan((30.0 + i) * deg)));
+        }
+        CHECK(worst < 2e-3);
+    }
+}
+
+TEST_CASE("Barton-Bandis joint: dilation while sliding, the residual, the bounds of its angle, unloading") {
+    JointPropertySpec p;
+    p.law = "barton_bandis";
     p.kn = 100e9, p.ks = 50e9;
     p.friction = 28.0, p.jrc = 12.0, p.jcs = 80e6, p.joint_length = 0.5;
     const contact::JointLaw law = contact::make_law(p);
     const auto& bb = std::get<contact::BartonBandisLaw>(law);
-    CHECK_FALSE(contact::starts_bonded(law));
-    CHECK(contact::law_names[std::size_t(p.law)] == "barton_bandis");
     const double deg = std::numbers::pi / 180.0;
-    // δp = (L/500)(JRC/L)^0.33 (Barton & Bandis 1982): 0.5 m, JRC 12 -> 2.85 mm.
     const double dp = 0.5 / 500.0 * std::pow(12.0 / 0.5, 0.33);
-    CHECK(bb.peak_displacement == doctest::Approx(dp).epsilon(1e-12));
-
-    // Sheared under a constant normal stress: the opening follows the dilation.
     for (double sn : {2e6, 10e6}) {
         CAPTURE(sn);
         contact::JointHistory h;
-        h.bonded = false;
-        const double du = 1e-6; // shear increment, m
-        double peak = 0.0, tau_at_4dp = 0.0, upn_at_peak_slip = -1.0;
-        for (int k = 0; k < 400000 && h.ups < 120.0 * dp; ++k) {
-            const double dun = (h.upn - sn / p.kn) - h.un; // keep σn = kn (upn − un) at sn
-            bb.update(h, dun, du);
-            peak = std::max(peak, h.tau);
-            if (upn_at_peak_slip < 0 && h.slipping) upn_at_peak_slip = h.upn;
-            if (tau_at_4dp == 0.0 && h.ups >= 3.0 * dp) tau_at_4dp = h.tau; // δ/δp = 1 + ups/δp = 4
-        }
+        const auto curve = shear_at_constant_normal_stress(bb, p.kn, sn, dp / 1000, 110.0 * dp, &h);
         const double roughness = 12.0 * std::log10(80e6 / sn);
-        CHECK(peak == doctest::Approx(sn * std::tan((28.0 + roughness) * deg)).epsilon(1e-4));
-        // JRC_mob = 0.70 JRC at δ/δp = 4 (Barton 1982), the residual σn tan φr beyond 100.
-        const double sn_now = -p.kn * (h.un - h.upn);
-        CHECK(tau_at_4dp == doctest::Approx(sn * std::tan((28.0 + 0.7 * roughness) * deg)).epsilon(1e-3));
-        CHECK(h.tau == doctest::Approx(sn_now * std::tan(28.0 * deg)).epsilon(1e-6));
-        // The opening while sliding: ∫ tan(½ JRC_mob log10(JCS/σn)) dups, between
-        // the peak's rate and zero: at least the first δp at the peak's rate.
-        CHECK(h.upn > dp * std::tan(0.5 * roughness * deg) * 0.99);
-        CHECK(h.upn < 120.0 * dp * std::tan(0.5 * roughness * deg));
+        // Past δ/δp = 100 the residual σn tan φr.
+        CHECK(curve.back().second == doctest::Approx(sn * std::tan(28.0 * deg)).epsilon(1e-6));
+        // The opening while sliding: ∫ tan(½ (φ_mob − φr)) dups, where positive:
+        // above the peak's rate over the stretch from 0.6 δp to 2 δp, where
+        // φ_mob − φr ≥ 0.75 i, and below the peak's rate over the whole slide.
+        CHECK(h.upn > 1.4 * dp * std::tan(0.5 * 0.75 * roughness * deg) * 0.99);
+        CHECK(h.upn < 110.0 * dp * std::tan(0.5 * roughness * deg));
     }
-    // Bounds: φr + JRC log10(JCS/σn) at most 70°; σn above JCS gives φr; apart, no shear.
-    CHECK(bb.strength(1.0, 0.0) == doctest::Approx(1.0 * std::tan(70.0 * deg)));
-    CHECK(bb.strength(100e6, 0.0) == doctest::Approx(100e6 * std::tan(28.0 * deg)));
+    // Bounds: φr + JRC log10(JCS/σn) at most 70°; σn above JCS gives φr (at the peak, δ = δp).
+    CHECK(bb.strength(1.0, dp) == doctest::Approx(1.0 * std::tan(70.0 * deg)));
+    CHECK(bb.strength(100e6, dp) == doctest::Approx(100e6 * std::tan(28.0 * deg)));
+    // Unloaded past its peak and reloaded: elastic with ks, then the softened strength.
+    contact::JointHistory h;
+    (void)shear_at_constant_normal_stress(bb, p.kn, 5e6, dp / 1000, 3.0 * dp, &h);
+    const double tau = h.tau, worn = h.ups;
+    bb.update(h, 0.0, -tau / p.ks / 2);
+    CHECK(h.tau == doctest::Approx(tau / 2).epsilon(1e-9));
+    CHECK(h.ups == worn);
     contact::JointHistory open;
     open.bonded = false;
     bb.update(open, 1e-4, 1e-4);

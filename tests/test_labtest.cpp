@@ -1,9 +1,9 @@
-// Numerical lab tests (studies/labtest.hpp) on the paper's 8 m × 16 m specimen of
+// Numerical lab tests (studies/lab/labtest.hpp) on the paper's 8 m × 16 m specimen of
 // Voronoi blocks with its joint properties (SPEC §8). The runs of minutes (trigon,
 // calibration) are in test_long.cpp.
 #include "core/solver.hpp"
-#include "studies/calibrate.hpp"
-#include "studies/labtest.hpp"
+#include "studies/calibration/calibrate.hpp"
+#include "studies/lab/labtest.hpp"
 #include "tests/specimens.hpp"
 
 #include <doctest/doctest.h>
@@ -28,7 +28,7 @@ TEST_CASE("direct tension, paper specimen: mean strength of 3 realizations withi
         auto o = LabTestOptions::paper_ucs();
         o.kind = LabTestOptions::Kind::tension;
         o.strain_per_step = 5e-9;
-        o.seed = seed;
+        o.rock.pattern.seed = seed;
         const auto r = run_labtest(o);
         INFO("seed " << seed << ": tensile strength " << r.peak_stress / 1e6 << " MPa");
         CHECK(r.peak_passed);
@@ -52,13 +52,13 @@ TEST_CASE("uniaxial compression, paper specimen, 3 realizations: the paper's mod
     // mean block area (examples/verification/hexagonal_lattice.toml); a random
     // Voronoi assembly is close to it.
     const auto base = LabTestOptions::paper_ucs();
-    const double kn = base.joint.kn, ks = base.joint.ks;
+    const double kn = base.rock.bonds.kn, ks = base.rock.bonds.ks;
     double E = 0, peak = 0, peak2 = 0;
     std::string seeds_E, seeds_peak, seeds_lattice; // the records' per-seed figures
     bool lattice_held = true;
     for (std::uint64_t seed : {1, 2, 3}) {
         auto o = base;
-        o.seed = seed;
+        o.rock.pattern.seed = seed;
         const auto r = run_labtest(o);
         const double d = std::sqrt(4.0 * o.width * o.height / (std::numbers::pi * r.blocks));
         const double a = d * std::sqrt(std::numbers::pi / (2 * std::sqrt(3.0)));
@@ -114,7 +114,7 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
     // gauges give the lattice's own values: E = 2a kn (kn + ks)/(3kn + ks),
     // nu = (kn - ks)/(3kn + ks), a the spacing (examples/verification/hexagonal_lattice.toml).
     auto o = LabTestOptions::paper_ucs();
-    o.pattern = meshing::PatternSpec::Kind::hexagonal;
+    o.rock.pattern.kind = meshing::PatternSpec::Kind::hexagonal;
     o.threads = 2;
     o.frame_every = 1500;
     // Statics after the axial joints split (docs/calibration.md, "The hexagonal
@@ -134,7 +134,7 @@ TEST_CASE("hexagonal lattice UCS with default options: E and nu of the linear pa
         if (na > 0 && ni > 0 && p.axial_stress > 0) frames.push_back({p.axial_strain, p.axial_stress, axial / na / p.axial_stress, inclined / ni / p.axial_stress});
     };
     const auto r = run_labtest(o, {}, {}, on_frame);
-    const double kn = o.joint.kn, ks = o.joint.ks, a = o.size;
+    const double kn = o.rock.bonds.kn, ks = o.rock.bonds.ks, a = o.rock.pattern.size;
     const double E = 2 * a * kn * (kn + ks) / (3 * kn + ks), nu = (kn - ks) / (3 * kn + ks);
     INFO("E " << r.E / 1e9 << " GPa (closed form " << E / 1e9 << "), nu " << r.nu << " (" << nu << "), E50 "
               << r.E50 / 1e9 << ", peak " << r.peak_stress / 1e6 << " MPa");
@@ -226,7 +226,7 @@ TEST_CASE("post-peak, mechanism 1: local crack bursts of a small rigid specimen 
     // the load carriers are asked: bonds still carry it, loading goes on, and the
     // specimen fails for real. Checked: without asking, it still locks.
     auto o = LabTestOptions::paper_ucs();
-    o.width = 2.0, o.height = 4.0, o.seed = 1;
+    o.width = 2.0, o.height = 4.0, o.rock.pattern.seed = 1;
     const auto p = post_peak_run(o);
     CHECK(p.r.peak_passed);
     CHECK_FALSE(p.r.still_loading);
@@ -240,7 +240,7 @@ TEST_CASE("a test not failed at its strain limit loads on to its strength and at
     // default 1% did this silently). With the default cap it loads on, fails, and
     // its peak is the one of a run limited at 1%: the same steps up to the peak.
     auto o = LabTestOptions::paper_ucs();
-    o.width = 2.0, o.height = 4.0, o.seed = 1;
+    o.width = 2.0, o.height = 4.0, o.rock.pattern.seed = 1;
     o.threads = 2;
     o.stop.max_strain = 5e-4;
     o.stop.strain_cap = 0.0;
@@ -281,19 +281,19 @@ TEST_CASE("deformable specimens meshed in parallel threads: no heap corruption, 
     // realizations one at a time: docs/calibration.md.)
     auto o = LabTestOptions::paper_ucs();
     o.width = 2.0, o.height = 4.0;
-    o.material.deformable_fraction = 0.95;
+    o.rock.material.deformable_fraction = 0.95;
     o.stop.max_strain = 2e-4;
     o.stop.strain_cap = 0.0; // the preload and a few steps are what this compares
     o.threads = 1;
     std::vector<LabTestResult> serial, parallel(3);
     for (int k = 0; k < 3; ++k) {
-        o.seed = std::uint64_t(k + 1);
+        o.rock.pattern.seed = std::uint64_t(k + 1);
         serial.push_back(run_labtest(o));
     }
     std::vector<std::thread> pool;
     for (int k = 0; k < 3; ++k)
         pool.emplace_back([&parallel, o, k]() mutable {
-            o.seed = std::uint64_t(k + 1);
+            o.rock.pattern.seed = std::uint64_t(k + 1);
             parallel[k] = run_labtest(o);
         });
     for (auto& t : pool) t.join();
@@ -333,7 +333,7 @@ TEST_CASE("a single plane of weakness slides where Jaeger's closed form says (bi
         o.rough_platens = false;
         o.joint_set.on = true;
         o.joint_set.angle = beta;
-        o.joint_set.joint.kn = o.joint.kn, o.joint_set.joint.ks = o.joint.ks;
+        o.joint_set.joint.kn = o.rock.bonds.kn, o.joint_set.joint.ks = o.rock.bonds.ks;
         o.joint_set.joint.friction = 30.0;
         o.stop.max_strain = 2e-3; // the slip is read before; the pieces then jam
         o.stop.strain_cap = 0.0;
@@ -363,15 +363,15 @@ TEST_CASE("a biaxial test whose confinement leaves a block the implicit preload 
     // start, and seed 1, which the preload solves, is unchanged in kind.
     auto o = LabTestOptions::paper_ucs();
     o.kind = LabTestOptions::Kind::biaxial;
-    o.pattern = meshing::PatternSpec::Kind::trigon;
-    o.size = 0.12, o.width = 2.4, o.height = 4.8;
-    o.joint.kn = 2000.3e9, o.joint.ks = 683.5e9;
-    o.joint.tensile = 17.9e6, o.joint.cohesion = 123.9e6, o.joint.friction = 35.0;
+    o.rock.pattern.kind = meshing::PatternSpec::Kind::trigon;
+    o.rock.pattern.size = 0.12, o.width = 2.4, o.height = 4.8;
+    o.rock.bonds.kn = 2000.3e9, o.rock.bonds.ks = 683.5e9;
+    o.rock.bonds.tensile = 17.9e6, o.rock.bonds.cohesion = 123.9e6, o.rock.bonds.friction = 35.0;
     o.confinement = 71e6;
     o.stop.max_steps = 3000;
     o.threads = 1;
     for (std::uint64_t seed : {1, 2}) {
-        o.seed = seed;
+        o.rock.pattern.seed = seed;
         const auto r = run_labtest(o);
         const double first = r.curve.front().axial_stress, last = r.curve.back().axial_stress;
         MESSAGE("seed " << seed << ": preload " << std::string(r.preload_skipped ? "skipped" : "solved") << ", "
@@ -418,14 +418,14 @@ TEST_CASE("the residual strength: the mean stress over the curve's last 0.2% of 
 }
 
 TEST_CASE("the envelope's confined test: its tail past the failure runs at the servo's fastest speed, the peak the same to the last digit" * validation) {
-    // studies/labtest.hpp, as_envelope_confined_test: bbm envelope and calibrate
+    // studies/lab/labtest.hpp, as_envelope_confined_test: bbm envelope and calibrate
     // stop a biaxial test 2e-4 of strain past its failure, and run that tail at
     // --servo-max instead of the post-failure half speed. Nothing before the
     // failure may change: the same steps up to it, so the same peak, first stall,
     // sigma_ci, E and nu, bit for bit; the tail takes fewer steps.
     auto o = LabTestOptions::paper_ucs();
     o.kind = LabTestOptions::Kind::biaxial;
-    o.width = 2.0, o.height = 4.0, o.seed = 1, o.confinement = 2e6, o.frame_every = 0;
+    o.width = 2.0, o.height = 4.0, o.rock.pattern.seed = 1, o.confinement = 2e6, o.frame_every = 0;
     o.stop.post_peak_strain = envelope_post_peak_strain;
     auto envelope = o;
     as_envelope_confined_test(envelope);

@@ -6,9 +6,9 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
-#include "studies/calibrate.hpp"
-#include "studies/labtest.hpp"
-#include "studies/opening.hpp"
+#include "studies/calibration/calibrate.hpp"
+#include "studies/lab/labtest.hpp"
+#include "studies/model/opening.hpp"
 #include "tests/restart.hpp"
 #include "tests/specimens.hpp"
 #include "tests/validation_record.hpp"
@@ -34,7 +34,7 @@ TEST_CASE("uniaxial compression, paper trigon specimen, 3 realizations: the pape
     for (int k = 0; k < 3; ++k)
         pool.emplace_back([&r, k] {
             auto o = test::paper_trigon_ucs();
-            o.seed = std::uint64_t(k + 1);
+            o.rock.pattern.seed = std::uint64_t(k + 1);
             r[k] = run_labtest(o);
         });
     for (auto& t : pool) t.join();
@@ -179,10 +179,10 @@ TEST_CASE("residual strength, Lac du Bonnet's in-situ set: broken joints at 10 d
     // degrees (Byerlee 1978); asserted within 3 degrees.
     LabTestOptions o;
     o.kind = LabTestOptions::Kind::biaxial;
-    o.size = 0.12, o.width = 2.4, o.height = 4.8, o.material.density = 2650, o.seed = 1001;
-    o.joint.kn = 954.511e9, o.joint.ks = 257.441e9;
-    o.joint.tensile = 15.1313e6, o.joint.cohesion = 41.843e6;
-    o.joint.friction = 5, o.joint.residual_friction = 10;
+    o.rock.pattern.size = 0.12, o.width = 2.4, o.height = 4.8, o.rock.material.density = 2650, o.rock.pattern.seed = 1001;
+    o.rock.bonds.kn = 954.511e9, o.rock.bonds.ks = 257.441e9;
+    o.rock.bonds.tensile = 15.1313e6, o.rock.bonds.cohesion = 41.843e6;
+    o.rock.bonds.friction = 5, o.rock.bonds.residual_friction = 10;
     o.confinement = 10e6;
     o.stop.fraction = 0.0, o.stop.max_strain = 0.02, o.stop.strain_cap = 0.02;
     o.threads = 2, o.frame_every = 0;
@@ -214,9 +214,9 @@ TEST_CASE("confined friction, Lac du Bonnet: sigma_ci unconfined and the laborat
     // same bonds without the confined friction far below the peak (their joints'
     // Coulomb envelope: 2c sqrt(N) + N sigma3 = 129 MPa).
     CalibrationOptions o;
-    o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
-    o.base.material.density = 2650;
-    auto& j = o.base.joint;
+    o.base.rock.pattern.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
+    o.base.rock.material.density = 2650;
+    auto& j = o.base.rock.bonds;
     j.kn = 957593745133.4312, j.ks = 266384954237.1118;
     j.tensile = 15296822.579253344, j.cohesion = 39651374.19228245;
     j.friction = 5, j.residual_friction = 10;
@@ -241,8 +241,8 @@ TEST_CASE("confined friction, Lac du Bonnet: sigma_ci unconfined and the laborat
     CHECK(fresh.still_loading == 0);
     LabTestOptions plain = o.base;
     plain.kind = LabTestOptions::Kind::biaxial;
-    plain.joint.confined_friction = -1;
-    plain.confinement = 35.5e6, plain.seed = 1001, plain.threads = 2, plain.frame_every = 0;
+    plain.rock.bonds.confined_friction = -1;
+    plain.confinement = 35.5e6, plain.rock.pattern.seed = 1001, plain.threads = 2, plain.frame_every = 0;
     plain.stop.post_peak_strain = envelope_post_peak_strain;
     const auto r = run_labtest(plain);
     MESSAGE("without the confined friction: sigma1 " << r.peak_stress / 1e6 << " MPa");
@@ -257,11 +257,11 @@ TEST_CASE("calibrate, Lac du Bonnet on crack initiation: E, nu, sigma_ci and ten
     // stiffnesses. Issue 23's targets on fresh seeds: E, nu and the strength within
     // 5%, tension within 10%.
     CalibrationOptions o;
-    o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
-    o.base.material.density = 2650;
-    o.base.joint.kn = 992e9, o.base.joint.ks = 339e9;
-    o.base.joint.tensile = 17.2e6, o.base.joint.cohesion = 36e6;
-    o.base.joint.friction = 5, o.base.joint.residual_friction = 35;
+    o.base.rock.pattern.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
+    o.base.rock.material.density = 2650;
+    o.base.rock.bonds.kn = 992e9, o.base.rock.bonds.ks = 339e9;
+    o.base.rock.bonds.tensile = 17.2e6, o.base.rock.bonds.cohesion = 36e6;
+    o.base.rock.bonds.friction = 5, o.base.rock.bonds.residual_friction = 35;
     o.start_kn = o.start_ks = o.start_tensile = o.start_cohesion = true;
     o.realizations = 3;
     o.threads = 2;
@@ -302,13 +302,13 @@ TEST_CASE("calibrate, Lac du Bonnet on crack initiation: E, nu, sigma_ci and ten
 namespace {
 
 /// Seeds 1–3 of a lab test: in parallel, one thread each; deformable specimens one
-/// at a time, two threads each, as `bbm ucs --realizations` runs them (studies/commands.cpp).
+/// at a time, two threads each, as `bbm ucs --realizations` runs them (studies/lab/commands.cpp).
 std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
     std::vector<LabTestResult> r(3);
-    if (base.material.deformable_fraction > 0.0) {
+    if (base.rock.material.deformable_fraction > 0.0) {
         for (int k = 0; k < 3; ++k) {
             auto o = base;
-            o.seed = std::uint64_t(k + 1);
+            o.rock.pattern.seed = std::uint64_t(k + 1);
             o.threads = 2;
             o.stop.fraction = 0.5;
             r[k] = run_labtest(o);
@@ -319,7 +319,7 @@ std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
     for (int k = 0; k < 3; ++k)
         pool.emplace_back([&r, &base, k] {
             auto o = base;
-            o.seed = std::uint64_t(k + 1);
+            o.rock.pattern.seed = std::uint64_t(k + 1);
             o.threads = 1;
             o.stop.fraction = 0.5; // the checks follow the softening to half the peak
             r[k] = run_labtest(o);
@@ -345,7 +345,7 @@ void check_softens(const std::vector<LabTestResult>& r, const char* what) {
 LabTestOptions small(double deformable_fraction) {
     auto o = LabTestOptions::paper_ucs();
     o.width = 4.0, o.height = 8.0;
-    o.material.deformable_fraction = deformable_fraction;
+    o.rock.material.deformable_fraction = deformable_fraction;
     return o;
 }
 

@@ -18,8 +18,8 @@
 #include "meshing/dfn_keys.hpp"
 #include "meshing/model_keys.hpp"
 #include "meshing/region_keys.hpp"
-#include "studies/commands.hpp"
-#include "studies/shear.hpp"
+#include "apps/flags.hpp"
+#include "studies/lab/shear.hpp"
 
 #include <doctest/doctest.h>
 
@@ -64,7 +64,7 @@ std::string file_error(const std::string& property) {
 /// itself is not run: an accepted set would run, so only refused sets are given).
 std::string flag_error(const std::vector<std::string>& flags) {
     try {
-        (void)studies::run_labtest_args("ucs", flags, true);
+        (void)cli::run_labtest_args("ucs", flags, true);
     } catch (const InputError& e) {
         return e.what();
     }
@@ -95,7 +95,8 @@ void check_reference(const std::string& name, const std::string& generated) {
 TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     const std::string joints = contact::joint_keys_markdown();
     check_reference("joint_property.md", joints);
-    for (const auto& k : contact::joint_keys) CHECK(joints.find("| `" + std::string(k.key) + "` |") != std::string::npos);
+    for (const contact::JointKey* k : contact::joint_keys())
+        CHECK(joints.find("| `" + std::string(k->key) + "` |") != std::string::npos);
     check_reference("material.md", material_keys_markdown());
     const std::string flow = flow_keys_markdown();
     check_reference("flow.md", flow);
@@ -112,8 +113,11 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {
-    for (const std::string_view key : studies::labtest_joint_keys) {
-        const contact::JointKey& k = *contact::find_joint_key(key);
+    // Every joint key a lab test's rock takes as a flag (declared `flag`): its numbers.
+    for (const contact::JointKey* declared : contact::joint_keys()) {
+        if (!declared->flag || !(declared->kind == KeyKind::number || declared->kind == KeyKind::integer)) continue;
+        const contact::JointKey& k = *declared;
+        const std::string_view key = k.key;
         const double bad = outside(k.bounds);
         const std::string value = shortest_text(bad);
         INFO(key, " = ", value);
@@ -127,8 +131,9 @@ TEST_CASE("A key and its flag refuse the same values in the same words") {
         CHECK(as_flag.find(contact::joint_flag(key)) != std::string::npos);
         CHECK(as_flag.find(k.bounds.text()) != std::string::npos);
     }
-    for (const std::string_view key : studies::labtest_material_keys) {
-        const MaterialKey& k = *find_key(material_keys, key);
+    for (const MaterialKey& k : material_keys) {
+        if (!k.flag) continue;
+        const std::string_view key = k.key;
         const std::string value = shortest_text(outside(k.bounds));
         INFO(key, " = ", value);
         const std::string in_file = [&]() -> std::string {
@@ -154,26 +159,25 @@ TEST_CASE("A key and its flag refuse the same values in the same words") {
 }
 
 TEST_CASE("Each law reads the keys it declares, and a key of another law is refused naming the law") {
-    for (std::size_t l = 0; l < contact::law_names.size(); ++l) {
-        const auto law = static_cast<JointPropertySpec::Law>(l);
-        const auto keys = contact::law_keys(law);
-        INFO(contact::law_names[l]);
+    for (const std::string_view law : contact::law_names) {
+        const auto keys = contact::law_key_names(law);
+        INFO(law);
         CHECK(std::ranges::find(keys, "kn") != keys.end());
-        for (const auto& k : contact::joint_keys) {
-            if (std::ranges::find(keys, k.key) != keys.end()) continue;
-            std::string set = "name = \"s\"\nlaw = \"" + std::string(contact::law_names[l]) + "\"\nkn = 1e10\nks = 1e10\n";
-            const std::string error = file_error(set + std::string(k.key) + " = 1\n");
-            CHECK_MESSAGE(error.find("joint_property[0]." + std::string(k.key)) != std::string::npos, k.key);
+        for (const contact::JointKey* k : contact::joint_keys()) {
+            if (std::ranges::find(keys, k->key) != keys.end()) continue;
+            std::string set = "name = \"s\"\nlaw = \"" + std::string(law) + "\"\nkn = 1e10\nks = 1e10\n";
+            const std::string error = file_error(set + std::string(k->key) + " = 1\n");
+            CHECK_MESSAGE(error.find("joint_property[0]." + std::string(k->key)) != std::string::npos, k->key);
         }
     }
     // A Barton-Bandis set read through its declared keys.
     const auto rock = io::parse_rock("[[joint_property]]\nname = \"j\"\nlaw = \"barton_bandis\"\nkn = 1e10\nks = 1e9\n"
                                      "friction = 28\njrc = 12\njcs = 80e6\njoint_length = 0.5\n",
                                      "rock.toml");
-    CHECK(rock.joint.jrc == 12.0);
-    CHECK(rock.joint.jcs == 80e6);
-    CHECK(rock.joint.joint_length == 0.5);
-    CHECK(rock.joint.friction == 28.0);
+    CHECK(rock.bonds.jrc == 12.0);
+    CHECK(rock.bonds.jcs == 80e6);
+    CHECK(rock.bonds.joint_length == 0.5);
+    CHECK(rock.bonds.friction == 28.0);
     CHECK(file_error("name = \"j\"\nlaw = \"barton_bandis\"\nkn = 1e10\nks = 1e9\njrc = 12\n").find("jcs") !=
           std::string::npos);
 }
@@ -195,7 +199,7 @@ TEST_CASE("The rules between keys say the same from a file and from the flags") 
 TEST_CASE("bbm shear takes the lab tests' rock: --rock, --confined-friction and --strength-classes") {
     auto shear_error = [](const std::vector<std::string>& flags) -> std::string {
         try {
-            (void)studies::run_shear_args(flags, true);
+            (void)cli::run_shear_args(flags, true);
         } catch (const InputError& e) {
             return e.what();
         }

@@ -49,7 +49,7 @@ TEST_CASE("restart: a lab test stopped before, at and after its peak resumes exa
 TEST_CASE("restart: a deformable lab test (f = 0.95, 2 x 4 m) stopped in failure resumes exactly" * validation) {
     // Peak near step 7,000 (about 29 MPa); contacts form from about 10,000.
     auto o = LabTestOptions::paper_ucs();
-    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.material.deformable_fraction = 0.95;
+    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.rock.material.deformable_fraction = 0.95;
     test::check_exact_restart(test::labtest_model(o, 13000), {3500, 7000, 10500, 12000}, {1});
 }
 

@@ -1,9 +1,10 @@
-// The direct shear test (studies/shear.hpp, issue 26): a planar joint slides at
+// The direct shear test (studies/lab/shear.hpp, issue 26): a planar joint slides at
 // its Coulomb strength under constant normal load, a weak bond peaks at c + σn tan φ
 // and falls to σn tan φr, the servo holds σn0 + K dv under constant normal
 // stiffness, and rock bridges make a joint stronger.
+#include "apps/flags.hpp"
 #include "base/error.hpp"
-#include "studies/shear.hpp"
+#include "studies/lab/shear.hpp"
 
 #include <doctest/doctest.h>
 #include "tests/validation.hpp"
@@ -22,11 +23,11 @@ double tan_deg(double a) { return std::tan(a * std::numbers::pi / 180.0); }
 /// The paper's rock bonds, a 2 m x 1 m specimen, an unbonded 30° joint at mid-height.
 ShearTestOptions shear_specimen(meshing::PatternSpec::Kind pattern, double size) {
     ShearTestOptions o;
-    o.pattern = pattern;
-    o.size = size;
-    o.rock = LabTestOptions::paper_ucs().joint;
-    o.plane.law = JointPropertySpec::Law::coulomb;
-    o.plane.kn = o.rock.kn, o.plane.ks = o.rock.ks;
+    o.rock.pattern.kind = pattern;
+    o.rock.pattern.size = size;
+    o.rock.bonds = paper_rock().bonds;
+    o.plane.law = "coulomb";
+    o.plane.kn = o.rock.bonds.kn, o.plane.ks = o.rock.bonds.ks;
     o.plane.friction = 30.0;
     return o;
 }
@@ -126,14 +127,15 @@ TEST_CASE("direct shear: bad options name their flag") {
     auto key_of = [](std::vector<std::string> args) {
         args.insert(args.end(), {"--max-displacement", "1e-4", "-q"});
         try {
-            studies::run_shear_args(args, true);
+            cli::run_shear_args(args, true);
         } catch (const InputError& e) {
             return e.file();
         }
         return std::string("none");
     };
     CHECK(key_of({"--pattern", "single", "--persistence", "0.5"}) == "--persistence");
-    CHECK(key_of({"--joint-law", "softening"}) == "--joint-law");
+    CHECK(key_of({"--joint-law", "softening"}) == "--joint-cohesion"); // a softening plane needs its peaks
+    CHECK(key_of({"--joint-jrc", "10"}) == "--joint-jrc");              // not a coulomb joint's key
     CHECK(key_of({"--size", "0.5"}) == "--size");
     CHECK(key_of({"--persistence", "1.5"}) == "shear");
     CHECK(key_of({"--normal-stress", "-1e6"}) == "shear");
@@ -146,7 +148,7 @@ TEST_CASE("direct shear: rock bridges make a joint stronger, the more of them th
         auto strength = [&](double k) {
             auto o = shear_specimen(meshing::PatternSpec::Kind::voronoi, 0.2);
             o.height = 1.25;
-            o.seed = seed;
+            o.rock.pattern.seed = seed;
             o.persistence = k;
             o.shear_rate = 1e-7;
             o.max_displacement = 6e-3;
@@ -167,7 +169,7 @@ TEST_CASE("direct shear: a Barton-Bandis joint peaks at sigma_n tan(phi_r + JRC 
     bool peak_held = true, dilation_held = true;
     for (double sn : {1e6, 5e6}) {
         auto o = shear_specimen(meshing::PatternSpec::Kind::single, 0.1);
-        o.plane.law = JointPropertySpec::Law::barton_bandis;
+        o.plane.law = "barton_bandis";
         o.plane.friction = 30.0, o.plane.jrc = 10.0, o.plane.jcs = 100e6;
         o.normal_stress = sn;
         o.max_displacement = 5e-4;

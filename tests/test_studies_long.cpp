@@ -4,10 +4,10 @@
 // the broken joints' friction calibrated on broken rock's, and the biaxial test
 // of the paper's joints at 5 MPa.
 #include "base/error.hpp"
-#include "studies/calibrate.hpp"
-#include "studies/commands.hpp"
-#include "studies/labtest.hpp"
-#include "studies/residual_friction.hpp"
+#include "studies/calibration/calibrate.hpp"
+#include "apps/flags.hpp"
+#include "studies/lab/labtest.hpp"
+#include "studies/lab/residual_friction.hpp"
 #include "tests/validation_record.hpp"
 
 #include <doctest/doctest.h>
@@ -32,7 +32,7 @@ TEST_CASE("calibrate to a steep envelope (Hoek-Brown mi 25): the joints' frictio
     // a macro friction angle of about 33 degrees (mi about 8); mi 25 asks for about
     // 49. The first correction must raise phi from 25 degrees, and the second
     // iteration's envelope must be steeper than the first's.
-    const std::string json = run_calibrate_args({"--width", "3", "--height", "6", "--realizations", "1",
+    const std::string json = cli::run_calibrate_args({"--width", "3", "--height", "6", "--realizations", "1",
                                                  "--iterations", "2", "--threads", "2", "--target-ucs", "22e6",
                                                  "--target-tensile", "2e6", "--target-mi", "25"},
                                                 true);
@@ -76,7 +76,7 @@ TEST_CASE("calibrate --fit-ci: the paper's rock to a granite-like sigma_ci/UCS o
     // hold that on seeds it has not seen. Measured 2026-11-26: converged at
     // iteration 6, m 1.73, sigma_ci/UCS 0.33; fresh seeds 0.34 (their UCS +13%:
     // strongly heterogeneous small specimens scatter, std 2 MPa).
-    const std::string json = run_calibrate_args({"--width", "3", "--height", "6", "--realizations", "2", "--iterations",
+    const std::string json = cli::run_calibrate_args({"--width", "3", "--height", "6", "--realizations", "2", "--iterations",
                                                  "8", "--threads", "2", "--target-ucs", "22e6", "--target-tensile",
                                                  "1.9e6", "--target-ci-ratio", "0.30", "--fit-ci"},
                                                 true);
@@ -108,7 +108,7 @@ TEST_CASE("biaxial at 5 MPa with the paper's joints: confinement applied without
     // The paper's joints: broken joints keep their 25 degrees.
     const auto locked = run_labtest(o);
     // Broken joints slide at 10 degrees.
-    o.joint.residual_friction = 10.0;
+    o.rock.bonds.residual_friction = 10.0;
     const auto sliding = run_labtest(o);
     INFO("UCS " << ucs.peak_stress / 1e6 << " MPa at strain " << ucs.strain_at_peak << "; residual 25 deg: first stall "
                 << locked.first_stall_stress / 1e6 << " MPa (macro friction " << macro_friction(locked.first_stall_stress)
@@ -154,10 +154,10 @@ TEST_CASE("calibrate --target-residual-friction: Lac du Bonnet's broken joints f
     // This test on 3 seeds (2026-11-29): 9.62 degrees after 2 iterations, fresh
     // seeds 2001-2003 41.3 (std 2.0).
     CalibrationOptions o;
-    o.base.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
-    o.base.material.density = 2650;
-    o.base.seed = 1001;
-    auto& j = o.base.joint;
+    o.base.rock.pattern.size = 0.12, o.base.width = 2.4, o.base.height = 4.8;
+    o.base.rock.material.density = 2650;
+    o.base.rock.pattern.seed = 1001;
+    auto& j = o.base.rock.bonds;
     j.kn = 954.511e9, j.ks = 257.441e9, j.tensile = 15.1313e6, j.cohesion = 41.843e6;
     j.friction = 5, j.residual_friction = 5;
     o.realizations = 3, o.threads = 2;

@@ -3,7 +3,7 @@
 // calibrated in bbm, and exact restart from a checkpoint.
 #include "io/model_input.hpp"
 #include "core/stages.hpp"
-#include "studies/opening.hpp"
+#include "studies/model/opening.hpp"
 #include "core/solver.hpp"
 #include "tests/restart.hpp"
 

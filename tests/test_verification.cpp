@@ -2,7 +2,7 @@
 // examples/verification/ run through the solver and compared with analytic answers.
 #include "io/model_input.hpp"
 #include "core/stages.hpp"
-#include "studies/labtest.hpp"
+#include "studies/lab/labtest.hpp"
 #include "core/solver.hpp"
 
 #include "tests/softening_reference.hpp"

@@ -5,8 +5,8 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "io/model_input.hpp"
-#include "studies/labtest.hpp"
-#include "studies/opening.hpp"
+#include "studies/lab/labtest.hpp"
+#include "studies/model/opening.hpp"
 
 #include "tests/validation_record.hpp"
 
@@ -75,9 +75,9 @@ TEST_CASE("hydraulic fracturing: breakdown pressure against Hubbert-Willis (Pb =
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
         LabTestOptions o;
         o.kind = LabTestOptions::Kind::tension;
-        o.size = 0.05, o.width = 1.0, o.height = 2.0, o.seed = seed, o.threads = 2, o.frame_every = 0;
+        o.rock.pattern.size = 0.05, o.width = 1.0, o.height = 2.0, o.rock.pattern.seed = seed, o.threads = 2, o.frame_every = 0;
         o.strain_per_step = 5e-9;
-        o.joint = file.analysis.joint_properties[0];
+        o.rock.bonds = file.analysis.joint_properties[0];
         tensile += run_labtest(o).peak_stress / 3.0;
     }
     const double hubbert_willis = 3.0 * sigma_h - sigma_H + tensile;

@@ -135,7 +135,12 @@ def _option_args(options):
             args.append(flag + ("=true" if value else "=false"))
             continue
         elif isinstance(value, (list, tuple)) or hasattr(value, "tolist"):
-            value = ",".join(repr(float(x)) if isinstance(x, float) else str(x) for x in list(value))
+            items = value.tolist() if hasattr(value, "tolist") else list(value)
+            if items and all(isinstance(x, (list, tuple)) for x in items):
+                # Points (a softening curve) as a model file writes them: [[1.7, 0.5], [4.0, 0]].
+                value = "[" + ", ".join("[" + ", ".join(repr(float(y)) for y in x) + "]" for x in items) + "]"
+            else:
+                value = ",".join(repr(float(x)) if isinstance(x, float) else str(x) for x in items)
         elif isinstance(value, float):
             value = repr(value)
         args += [flag, str(value)]

@@ -359,6 +359,9 @@ def test_labtest_options_are_checked_as_flags():
         bbm.ucs(pattren="trigon")
     with pytest.raises(bbm.InputError, match="--size"):
         bbm.ucs(size=5.0, width=2, height=4)
+    # A softening curve is its points, as a model file writes them; checked by the same rules.
+    with pytest.raises(bbm.InputError, match="--tension-softening: \\[1\\]\\[0\\]: the curve snaps back"):
+        bbm.ucs(tension_softening=[[1.7, 0.5], [1.5, 0.0]])
 
 
 def test_realizations_give_one_curve_each():
