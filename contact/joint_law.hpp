@@ -24,6 +24,7 @@
 
 #include "contact/laws/barton_bandis.hpp"
 #include "contact/laws/coulomb.hpp"
+#include "contact/laws/cwfs.hpp"
 #include "contact/laws/elastic.hpp"
 #include "contact/laws/softening.hpp"
 
@@ -35,7 +36,7 @@
 namespace bbm::contact {
 
 /// Every joint law, one alternative each.
-using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw, BartonBandisLaw>;
+using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw, BartonBandisLaw, CwfsLaw>;
 
 /// The laws' names, in the order of JointLaw (the model file's `law`).
 inline constexpr auto law_names = []<std::size_t... I>(std::index_sequence<I...>) {

@@ -1,6 +1,7 @@
 // Joint laws (contact/joint_law.hpp) against SPEC §4: the softening curves pass
 // through their points, fracture energies equal the areas under the curves,
 // unloading is elastic with the initial stiffness, damage persists.
+#include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
 #include "core/rock.hpp"
 
@@ -383,4 +384,105 @@ TEST_CASE("Barton-Bandis joint: dilation while sliding, the residual, the bounds
     bb.update(open, 1e-4, 1e-4);
     CHECK(open.sn == 0.0);
     CHECK(open.tau == 0.0);
+}
+
+namespace {
+
+/// A CWFS bond after Hajiabdolmajid, Kaiser & Martin (2002): cohesion 50 → 15 MPa
+/// over 0.2 mm of plastic slip, friction 0 → 48° over 0.5 mm (their Lac du Bonnet
+/// parameters, with their plastic strains 0.2% and 0.5% read as slips over 0.1 m).
+JointPropertySpec cwfs_bond() {
+    JointPropertySpec p;
+    p.name = "cwfs";
+    p.law = "cwfs";
+    p.kn = 500e9, p.ks = 200e9;
+    p.cohesion = 50e6, p.tensile = 10e6, p.friction = 0.0;
+    set_law_value(p, "residual_cohesion", 15e6);
+    set_law_value(p, "mobilised_friction", 48.0);
+    set_law_value(p, "cohesion_slip", 0.2e-3);
+    set_law_value(p, "friction_slip", 0.5e-3);
+    return p;
+}
+
+void law_update(const contact::JointLaw& law, contact::JointHistory& h, double dun, double dus) {
+    std::visit([&](const auto& l) { l.update(h, dun, dus); }, law);
+}
+
+} // namespace
+
+TEST_CASE("cwfs: under a held normal stress the shear stress follows c(ups) + sigma_n tan phi(ups), the closed form") {
+    const auto p = cwfs_bond();
+    REQUIRE_FALSE(contact::check_joint_property(p));
+    const contact::JointLaw law = contact::make_law(p);
+    const auto& cwfs = std::get<contact::CwfsLaw>(law);
+    const double uc = 0.2e-3, uf = 0.5e-3, deg = std::numbers::pi / 180.0;
+    // The closed form: c falls linearly to cr over uc, tan φ rises linearly to tan φm over uf.
+    auto c = [&](double ups) { return 50e6 + (15e6 - 50e6) * std::min(ups / uc, 1.0); };
+    auto tan_phi = [&](double ups) { return std::tan(48.0 * deg) * std::min(ups / uf, 1.0); };
+    for (double sn : {0.0, 10e6, 60e6}) {
+        CAPTURE(sn);
+        contact::JointHistory h;
+        law_update(law, h, -sn / p.kn, 0.0);
+        CHECK(h.sn == doctest::Approx(sn));
+        // Coarse increments (a tenth of uc): the return is exact on the cap's pieces.
+        const double du = uc / 10;
+        double worst = 0.0, peak = 0.0;
+        for (int k = 0; k < 100; ++k) {
+            law_update(law, h, 0.0, du);
+            peak = std::max(peak, h.tau);
+            if (h.slipping) worst = std::max(worst, std::abs(h.tau - (c(h.ups) + sn * tan_phi(h.ups))) / 50e6);
+            CHECK(h.ups == doctest::Approx(std::max(0.0, h.us - h.tau / p.ks)).epsilon(1e-9));
+        }
+        CHECK(worst < 1e-12);
+        // The end: the residual cohesion and the mobilised friction.
+        CHECK(h.tau == doctest::Approx(15e6 + sn * std::tan(48.0 * deg)).epsilon(1e-12));
+        CHECK(h.bonded); // a residual cohesion: never broken in shear
+        // The peak: the cap's largest value, at one of its breakpoints 0, uc, uf (the
+        // sampled one at most an elastic increment ks du below it, never above).
+        auto cap = [&](double u) { return c(u) + sn * tan_phi(u); };
+        const double top = std::max({cap(0.0), cap(uc), cap(uf)});
+        CHECK(peak <= top * (1 + 1e-12));
+        CHECK(peak >= top - p.ks * du);
+        // The plastic work: the area under the cap over the plastic slip.
+        double area = 0.0;
+        const int n = 200000;
+        for (int k = 0; k < n; ++k) area += cap((k + 0.5) * h.ups / n) * h.ups / n;
+        CHECK(h.dissipated == doctest::Approx(area).epsilon(1e-6));
+    }
+    // Friction strengthening: under a high normal stress the residual is stronger than the peak.
+    contact::JointHistory deep;
+    law_update(law, deep, -200e6 / p.kn, 0.0);
+    for (int k = 0; k < 400; ++k) law_update(law, deep, 0.0, uc / 20);
+    CHECK(deep.tau == doctest::Approx(15e6 + 200e6 * std::tan(48.0 * deg)).epsilon(1e-12));
+    CHECK(deep.tau > 50e6); // above the intact cap c0 + σn tan φ0
+    // The tensile strength goes with the cohesion: after half the cohesion slip
+    // (c about 32.5 MPa) the bond opens at σt c / c0, about 6.5 MPa, not 10.
+    contact::JointHistory t;
+    while (t.ups < 0.5 * uc) law_update(law, t, 0.0, uc / 1000); // sheared at σn = 0
+    law_update(law, t, 0.0, -t.tau / p.ks);                       // the shear unloaded elastically
+    CHECK(std::abs(t.tau) < 1.0);
+    const double expected = 10e6 * cwfs.cohesion(t.ups) / 50e6;
+    double opened_at = 0.0;
+    for (int k = 1; k <= 2000 && t.bonded; ++k) {
+        law_update(law, t, 10e6 / p.kn / 1000, 0.0);
+        if (t.bonded) opened_at = -t.sn;
+    }
+    CHECK_FALSE(t.bonded);
+    CHECK(t.broken == JointState::broken_tension);
+    CHECK(opened_at <= expected);
+    CHECK(opened_at > expected - 10e6 / 1000);
+    // Without a residual cohesion the bond breaks once the cohesion is lost: a shear crack.
+    auto q = p;
+    set_law_value(q, "residual_cohesion", 0.0);
+    const contact::JointLaw brittle = contact::make_law(q);
+    contact::JointHistory b;
+    for (int k = 0; k < 100 && b.bonded; ++k) law_update(brittle, b, 0.0, uc / 10);
+    CHECK(b.broken == JointState::broken_shear);
+    // The rules: a residual above the peak, a friction that weakens, are refused by key.
+    auto bad = p;
+    set_law_value(bad, "residual_cohesion", 60e6);
+    CHECK(contact::check_joint_property(bad)->key == "residual_cohesion");
+    bad = p;
+    set_law_value(bad, "mobilised_friction", -1.0);
+    CHECK(contact::check_joint_property(bad)->key == "mobilised_friction");
 }
