@@ -45,8 +45,10 @@ struct ModelScale {
 class TableReader {
 public:
     virtual ~TableReader() = default;
-    /// Refuses a key not in `allowed` (with "did you mean"); `what` names the table.
-    virtual void check_keys(std::span<const std::string_view> allowed, std::string_view what) = 0;
+    /// Refuses a key outside `allowed` (with "did you mean"); `what` names the table; one in `elsewhere` (another table's of the
+    /// same keys: a bolt's in a dowel) as not applying to `what` ("a dowel set").
+    virtual void check_keys(std::span<const std::string_view> allowed, std::string_view what,
+                            std::span<const std::string_view> elsewhere = {}) = 0;
     virtual bool has(std::string_view key) const = 0;
     /// The required, non-empty `name`, unique among the named tables of its kind.
     virtual std::string name() = 0;

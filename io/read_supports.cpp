@@ -18,8 +18,9 @@ public:
     TomlTable(Ctx& c, const toml::table& t, Path p, Names* names, const ModelScale& scale)
         : c_(c), t_(t), p_(std::move(p)), names_(names), scale_(scale) {}
 
-    void check_keys(std::span<const std::string_view> allowed, std::string_view) override {
-        reader::check_keys(c_, t_, p_, allowed);
+    void check_keys(std::span<const std::string_view> allowed, std::string_view what,
+                    std::span<const std::string_view> elsewhere) override {
+        reader::check_keys(c_, t_, p_, allowed, elsewhere, what);
     }
     bool has(std::string_view key) const override { return t_.contains(key); }
     std::string name() override { return read_name(c_, t_, p_, *names_); }

@@ -179,7 +179,7 @@ TEST_CASE("a fracture that ends at an earlier one ends exactly on it: no rock br
     CHECK(t.stats.rock_bridges == free_ends);
 }
 
-TEST_CASE("a closed cycle of fractures inside a block is opened by a vertical cut; a sliver is merged") {
+TEST_CASE("a closed cycle of fractures inside a block is opened by a vertical cut — a sliver is merged") {
     // A triangle of traces inside one block: a block of its own, and the block
     // around it, which would have a hole, is cut open along the vertical line
     // through the middle of the triangle's x-range.

@@ -357,7 +357,7 @@ property = "bond"
     CHECK_THROWS_AS(studies::parse_set("region[0].dfn[0].p21+=0.1"), InputError);
 }
 
-TEST_CASE("a network too large is refused before it is drawn; a dense one is cut into blocks that tile the region") {
+TEST_CASE("a network too large is refused before it is drawn — a dense one is cut into blocks that tile the region") {
     const auto model = [](const std::string& sets) {
         return std::string(R"(
 [model]

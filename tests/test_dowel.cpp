@@ -214,7 +214,7 @@ TEST_CASE("a pretensioned dowel clamps two blocks: the joint carries the dowel's
     CHECK(summary[0].figure("max_axial_kN") == doctest::Approx(T / 1e3).epsilon(0.02));
 }
 
-TEST_CASE("dowel input: a pretension needs a plate and an anchor; names are shared with bolts and liners") {
+TEST_CASE("dowel input: a pretension needs a plate and an anchor — names are shared with bolts and liners") {
     const std::string base = two_blocks("kn = 1e11\nks = 1e11\nfriction = 30.0\n", "",
                                         "bolts = [[[0.0, -0.5], [0.0, 0.5]]]\n");
     CHECK_THROWS_WITH_AS(io::parse_model(base + "pretension = 1e4\n", "d.toml"),

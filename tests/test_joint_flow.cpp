@@ -270,7 +270,7 @@ TEST_CASE("a pressurised crack in elastic blocks opens as Sneddon's: w = 4 (1 - 
                        checked > 20 && worst < 0.05);
 }
 
-TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far field, inflow; exact on restart "
+TEST_CASE("the paper's tunnel below a water table: drained wall, hydrostatic far field, inflow — exact on restart "
           "and on 2 threads") {
     auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/tunnel_below_water_table.toml");
     test::RestartModel m{meshing::generate_blocks(file.geometry), file.analysis};
@@ -392,7 +392,7 @@ pressure = 1e6
     for (double a : contact_apertures(flow, contacts(s.world()))) CHECK((a == 0.0 || a == doctest::Approx(a0)));
 }
 
-TEST_CASE("a borehole's pressurise stages: breakdown, shut-in and re-opening ramps; the wall's water follows the "
+TEST_CASE("a borehole's pressurise stages: breakdown, shut-in and re-opening ramps — the wall's water follows the "
           "ramp, exact on restart inside a ramp and on 2 threads") {
     // The hydraulic fracturing example on 0.25 m blocks, its stages shortened.
     auto file = io::read_model(std::string(BBM_SOURCE_DIR) + "/examples/water/hydraulic_fracturing.toml");

@@ -103,8 +103,11 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     for (const auto& k : flow_keys) CHECK(flow.find("| `" + std::string(k.key) + "` |") != std::string::npos);
     check_reference("solver.md", solver_keys_markdown());
     check_reference("stage.md", stage_keys_markdown());
-    check_reference("bolt.md", bolt_keys_markdown());
-    check_reference("liner.md", liner_keys_markdown());
+    // Each support type's page, from the registry.
+    for_each_support_type([](auto type) {
+        using T = typename decltype(type)::type;
+        if constexpr (requires { T::reference(); }) check_reference(std::string(T::table) + ".md", T::reference());
+    });
     check_reference("boundary.md", boundary_keys_markdown());
     check_reference("history.md", history_keys_markdown());
     check_reference("model.md", meshing::model_keys_markdown());

@@ -9,26 +9,7 @@
 
 namespace bbm {
 
-std::vector<std::array<Vec2, 2>> expand_bolts(const BoltSetSpec& spec) {
-    std::vector<std::array<Vec2, 2>> out = spec.bolts;
-    if (!spec.ring) return out;
-    const auto& r = *spec.ring;
-    const double span = r.to - r.from;
-    const bool full = std::abs(std::abs(span) - 360.0) < 1e-9;
-    int count = r.count;
-    if (count <= 0 && r.spacing > 0.0) {
-        const double arc = std::abs(span) * std::numbers::pi / 180.0 * r.radius;
-        count = std::max(1, int(std::floor(arc / r.spacing + 1e-9)) + (full ? 0 : 1));
-    }
-    for (int k = 0; k < count; ++k) {
-        // A full circle: count intervals; an arc: bolts at both of its ends.
-        const double f = full ? double(k) / count : (count > 1 ? double(k) / (count - 1) : 0.5);
-        const double a = (r.from + f * span) * std::numbers::pi / 180.0;
-        const Vec2 u{std::cos(a), std::sin(a)};
-        out.push_back({r.center + r.radius * u, r.center + (r.radius + r.length) * u});
-    }
-    return out;
-}
+std::vector<std::array<Vec2, 2>> expand_bolts(const BoltSetSpec& spec) { return expand_bars(spec.bolts, spec.ring); }
 
 std::string bolt_keys_markdown() {
     return "# [[bolt]] and [[dowel]] keys\n\n"
@@ -40,46 +21,17 @@ std::string bolt_keys_markdown() {
            key_table_markdown(bolt_keys, "tables");
 }
 
-namespace {
-
-BoltSetSpec::Ring read_ring(TableReader& t) {
-    static constexpr std::array<std::string_view, 7> keys{"center", "radius", "length", "count",
-                                                          "spacing", "from",  "to"};
-    t.check_keys(keys, "a ring of bolts");
-    BoltSetSpec::Ring r;
-    r.center = t.required_point("center");
-    r.radius = t.required_number("radius", above(0, metres));
-    r.length = t.required_number("length", above(0, metres));
-    const auto count = t.integer("count", between(1, 100000, ""));
-    const auto spacing = t.number("spacing", above(0, metres));
-    if (count.has_value() == spacing.has_value())
-        t.fail("", "give the bolts' 'count' or their 'spacing' along the wall (one of them)");
-    r.count = int(count.value_or(0));
-    r.spacing = spacing.value_or(0.0);
-    r.from = t.number("from", unbounded(degrees)).value_or(0.0);
-    r.to = t.number("to", unbounded(degrees)).value_or(r.from + 360.0);
-    if (!(r.to > r.from) || r.to - r.from > 360.0 + 1e-9)
-        t.fail("", "'to' must be above 'from' by at most 360 degrees, got from " + shortest_text(r.from) + " to " +
-                       shortest_text(r.to));
-    t.check_length_resolves("radius", r.radius);
-    t.check_length_resolves("length", r.length);
-    return r;
-}
-
-} // namespace
 
 BoltSetSpec read_bar_set(TableReader& t, std::string_view type) {
     std::vector<std::string_view> keys;
     for (const auto& k : bolt_keys)
         if (key_applies(k, type)) keys.push_back(k.key);
-    t.check_keys(keys, "a " + std::string(type) + " set");
+    std::vector<std::string_view> all;
+    for (const auto& k : bolt_keys) all.push_back(k.key);
+    t.check_keys(keys, "a " + std::string(type) + " set", all);
     BoltSetSpec b;
     b.name = t.name();
-    if (auto bars = t.segments("bolts", "bolts [[x1, y1], [x2, y2]] (head, toe)", "head and toe")) b.bolts = std::move(*bars);
-    if (auto ring = t.table("ring", "a table {center, radius, length, count or spacing, from, to}"))
-        b.ring = read_ring(*ring);
-    if (b.bolts.empty() && !b.ring)
-        t.fail("", t.owner() + "no bolts: give 'bolts' (head and toe of each) or a 'ring' around an opening");
+    read_bars(t, "bolts", b.bolts, b.ring);
     t.declared(bolt_keys, b, type);
     const auto area = t.number("area", find_key(bolt_keys, "area")->bounds);
     const auto diameter = t.number("diameter", find_key(bolt_keys, "diameter")->bounds);

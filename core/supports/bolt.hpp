@@ -31,6 +31,7 @@
 
 #include "base/keys.hpp"
 #include "base/table_reader.hpp"
+#include "core/supports/bars.hpp"
 #include "core/supports/support.hpp"
 
 #include <array>
@@ -49,17 +50,8 @@ struct BoltSetSpec {
     std::string name;
     /// Bolts given one by one: head (at the wall) and toe.
     std::vector<std::array<Vec2, 2>> bolts;
-    /// Radial bolts around a circular opening: heads on the circle, evenly spaced
-    /// (`count`, or `spacing` along the wall) from angle `from` to `to`, degrees
-    /// counter-clockwise from +x (a full circle when to − from = 360).
-    struct Ring {
-        Vec2 center{};
-        double radius = 0.0, length = 0.0;
-        int count = 0;
-        double spacing = 0.0;
-        double from = 0.0, to = 360.0;
-    };
-    std::optional<Ring> ring;
+    /// Radial bolts around a circular opening (core/supports/bars.hpp).
+    std::optional<BarRing> ring;
     double segment_length = 0.25;  ///< m: nodes along a bolt at most this far apart
     double young = 200e9;          ///< Pa, steel
     double area = 4.91e-4;         ///< m², steel cross-section (25 mm bar)
@@ -180,6 +172,8 @@ struct Bolts {
     using Spec = BoltSetSpec;
     using State = BoltState;
     static constexpr const auto& keys = bolt_keys;
+    /// docs/reference/bolt.md (a dowel's keys are on the same page).
+    static std::string reference() { return bolt_keys_markdown(); }
     static Spec read(TableReader& t) { return read_bar_set(t, table); }
     static State make(const std::vector<Spec>& specs);
     static const std::vector<std::string>& set_names(const State& s) { return s.names; }

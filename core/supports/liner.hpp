@@ -155,6 +155,8 @@ struct Liners {
     using Spec = LinerSpec;
     using State = LinerState;
     static constexpr const auto& keys = liner_keys;
+    /// docs/reference/liner.md.
+    static std::string reference() { return liner_keys_markdown(); }
     static Spec read(TableReader& t);
     static State make(const std::vector<Spec>& specs);
     static const std::vector<std::string>& set_names(const State& s) { return s.names; }

@@ -11,8 +11,10 @@
 //                        key, the VTK files' stem) and its model-file table
 //                        (`table` = "x": [[x]] tables);
 //   Spec, State          one table's values, and the installed state;
-//   keys, read(...)      its keys (base/keys.hpp: units, bounds, meaning; the
-//                        reference) and its reader (base/table_reader.hpp);
+//   keys, read(...)      its keys (base/keys.hpp: units, bounds, meaning) and its
+//                        reader (base/table_reader.hpp);
+//   reference()          docs/reference/<table>.md, its keys' page (a type whose
+//                        keys are another's page, the dowel's, has none);
 //   make(specs)          its State from its tables, nothing installed;
 //   set_names, installed, install(set, find), tie_count, host(tie);
 //   force_pass           its element and tie forces, what each tie puts on the
