@@ -728,3 +728,95 @@ TEST_CASE("a support pressure: keeping a fraction of the excavated rock's suppor
     // It resumes exactly from a checkpoint.
     check_resumes_exactly(pressed, 300, 300);
 }
+
+TEST_CASE("a yielding bolt pulled apart: elastic to its yield force, held there over its slip capacity, then "
+          "ruptured, the energy it absorbed the closed form's") {
+    // A slab pulled off fixed rock across an open joint, a yielding bolt from a
+    // plate in the slab to an anchor in the rock: L = 3 m, EA = 200 GPa x 3.8e-4 m²,
+    // F_y = 100 kN, slip capacity 20 mm, at 1.5 m out of plane.
+    constexpr double length = 3.0, ea = 200e9 * 3.8e-4, fy = 100e3, capacity = 0.02, spacing = 1.5, v = 1e-5;
+    const auto m = build(R"(
+[[joint_property]]
+name = "open"
+law = "coulomb"
+kn = 1e10
+ks = 1e10
+friction = 0.0
+
+[[joint_assignment]]
+property = "open"
+
+[[region]]
+name = "rock"
+outline = { type = "rectangle", min = [0.0, -1.0], max = [2.0, 1.0] }
+pattern = { type = "single" }
+
+[[region]]
+name = "slab"
+outline = { type = "rectangle", min = [2.0, -1.0], max = [4.0, 1.0] }
+pattern = { type = "single" }
+
+[[boundary]]
+name = "fixed"
+type = "velocity"
+regions = ["rock"]
+vx = 0.0
+vy = 0.0
+omega = 0.0
+
+[[boundary]]
+name = "pulled"
+type = "velocity"
+regions = ["slab"]
+vx = 1e-5
+vy = 0.0
+omega = 0.0
+
+[[yielding_bolt]]
+name = "d_bolts"
+bolts = [[[3.5, 0.0], [0.5, 0.0]]]
+area = 3.8e-4
+yield_force = 100e3
+slip_capacity = 0.02
+spacing = 1.5
+
+[[stage]]
+type = "install"
+supports = ["d_bolts"]
+)");
+    Solver s(m.blocks, m.file.analysis);
+    install_supports(s.world(), {"d_bolts"});
+    const auto& Y = support_state<YieldingBolts>(s.world().supports);
+    const double k = ea / length, yield_elongation = fy * length / ea;
+    double worst = 0.0, energy = 0.0, last_n = 0.0, last_delta = 0.0;
+    long ruptured_at = -1;
+    for (long step = 1; step <= 3000; ++step) {
+        s.step();
+        const double delta = norm(Y.end[1] - Y.end[0]) - length;
+        const double n = Y.axial[0] * spacing;
+        // The closed form of its load-elongation: elastic, held at F_y, zero past the capacity.
+        const double expected = delta - yield_elongation > capacity ? 0.0 : std::min(k * delta, fy);
+        if (ruptured_at < 0 && Y.state[0] == YieldingBoltState::ruptured) ruptured_at = step;
+        if (ruptured_at < 0 || step > ruptured_at + 1) worst = std::max(worst, std::abs(n - expected) / fy);
+        if (ruptured_at < 0) energy += 0.5 * (last_n + n) * (delta - last_delta);
+        last_n = n, last_delta = delta;
+    }
+    CHECK(worst < 1e-9);
+    // It ruptured where its slip passed the capacity: at δ = δy + capacity, within a step.
+    REQUIRE(ruptured_at > 0);
+    CHECK(double(ruptured_at) * v == doctest::Approx(yield_elongation + capacity).epsilon(2e-3));
+    // The energy absorbed: F_y² L / 2EA + F_y × capacity (2.2 kJ), per bolt, as the summary reports it.
+    const double closed_form = fy * fy * length / (2.0 * ea) + fy * capacity;
+    const auto summary = YieldingBolts::summary(Y);
+    REQUIRE(summary.size() == 1);
+    MESSAGE("energy absorbed " << summary[0].figure("energy_kJ") << " kJ, closed form " << closed_form / 1e3 << " kJ");
+    CHECK(summary[0].figure("energy_kJ") * 1e3 == doctest::Approx(closed_form).epsilon(2e-3));
+    CHECK(energy == doctest::Approx(closed_form).epsilon(2e-3));
+    CHECK(summary[0].figure("ruptured") == 1);
+    CHECK(summary[0].figure("max_axial_kN") == 0.0);
+    test::record_check(test::Against::closed_form, "a yielding bolt's energy absorbed by its rupture",
+                       "F_y^2 L / 2EA + F_y s_cap = " + test::figure(closed_form / 1e3) + " kJ", "0.2%",
+                       test::figure(summary[0].figure("energy_kJ")) + " kJ (" +
+                           test::percent(summary[0].figure("energy_kJ") * 1e3, closed_form) + ")",
+                       summary[0].figure("energy_kJ") * 1e3 == doctest::Approx(closed_form).epsilon(2e-3));
+}

@@ -12,6 +12,7 @@
 #include "core/supports/bolt.hpp"
 #include "core/supports/dowel.hpp"
 #include "core/supports/liner.hpp"
+#include "core/supports/yielding_bolt.hpp"
 
 #include <cstddef>
 #include <string_view>
@@ -23,7 +24,7 @@
 namespace bbm {
 
 /// The registered support types, in tie order.
-using SupportTypes = std::tuple<Bolts, Liners, Dowels>;
+using SupportTypes = std::tuple<Bolts, Liners, Dowels, YieldingBolts>;
 
 inline constexpr std::size_t support_type_count = std::tuple_size_v<SupportTypes>;
 
