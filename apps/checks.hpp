@@ -1,4 +1,4 @@
-// Validators for numeric command-line options that a person can read.
+// bbm apps: validators for numeric command-line options that a person can read.
 //
 // CLI11's PositiveNumber and Range let NaN through (every comparison with NaN is
 // false) and print their bounds as 300-digit numbers; an unsigned option takes

@@ -343,7 +343,7 @@ void add_labtest_options(CLI::App* sub, studies::LabTestValues& c, bool& quiet) 
     sub->add_option("-o,--out", c.out, "Output directory")->capture_default_str();
     sub->add_flag("-q,--quiet", quiet, "No progress, only errors");
     // After the command's flags are parsed, those of --config too: the file, then
-    // the flags given beside it. A final callback, not parse_complete_callback: with
+    // the flags given beside it. A final callback, not a parse-complete callback: with
     // one, CLI11 (2.1) reads a --config file after it and never sets the
     // command's flags from the file (fit-curvature = true was silently false).
     sub->final_callback([sub, &c] {

@@ -1,4 +1,4 @@
-// bbm core: the error types that carry the user back to what must be fixed.
+// bbm base: the error types that carry the user back to what must be fixed.
 //
 // InputError is the one always-on check for anything a user wrote: it names the
 // file, the line and the key (e.g. "tunnel.toml:12: region[1].pattern.size: must

@@ -4,7 +4,7 @@
 // A table of these per section (contact/joint_keys.hpp for [[joint_property]],
 // core/material_keys.hpp for [[material]], core/flow_keys.hpp for [flow]) is what the
 // reader checks a file by, what
-// the command-line flags of the same values are made from (studies/lab/commands.hpp,
+// the command-line flags of the same values are made from (apps/flags.hpp,
 // apps/flags.hpp add_key_flags; those marked `flag` are a lab test's rock's) and what the key reference in docs/reference/ is generated from,
 // so the three cannot drift apart.
 #pragma once

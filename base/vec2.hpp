@@ -1,4 +1,4 @@
-// bbm core: 2D vector and polygon primitives shared by every layer.
+// bbm base: 2D vector and polygon primitives shared by every layer.
 //
 // Everything in bbm is plane strain with unit thickness, so a point, a force
 // and a displacement are all a pair of doubles. This header is the lowest layer

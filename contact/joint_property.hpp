@@ -35,7 +35,7 @@ struct JointPropertySpec {
     double confined_friction = -1;           ///< φ2, degrees
     double confined_friction_from = 0.0;     ///< σ*, Pa (> 0 with confined_friction)
     double cohesion = 0.0;        ///< c, Pa (coulomb: brittle bond; softening: peak cohesion)
-    /// Barton–Bandis (contact/barton_bandis.hpp; `friction` is its φr): the joint
+    /// Barton–Bandis (contact/laws/barton_bandis.hpp; `friction` is its φr): the joint
     /// roughness coefficient, the joint wall compressive strength (Pa) and the
     /// joint length (m) that sets the peak shear displacement (≤ 0: none, the
     /// strength stays at its peak).

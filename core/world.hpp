@@ -15,7 +15,7 @@
 // regions, body-frame vertices) sit in other arrays the step seldom touches.
 //
 // Each part lists its own fields (base/fields.hpp) in a visit_fields beside it;
-// the world's list (for_each_field, core/world_fields.hpp) is theirs joined, and
+// the world's list (for_each_field, below) is theirs joined, and
 // the checkpoint, the state hash, the model fingerprint, the memory report and
 // the Python views all walk it: a field added to a part's list is saved, hashed,
 // fingerprinted, counted and viewed with no other line.
@@ -147,7 +147,7 @@ struct Properties {
     int new_contact = 0;                   ///< the set of contacts formed during the run
 };
 /// The laws' parameters enter the model fingerprint through their specs
-/// (fingerprint_properties, core/state.cpp), not as a field.
+/// (model_fingerprint, core/state.cpp: every declared key's value), not as a field.
 template <part_of<Properties> P, class V>
 void visit_fields(P& p, V&& v) {
     v(FieldInfo{"properties.face_shear", MemoryGroup::other, field_use::model}, p.face_shear);
@@ -411,7 +411,7 @@ struct World {
     Ties ties;
     StageMonitor monitor;           ///< what the current stage did, for its verdict
     Team team;
-    /// Taken when the world is built (model_fingerprint, core/world_fields.hpp):
+    /// Taken when the world is built (model_fingerprint, core/state.hpp):
     /// a checkpoint carries it and refuses another model.
     std::uint64_t fingerprint = 0;
 };

@@ -1,4 +1,4 @@
-// bbm apps: pictures drawn with cairo (PNG or SVG by the file extension, written
+// bbm io: pictures drawn with cairo (PNG or SVG by the file extension, written
 // atomically), for machines without a display or ParaView: the block model with
 // its joints coloured by tag; a failure plot (blocks at their current place,
 // cracks by mode, like the paper's Figures 4b–7); x–y curves (stress–strain,

@@ -12,7 +12,7 @@
 #include "base/table_reader.hpp"
 #include "io/model_input.hpp"
 
-// toml++ 3.3 asserts in its parser a condition that input can break (parse_key
+// toml++ 3.3 asserts in its parser a condition that input can break (toml::parse_key
 // entered on a table header "[[:" — found by fuzz_model) and then reports the
 // syntax error itself. Release builds compile its asserts out (NDEBUG); so does the
 // checking build, for toml++ alone, so that such a file gets the same error there

@@ -1,4 +1,4 @@
-// Dowels (core/dowels.hpp) against closed forms: a dowel across a sliding joint
+// Dowels (core/supports/dowel.hpp) against closed forms: a dowel across a sliding joint
 // as a beam on an elastic foundation (Hetényi 1946), and a pretensioned dowel
 // clamping two blocks together; both exact on restart and on any thread count.
 #include "contact/contacts.hpp"
@@ -219,7 +219,7 @@ TEST_CASE("dowel input: a pretension needs a plate and an anchor — names are s
                                         "bolts = [[[0.0, -0.5], [0.0, 0.5]]]\n");
     CHECK_THROWS_WITH_AS(io::parse_model(base + "pretension = 1e4\n", "d.toml"),
                          doctest::Contains("dowel[0].pretension"), InputError);
-    // A bolt's own key in a dowel, and a dowel's in a bolt: named as another table's (core/bolt_keys.hpp).
+    // A bolt's own key in a dowel, and a dowel's in a bolt: named as another table's (core/supports/bolt.hpp).
     CHECK_THROWS_WITH_AS(io::parse_model(base + "cable = true\n", "d.toml"),
                          doctest::Contains("key 'cable' does not apply to a dowel set"), InputError);
     CHECK_THROWS_WITH_AS(

@@ -302,7 +302,7 @@ TEST_CASE("calibrate, Lac du Bonnet on crack initiation: E, nu, sigma_ci and ten
 namespace {
 
 /// Seeds 1–3 of a lab test: in parallel, one thread each; deformable specimens one
-/// at a time, two threads each, as `bbm ucs --realizations` runs them (studies/lab/commands.cpp).
+/// at a time, two threads each, as `bbm ucs --realizations` runs them (studies/lab/labtest_command.cpp).
 std::vector<LabTestResult> three_seeds(const LabTestOptions& base) {
     std::vector<LabTestResult> r(3);
     if (base.rock.material.deformable_fraction > 0.0) {

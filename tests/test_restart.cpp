@@ -53,7 +53,7 @@ TEST_CASE("restart: a deformable lab test (f = 0.95, 2 x 4 m) stopped in failure
     test::check_exact_restart(test::labtest_model(o, 13000), {3500, 7000, 10500, 12000}, {1});
 }
 
-// The state-field list (core/state_fields.hpp): one list that the checkpoint, the
+// The state-field list (core/world.hpp, for_each_field): one list that the checkpoint, the
 // state hash and the memory report walk. Every evolving field, perturbed by one
 // bit, changes the hash and the checkpoint's bytes, and a checkpoint loaded into a
 // new solver restores it; every field's bytes are in the memory report's group.

@@ -1,4 +1,4 @@
-// bbm core: calibration of joint micro-properties against macro targets
+// bbm studies: calibration of joint micro-properties against macro targets
 // (`bbm calibrate`; paper §4.2 calls systematic calibration an open problem).
 //
 // Targets: Young's modulus E, Poisson's ratio ν, uniaxial compressive strength

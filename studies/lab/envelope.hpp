@@ -61,7 +61,7 @@ struct EnvelopeOptions {
     std::string target_record;
     double target_sigma_ci = 0.0, target_mi = 0.0;
     bool replot = false; ///< envelope.png again from DIR/envelope.json, no test run
-    /// A model file whose rock is tested (model_rock.hpp): its bonded region's
+    /// A model file whose rock is tested (io::rock_of_model): its bonded region's
     /// pattern, seed, joints and blocks replace the lab flags' values; the
     /// specimen's size, loading and the study's flags still apply.
     std::string model;

@@ -24,7 +24,7 @@
 //        with stress between 10% and 50% of the peak (the initial linear part)
 //   ν  = −(least-squares slope of lateral against axial strain) over the same points
 // Brazilian: indirect tensile strength σt = 2P / (π D), P the peak line load.
-// The run stops when the stress has dropped below `stop_fraction` of the peak
+// The run stops when the stress has dropped below `stop.fraction` of the peak
 // after it, at `max_strain` (a specimen not yet failed there loads on, up to
 // `strain_cap`: its strength is not measured yet), or when after failure (a drop by `failure_drop`, or
 // a stall of the stress over 2e-4 of strain) it stays above the peak for 10
@@ -34,7 +34,7 @@
 // cracks, and loading goes on (unconfined tests; docs/calibration.md, After the
 // peak). Confined tests read the laboratory's peak: a stall is yielding (kept as
 // first_stall_stress), only a drop is failure, and a climb back above a dropped
-// peak is loading on (confined_peak_at_stall: the former rule, the first stall
+// peak is loading on (stop.peak_at_first_stall: the former rule, the first stall
 // is the strength; docs/calibration.md, The confined peak).
 #pragma once
 

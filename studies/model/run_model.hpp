@@ -1,4 +1,4 @@
-// bbm apps: `bbm run` — a model file's stages with output, checkpoints and
+// bbm studies: `bbm run` — a model file's stages with output, checkpoints and
 // numerical health checks.
 //
 // Output in DIR: result.pvd (ParaView series: one grid of rigid blocks and zones,
@@ -66,7 +66,7 @@ bool stop_signal_received();
 /// mode, failed-zone depths, counts and run time per model) and comparison.png
 /// (broken contacts against step, one curve per model). Models with a [report]
 /// give the opening columns. With `envelope` (enabled), the strength envelope of
-/// each model's rock too (model_rock.hpp): DIR/<name>/envelope/, DIR/envelopes.csv
+/// each model's rock too (studies/model/compare_envelopes.hpp): DIR/<name>/envelope/, DIR/envelopes.csv
 /// and a second table in comparison.md. Returns the first non-zero exit status of
 /// a run, or 0.
 struct CompareEnvelopeOptions;
