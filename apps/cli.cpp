@@ -34,6 +34,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -43,10 +44,9 @@ using namespace bbm;
 
 namespace {
 
-int run_cli(int argc, char** argv) {
-    CLI::App app{"bbm — bonded-block models of rock failure (2D, plane strain).\n"
-                 "Rigid or deformable blocks bonded by softening joints, one explicit loop.",
-                 "bbm"};
+/// The options of the program itself, before any command: --version, --config,
+/// --quiet and --check.
+void add_program_options(CLI::App& app, bool& quiet, bool& check_only) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "bbm " BBM_VERSION_TEXT, "Print bbm's version and the commit it was built from");
     // Any command's options can come from a TOML file: a table per command, keys
@@ -54,180 +54,311 @@ int run_cli(int argc, char** argv) {
     app.set_config("--config", "", "Read options from a TOML file ([ucs], [tension], [calibrate], ... tables; keys "
                                    "are the long option names)");
     app.allow_config_extras(CLI::config_extras_mode::error);
-    bool quiet = false, check_only = false;
     app.add_flag("-q,--quiet", quiet, "Print nothing but errors");
     app.add_flag("--check", check_only,
                  "Check the options and model files (read, and for mesh and run, generate the blocks) and stop: "
                  "exit status 0 if they are valid, 2 with the mistake otherwise; nothing is written");
+}
 
-    auto* mesh = app.add_subcommand(
-        "mesh", "Generate the blocks of a model file and write DIR/blocks.vtu (polygons: block id, "
-                "region, area, pattern), DIR/joints.vtu (lines: joint tag, the two blocks) and "
-                "DIR/blocks.png (a picture of blocks and joints) and DIR/summary.json (counts, areas, "
-                "mean block size).");
-    studies::MeshCommand mesh_command;
-    mesh->add_option("model", mesh_command.model, "Model file (TOML; keys in docs/input.md)")
-        ->required()
-        ->check(CLI::ExistingFile);
-    mesh->add_option("-o,--out", mesh_command.out, "Output directory (created if missing)")->capture_default_str();
-    mesh->add_flag("-q,--quiet", quiet, "Print nothing but errors");
-    mesh->add_option("--max-elements", mesh_command.max_elements, cli::max_elements_help)->check(cli::positive());
-    mesh->add_option("--window", mesh_command.window, "Part of the model drawn in blocks.png: XMIN YMIN XMAX YMAX (m)")
-        ->expected(4);
+/// `bbm mesh`: its options and its run.
+struct MeshCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::MeshCommand values;
 
-    studies::RunOptions run_options;
-    std::string run_out = "out";
-    auto* run = app.add_subcommand(
-        "run", "Generate the blocks of a model file and run its stages (initialize, elastic, solve, excavate, "
-               "cycle). Writes DIR/result.pvd (ParaView series of blocks, zones and contacts), DIR/history.csv, "
-               "history.png, failure.png/.svg and DIR/summary.json. Ctrl-C stops after the current step, writes a "
-               "checkpoint and the output; `bbm run --resume --out DIR` continues.");
-    run->add_option("model", run_options.model, "Model file (TOML; keys in docs/input.md)")->check(CLI::ExistingFile);
-    run->add_option("-o,--out", run_out, "Output directory (created if missing)")->capture_default_str();
-    run->add_flag("-q,--quiet", quiet, "No progress, only errors");
-    run->add_option("--threads", run_options.threads,
-                    "Threads of the loop (the result is the same, bit for bit, on any number)")
-        ->check(cli::positive())
-        ->capture_default_str();
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "mesh", "Generate the blocks of a model file and write DIR/blocks.vtu (polygons: block id, "
+                    "region, area, pattern), DIR/joints.vtu (lines: joint tag, the two blocks) and "
+                    "DIR/blocks.png (a picture of blocks and joints) and DIR/summary.json (counts, areas, "
+                    "mean block size).");
+        cmd->add_option("model", values.model, "Model file (TOML; keys in docs/input.md)")
+            ->required()
+            ->check(CLI::ExistingFile);
+        cmd->add_option("-o,--out", values.out, "Output directory (created if missing)")->capture_default_str();
+        cmd->add_flag("-q,--quiet", quiet, "Print nothing but errors");
+        cmd->add_option("--max-elements", values.max_elements, cli::max_elements_help)->check(cli::positive());
+        cmd->add_option("--window", values.window, "Part of the model drawn in blocks.png: XMIN YMIN XMAX YMAX (m)")
+            ->expected(4);
+    }
+    int run(bool quiet, bool check_only) const { return studies::run_mesh(values, quiet, check_only); }
+};
+
+/// `bbm run`: its options and its run.
+struct RunCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::RunOptions options;
+    std::string out = "out";
     std::string checkpoint_every;
-    run->add_option("--checkpoint-every", checkpoint_every,
-                    "Write DIR/checkpoint.bin every N steps (5000) or every stretch of wall time (30min, 2h, 90s), "
-                    "as well as when interrupted (SIGINT, SIGTERM, SIGUSR1)");
-    run->add_option("--stop-at-step", run_options.stop_at_step,
-                    "Stop after this step as if interrupted: checkpoint, output, exit status 130 (an exact "
-                    "interruption, for tests and scripted runs)")
-        ->check(cli::positive());
-    run->add_flag("--resume", run_options.resume,
-                  "Continue the run whose checkpoint is in --out (the model file is the checkpoint's; exit 0 if the "
-                  "run had already finished)");
-    run->add_option("--max-elements", run_options.max_elements, cli::max_elements_help)->check(cli::positive());
-    run->add_flag("--profile", run_options.profile,
-                  "Time each stage of the step (detection, contacts and zones, gather, integration...): a table on "
-                  "stderr at the end, and \"profile\" in summary.json");
-    run->add_option_function<std::string>(
-           "--shade", [&run_options](const std::string& v) { run_options.shade_pressure = v == "pressure"; },
-           "What failure.png's blocks are shaded by: displacement (the default) or pressure (the water in their "
-           "joints, a model with [flow])")
-        ->check(CLI::IsMember({"displacement", "pressure"}));
 
-    std::vector<std::string> compare_models;
-    std::string compare_out = "out/compare";
-    int compare_threads = 1;
-    studies::SweepOptions sweep_options;
-    std::vector<std::string> sweep_sets;
-    auto* sweep = app.add_subcommand(
-        "sweep", "Run a model file over the cross product of key overrides and seeds (under mpirun: spread over the "
-                 "ranks). Each run gets DIR/run_NNN (the edited model.toml and the output of bbm run); DIR/sweep.csv "
-                 "and sweep.json tabulate them (values, status, error, steps, cracks, the --plot value) and "
-                 "sweep.png plots --plot against the first --set key. A failed run is reported and the others go "
-                 "on (exit status 1 if any failed).");
-    sweep->add_option("model", sweep_options.model, "Model file (TOML; keys in docs/input.md)")
-        ->required()
-        ->check(CLI::ExistingFile);
-    sweep->add_option("--set", sweep_sets,
-                      "KEY=V1,V2,...: a model-file key as error messages name it and its values, e.g. "
-                      "joint_property[0].tensile=2e6,3e6 or region[1].pattern.size=0.2,0.3 (repeatable); keys joined by '+' take the same values together")
-        ->take_all();
-    sweep->add_option("--seeds", sweep_options.seeds,
-                      "Seeds per combination: the random patterns' seeds plus 0, 1, ... seeds-1")
-        ->check(cli::whole_at_least(1))
-        ->capture_default_str();
-    sweep->add_option("-o,--out", sweep_options.out, "Output directory")->capture_default_str();
-    sweep->add_option("--threads", sweep_options.threads, "Threads of each run's loop")
-        ->check(cli::positive())
-        ->capture_default_str();
-    sweep->add_option("--jobs", sweep_options.jobs, "Runs at once (per rank under mpirun)")
-        ->check(cli::positive())
-        ->capture_default_str();
-    sweep->add_flag("--resume", sweep_options.resume,
-                    "Keep the runs already finished in --out (complete summary, same model)");
-    sweep->add_option("--plot", sweep_options.plot,
-                      "The summary.json value drawn in sweep.png, dotted (cracks.shear, steps, "
-                      "opening.failed_depth_springline, ...)")
-        ->capture_default_str();
-    sweep->add_flag("-q,--quiet", quiet, "No progress, only errors");
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "run", "Generate the blocks of a model file and run its stages (initialize, elastic, solve, excavate, "
+                   "cycle). Writes DIR/result.pvd (ParaView series of blocks, zones and contacts), DIR/history.csv, "
+                   "history.png, failure.png/.svg and DIR/summary.json. Ctrl-C stops after the current step, writes a "
+                   "checkpoint and the output; `bbm run --resume --out DIR` continues.");
+        cmd->add_option("model", options.model, "Model file (TOML; keys in docs/input.md)")->check(CLI::ExistingFile);
+        cmd->add_option("-o,--out", out, "Output directory (created if missing)")->capture_default_str();
+        cmd->add_flag("-q,--quiet", quiet, "No progress, only errors");
+        cmd->add_option("--threads", options.threads,
+                        "Threads of the loop (the result is the same, bit for bit, on any number)")
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_option("--checkpoint-every", checkpoint_every,
+                        "Write DIR/checkpoint.bin every N steps (5000) or every stretch of wall time (30min, 2h, 90s), "
+                        "as well as when interrupted (SIGINT, SIGTERM, SIGUSR1)");
+        cmd->add_option("--stop-at-step", options.stop_at_step,
+                        "Stop after this step as if interrupted: checkpoint, output, exit status 130 (an exact "
+                        "interruption, for tests and scripted runs)")
+            ->check(cli::positive());
+        cmd->add_flag("--resume", options.resume,
+                      "Continue the run whose checkpoint is in --out (the model file is the checkpoint's; exit 0 if the "
+                      "run had already finished)");
+        cmd->add_option("--max-elements", options.max_elements, cli::max_elements_help)->check(cli::positive());
+        cmd->add_flag("--profile", options.profile,
+                      "Time each stage of the step (detection, contacts and zones, gather, integration...): a table on "
+                      "stderr at the end, and \"profile\" in summary.json");
+        cmd->add_option_function<std::string>(
+               "--shade", [this](const std::string& v) { options.shade_pressure = v == "pressure"; },
+               "What failure.png's blocks are shaded by: displacement (the default) or pressure (the water in their "
+               "joints, a model with [flow])")
+            ->check(CLI::IsMember({"displacement", "pressure"}));
+    }
+    int run(bool quiet, bool check_only) {
+        if (options.model.empty() && !options.resume)
+            throw InputError("bbm run", 0, "", "give a model file, or --resume with the --out of a run to continue");
+        options.out = out;
+        if (!checkpoint_every.empty()) options.checkpoint_every = studies::parse_checkpoint_interval(checkpoint_every);
+        options.quiet = quiet;
+        options.check_only = check_only;
+        return studies::run_model(options);
+    }
+};
 
-    auto* compare = app.add_subcommand(
-        "compare", "Run several model files (e.g. rigid and deformable blocks, examples/compare_rigid_deformable/) "
-                   "into DIR/<name>/ and write DIR/comparison.csv, comparison.md (wall displacements, cracks by "
-                   "mode, failed-zone depth, run time) and comparison.png (cracks against step).");
-    compare->add_option("models", compare_models, "Model files")->required()->check(CLI::ExistingFile);
-    compare->add_option("-o,--out", compare_out, "Output directory")->capture_default_str();
-    compare->add_option("--threads", compare_threads, "Threads of each run's contact loop")
-        ->check(cli::positive())
-        ->capture_default_str();
-    studies::CompareEnvelopeOptions compare_envelope;
-    compare->add_flag("--envelope", compare_envelope.enabled,
+/// `bbm sweep`: its options and its run.
+struct SweepCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::SweepOptions options;
+    std::vector<std::string> sets;
+
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "sweep", "Run a model file over the cross product of key overrides and seeds (under mpirun: spread over the "
+                     "ranks). Each run gets DIR/run_NNN (the edited model.toml and the output of bbm run); DIR/sweep.csv "
+                     "and sweep.json tabulate them (values, status, error, steps, cracks, the --plot value) and "
+                     "sweep.png plots --plot against the first --set key. A failed run is reported and the others go "
+                     "on (exit status 1 if any failed).");
+        cmd->add_option("model", options.model, "Model file (TOML; keys in docs/input.md)")
+            ->required()
+            ->check(CLI::ExistingFile);
+        cmd->add_option("--set", sets,
+                        "KEY=V1,V2,...: a model-file key as error messages name it and its values, e.g. "
+                        "joint_property[0].tensile=2e6,3e6 or region[1].pattern.size=0.2,0.3 (repeatable); keys joined by '+' take the same values together")
+            ->take_all();
+        cmd->add_option("--seeds", options.seeds,
+                        "Seeds per combination: the random patterns' seeds plus 0, 1, ... seeds-1")
+            ->check(cli::whole_at_least(1))
+            ->capture_default_str();
+        cmd->add_option("-o,--out", options.out, "Output directory")->capture_default_str();
+        cmd->add_option("--threads", options.threads, "Threads of each run's loop")
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_option("--jobs", options.jobs, "Runs at once (per rank under mpirun)")
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_flag("--resume", options.resume,
+                      "Keep the runs already finished in --out (complete summary, same model)");
+        cmd->add_option("--plot", options.plot,
+                        "The summary.json value drawn in sweep.png, dotted (cracks.shear, steps, "
+                        "opening.failed_depth_springline, ...)")
+            ->capture_default_str();
+        cmd->add_flag("-q,--quiet", quiet, "No progress, only errors");
+    }
+    int run(bool quiet, bool check_only) {
+        for (const auto& text : sets) options.set.push_back(studies::parse_set(text));
+        options.quiet = quiet;
+        options.check_only = check_only;
+        return studies::run_sweep(options);
+    }
+};
+
+/// `bbm compare`: its options and its run.
+struct CompareCommandLine {
+    CLI::App* cmd = nullptr;
+    std::vector<std::string> models;
+    std::string out = "out/compare";
+    int threads = 1;
+    studies::CompareEnvelopeOptions envelope;
+
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "compare", "Run several model files (e.g. rigid and deformable blocks, examples/compare_rigid_deformable/) "
+                       "into DIR/<name>/ and write DIR/comparison.csv, comparison.md (wall displacements, cracks by "
+                       "mode, failed-zone depth, run time) and comparison.png (cracks against step).");
+        cmd->add_option("models", models, "Model files")->required()->check(CLI::ExistingFile);
+        cmd->add_option("-o,--out", out, "Output directory")->capture_default_str();
+        cmd->add_option("--threads", threads, "Threads of each run's contact loop")
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_flag("--envelope", envelope.enabled,
                       "Also measure each model's rock as a laboratory does (bbm envelope on specimens of the model's "
                       "block pattern, joints and blocks): DIR/<name>/envelope/, DIR/envelopes.csv and a table in "
                       "comparison.md (UCS, T/UCS, Hoek-Brown mi, Mohr-Coulomb c and phi, sigma_ci / peak)");
-    compare->add_option("--envelope-width", compare_envelope.width, "--envelope: specimen width (m)")
-        ->check(cli::positive())
-        ->capture_default_str();
-    compare->add_option("--envelope-height", compare_envelope.height, "--envelope: specimen height (m)")
-        ->check(cli::positive())
-        ->capture_default_str();
-    compare->add_option("--envelope-realizations", compare_envelope.realizations,
+        cmd->add_option("--envelope-width", envelope.width, "--envelope: specimen width (m)")
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_option("--envelope-height", envelope.height, "--envelope: specimen height (m)")
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_option("--envelope-realizations", envelope.realizations,
                         "--envelope: seeds of each test (from the model's pattern seed)")
-        ->check(cli::positive())
-        ->capture_default_str();
-    compare->add_option("--envelope-confinements", compare_envelope.confinements,
+            ->check(cli::positive())
+            ->capture_default_str();
+        cmd->add_option("--envelope-confinements", envelope.confinements,
                         "--envelope: lateral stresses of the biaxial tests, Pa, comma-separated (default: 0.1 to 0.5 "
                         "times each rock's UCS)")
-        ->delimiter(',')
-        ->check(cli::positive());
-    compare->add_flag("-q,--quiet", quiet, "No progress, only errors");
+            ->delimiter(',')
+            ->check(cli::positive());
+        cmd->add_flag("-q,--quiet", quiet, "No progress, only errors");
+    }
+    int run(bool quiet, bool check_only) {
+        if (check_only) {
+            for (const auto& m : models) {
+                const auto model = io::read_model(m);
+                if (envelope.enabled) (void)io::rock_of_model(model, m);
+            }
+            return 0;
+        }
+        return studies::compare_models(models, out, threads, quiet, &envelope);
+    }
+};
 
-    studies::CalibrateValues calibrate_values;
-    auto* calibrate_cmd = app.add_subcommand(
-        "calibrate", "Find kn, ks, tensile strength and cohesion that give target E, nu, UCS and direct tensile "
-                     "strength (means over --realizations seeds of UCS and tension tests), and the friction angle "
-                     "too given a biaxial strength (--target-biaxial, --target-confinement). Prints the iterations, "
-                     "writes DIR/joint_property.toml (a [[joint_property]] for a model file) and calibration.json. "
-                     "Exit status 4 if not converged.");
-    cli::add_calibrate_options(calibrate_cmd, calibrate_values, quiet);
+/// `bbm calibrate`: its options (apps/study_flags.cpp) and its run.
+struct CalibrateCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::CalibrateValues values;
 
-    studies::EnvelopeOptions envelope_values;
-    auto* envelope_cmd = app.add_subcommand(
-        "envelope", "The strength envelope of a block model as a laboratory measures it: uniaxial compression, a "
-                    "tension test and biaxial tests at several confinements (--confinements), --realizations seeds "
-                    "each; fits Hoek-Brown (sigma_ci, mi) and Mohr-Coulomb (c, phi) to the peaks, and reports "
-                    "sigma_ci and sigma_cd at each confinement. Writes envelope.json, envelope.csv and envelope.png "
-                    "in --out.");
-    cli::add_envelope_options(envelope_cmd, envelope_values, quiet);
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "calibrate", "Find kn, ks, tensile strength and cohesion that give target E, nu, UCS and direct tensile "
+                         "strength (means over --realizations seeds of UCS and tension tests), and the friction angle "
+                         "too given a biaxial strength (--target-biaxial, --target-confinement). Prints the iterations, "
+                         "writes DIR/joint_property.toml (a [[joint_property]] for a model file) and calibration.json. "
+                         "Exit status 4 if not converged.");
+        cli::add_calibrate_options(cmd, values, quiet);
+    }
+    int run(bool quiet, bool check_only) {
+        cli::note_given_joint_values(*cmd, values);
+        return studies::run_calibrate(values, quiet, check_only);
+    }
+};
 
-    studies::ShearValues shear_values;
-    auto* shear_cmd = app.add_subcommand(
-        "shear", "Direct shear test of a joint across a bonded-block specimen, persistent or with rock bridges "
-                 "(--persistence, --bridges), under constant normal load or constant normal stiffness "
-                 "(--normal-stiffness), at one or more normal stresses (--normal-stress 2e6,5e6,10e6). Writes "
-                 "summary.json (peak and residual strength, dilation, Coulomb fits), shear.csv, shear_stress.png, "
-                 "dilation.png and per run failure.png and result.pvd in --out.");
-    cli::add_shear_options(shear_cmd, shear_values, quiet);
+/// `bbm envelope`: its options (apps/study_flags.cpp) and its run.
+struct EnvelopeCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::EnvelopeOptions values;
 
-    // Lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
-    const std::pair<const char*, const char*> labtests[] = {
-        {"ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, the paper's calibration run "
-                "(Voronoi 0.3 m, 8 m x 16 m, SPEC §8). Writes summary.json (E, nu, peak_stress, ...), "
-                "stress_strain.csv/.png, failure.png/.svg and result.pvd in --out."},
-        {"tension", "Direct uniaxial tension test (same options as ucs; loaded ten times slower by default: its peak "
-                    "comes at a tenth of the strain)."},
-        {"biaxial", "Compression with a constant lateral stress (same options as ucs)."},
-        {"brazilian", "Brazilian test: a disc of diameter --width loaded across a diameter; reports the indirect "
-                      "tensile strength 2P/(pi D)."}};
-    std::vector<std::pair<CLI::App*, studies::LabTestValues>> labtest_commands;
-    labtest_commands.reserve(4);
-    for (const auto& [name, help] : labtests) {
-        const auto kind = studies::labtest_kind(name);
-        labtest_commands.emplace_back(app.add_subcommand(name, help), studies::labtest_defaults(kind));
-        auto& [command, values] = labtest_commands.back();
-        cli::add_labtest_options(command, values, quiet);
-        if (kind == LabTestOptions::Kind::biaxial)
-            command->add_option("--confinement", values.o.confinement, "Lateral stress (Pa, compression positive)")
-                ->required()
-                ->check(cli::non_negative());
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "envelope", "The strength envelope of a block model as a laboratory measures it: uniaxial compression, a "
+                        "tension test and biaxial tests at several confinements (--confinements), --realizations seeds "
+                        "each; fits Hoek-Brown (sigma_ci, mi) and Mohr-Coulomb (c, phi) to the peaks, and reports "
+                        "sigma_ci and sigma_cd at each confinement. Writes envelope.json, envelope.csv and envelope.png "
+                        "in --out.");
+        cli::add_envelope_options(cmd, values, quiet);
+    }
+    int run(bool quiet, bool check_only) { return studies::run_envelope(values, quiet, check_only); }
+};
+
+/// `bbm shear`: its options (apps/study_flags.cpp) and its run.
+struct ShearCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::ShearValues values;
+
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "shear", "Direct shear test of a joint across a bonded-block specimen, persistent or with rock bridges "
+                     "(--persistence, --bridges), under constant normal load or constant normal stiffness "
+                     "(--normal-stiffness), at one or more normal stresses (--normal-stress 2e6,5e6,10e6). Writes "
+                     "summary.json (peak and residual strength, dilation, Coulomb fits), shear.csv, shear_stress.png, "
+                     "dilation.png and per run failure.png and result.pvd in --out.");
+        cli::add_shear_options(cmd, values, quiet);
+    }
+    int run(bool quiet, bool check_only) { return studies::run_shear(values, quiet, check_only); }
+};
+
+/// The lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
+struct LabTestCommandLines {
+    std::vector<std::pair<CLI::App*, studies::LabTestValues>> commands;
+
+    void add(CLI::App& app, bool& quiet) {
+        const std::pair<const char*, const char*> labtests[] = {
+            {"ucs", "Uniaxial compression test of a bonded-block specimen; with no flags, the paper's calibration run "
+                    "(Voronoi 0.3 m, 8 m x 16 m, SPEC §8). Writes summary.json (E, nu, peak_stress, ...), "
+                    "stress_strain.csv/.png, failure.png/.svg and result.pvd in --out."},
+            {"tension", "Direct uniaxial tension test (same options as ucs; loaded ten times slower by default: its peak "
+                        "comes at a tenth of the strain)."},
+            {"biaxial", "Compression with a constant lateral stress (same options as ucs)."},
+            {"brazilian", "Brazilian test: a disc of diameter --width loaded across a diameter; reports the indirect "
+                          "tensile strength 2P/(pi D)."}};
+        commands.reserve(4);
+        for (const auto& [name, help] : labtests) {
+            const auto kind = studies::labtest_kind(name);
+            commands.emplace_back(app.add_subcommand(name, help), studies::labtest_defaults(kind));
+            auto& [command, values] = commands.back();
+            cli::add_labtest_options(command, values, quiet);
+            if (kind == LabTestOptions::Kind::biaxial)
+                command->add_option("--confinement", values.o.confinement, "Lateral stress (Pa, compression positive)")
+                    ->required()
+                    ->check(cli::non_negative());
+        }
+    }
+    /// The lab test given, run; none if no lab test was given.
+    std::optional<int> run(bool quiet, bool check_only) {
+        for (auto& [command, values] : commands)
+            if (*command) return studies::run_labtest_command(values, values.o.kind, quiet, check_only);
+        return std::nullopt;
+    }
+};
+
+/// Every command, added to the program in the order of its help.
+struct Commands {
+    MeshCommandLine mesh;
+    RunCommandLine run;
+    SweepCommandLine sweep;
+    CompareCommandLine compare;
+    CalibrateCommandLine calibrate;
+    EnvelopeCommandLine envelope;
+    ShearCommandLine shear;
+    LabTestCommandLines labtests;
+
+    void add(CLI::App& app, bool& quiet) {
+        mesh.add(app, quiet);
+        run.add(app, quiet);
+        sweep.add(app, quiet);
+        compare.add(app, quiet);
+        calibrate.add(app, quiet);
+        envelope.add(app, quiet);
+        shear.add(app, quiet);
+        labtests.add(app, quiet);
     }
 
+    /// The command given, run; its exit status.
+    int run_given(bool quiet, bool check_only) {
+        if (*run.cmd) return run.run(quiet, check_only);
+        if (*envelope.cmd) return envelope.run(quiet, check_only);
+        if (*shear.cmd) return shear.run(quiet, check_only);
+        if (*calibrate.cmd) return calibrate.run(quiet, check_only);
+        if (*sweep.cmd) return sweep.run(quiet, check_only);
+        if (*compare.cmd) return compare.run(quiet, check_only);
+        if (const auto status = labtests.run(quiet, check_only)) return *status;
+        if (*mesh.cmd) return mesh.run(quiet, check_only);
+        return 0;
+    }
+};
+
+/// Parses the command line; the exit status if the program stops here (help,
+/// the version, or a mistake in the options, said on stderr), none to go on.
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ConfigError& e) {
@@ -248,41 +379,13 @@ int run_cli(int argc, char** argv) {
         if (studies::Ranks::root()) std::fprintf(stderr, "bbm: error: %s\n", e.what());
         return 2;
     }
+    return std::nullopt;
+}
+
+/// Runs the command given; its exit status, a failure's said on stderr.
+int run_command(Commands& commands, bool quiet, bool check_only) {
     try {
-        if (*run) {
-            if (run_options.model.empty() && !run_options.resume)
-                throw InputError("bbm run", 0, "", "give a model file, or --resume with the --out of a run to continue");
-            run_options.out = run_out;
-            if (!checkpoint_every.empty()) run_options.checkpoint_every = studies::parse_checkpoint_interval(checkpoint_every);
-            run_options.quiet = quiet;
-            run_options.check_only = check_only;
-            return studies::run_model(run_options);
-        }
-        if (*envelope_cmd) return studies::run_envelope(envelope_values, quiet, check_only);
-        if (*shear_cmd) return studies::run_shear(shear_values, quiet, check_only);
-        if (*calibrate_cmd) {
-            cli::note_given_joint_values(*calibrate_cmd, calibrate_values);
-            return studies::run_calibrate(calibrate_values, quiet, check_only);
-        }
-        if (*sweep) {
-            for (const auto& text : sweep_sets) sweep_options.set.push_back(studies::parse_set(text));
-            sweep_options.quiet = quiet;
-            sweep_options.check_only = check_only;
-            return studies::run_sweep(sweep_options);
-        }
-        if (*compare) {
-            if (check_only) {
-                for (const auto& m : compare_models) {
-                    const auto model = io::read_model(m);
-                    if (compare_envelope.enabled) (void)io::rock_of_model(model, m);
-                }
-                return 0;
-            }
-            return studies::compare_models(compare_models, compare_out, compare_threads, quiet, &compare_envelope);
-        }
-        for (auto& [command, values] : labtest_commands)
-            if (*command) return studies::run_labtest_command(values, values.o.kind, quiet, check_only);
-        if (*mesh) return studies::run_mesh(mesh_command, quiet, check_only);
+        return commands.run_given(quiet, check_only);
     } catch (const InputError& e) {
         // Under mpirun every rank meets the same error: one says it.
         if (studies::Ranks::root()) std::fprintf(stderr, "bbm: error: %s\n", e.what());
@@ -301,7 +404,18 @@ int run_cli(int argc, char** argv) {
                      e.what());
         return 1;
     }
-    return 0;
+}
+
+int run_cli(int argc, char** argv) {
+    CLI::App app{"bbm — bonded-block models of rock failure (2D, plane strain).\n"
+                 "Rigid or deformable blocks bonded by softening joints, one explicit loop.",
+                 "bbm"};
+    bool quiet = false, check_only = false;
+    add_program_options(app, quiet, check_only);
+    Commands commands;
+    commands.add(app, quiet);
+    if (const auto status = parse_command_line(app, argc, argv)) return *status;
+    return run_command(commands, quiet, check_only);
 }
 
 } // namespace

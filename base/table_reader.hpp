@@ -40,6 +40,13 @@ struct ModelScale {
         return !extent.empty() && p.x >= extent.lo.x - s && p.x <= extent.hi.x + s && p.y >= extent.lo.y - s &&
                p.y <= extent.hi.y + s;
     }
+    /// Overlapping that neighbourhood (a box may reach far beyond the model to
+    /// take all of one side; one wholly beside it selects nothing it means).
+    bool near(const Box2& b) const {
+        const double s = size();
+        return !extent.empty() && b.hi.x >= extent.lo.x - s && b.lo.x <= extent.hi.x + s &&
+               b.hi.y >= extent.lo.y - s && b.lo.y <= extent.hi.y + s;
+    }
 };
 
 class TableReader {

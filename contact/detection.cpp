@@ -104,12 +104,12 @@ Box2 current_box(const Detector::Piece& pc, const BlockView& b, double inflate) 
     return box;
 }
 
-void build_grid(Detector& d, const DetectionInput& in) {
-    // A block with many vertices (a deformable block's boundary, hundreds of
-    // nodes) enters as pieces of at most `chunk` consecutive vertices, each with
-    // its own box: otherwise its one box, as large as the model, would pair it
-    // with every block and the narrow phase would test every vertex against all
-    // its edges.
+/// The blocks as pieces, made again when the number of blocks changes. A block
+/// with many vertices (a deformable block's boundary, hundreds of nodes) enters
+/// as pieces of at most `chunk` consecutive vertices, each with its own box:
+/// otherwise its one box, as large as the model, would pair it with every block
+/// and the narrow phase would test every vertex against all its edges.
+void split_into_pieces(Detector& d, const DetectionInput& in) {
     constexpr std::uint32_t chunk = 16;
     const BlockView& b = in.blocks;
     const int nb = in.block_count;
@@ -122,6 +122,13 @@ void build_grid(Detector& d, const DetectionInput& in) {
             d.block_piece.push_back(int(d.pieces.size()));
         }
     }
+}
+
+/// Each piece's stored box: its current box inflated by the tolerance and the
+/// margin (a tenth of the pieces' mean extent, at least four tolerances); the
+/// grid's box around them. Returns the pieces' mean extent.
+double store_piece_boxes(Detector& d, const DetectionInput& in) {
+    const BlockView& b = in.blocks;
     const int np = int(d.pieces.size());
     d.stored.resize(np);
     d.grid_box = Box2{};
@@ -142,29 +149,130 @@ void build_grid(Detector& d, const DetectionInput& in) {
         d.grid_box.add(d.stored[p].lo);
         d.grid_box.add(d.stored[p].hi);
     }
-    d.cell = std::max(extent + 2.0 * d.margin, 1e-12);
-    d.nx = std::clamp(int(d.grid_box.width() / d.cell) + 1, 1, 1 << 14);
-    d.ny = std::clamp(int(d.grid_box.height() / d.cell) + 1, 1, 1 << 14);
-    auto for_cells = [&](const Box2& bx, auto&& visit) {
-        const int i0 = std::clamp(int((bx.lo.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
-        const int i1 = std::clamp(int((bx.hi.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
-        const int j0 = std::clamp(int((bx.lo.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
-        const int j1 = std::clamp(int((bx.hi.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
-        for (int j = j0; j <= j1; ++j)
-            for (int i = i0; i <= i1; ++i) visit(std::size_t(j) * d.nx + i);
-    };
-    // Counting sort of the pieces into the cells their stored boxes cover.
+    return extent;
+}
+
+/// Visits the index of every grid cell the box covers.
+template <class Visit>
+inline void for_cells(const Detector& d, const Box2& bx, Visit&& visit) {
+    const int i0 = std::clamp(int((bx.lo.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
+    const int i1 = std::clamp(int((bx.hi.x - d.grid_box.lo.x) / d.cell), 0, d.nx - 1);
+    const int j0 = std::clamp(int((bx.lo.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
+    const int j1 = std::clamp(int((bx.hi.y - d.grid_box.lo.y) / d.cell), 0, d.ny - 1);
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) visit(std::size_t(j) * d.nx + i);
+}
+
+/// Counting sort of the pieces into the cells their stored boxes cover.
+void sort_pieces_into_cells(Detector& d, const DetectionInput& in) {
+    const int np = int(d.pieces.size());
     d.cell_first.assign(std::size_t(d.nx) * d.ny + 1, 0);
     for (int p = 0; p < np; ++p)
-        if (!(in.removed && in.removed[d.pieces[p].block])) for_cells(d.stored[p], [&](std::size_t k) { ++d.cell_first[k + 1]; });
+        if (!(in.removed && in.removed[d.pieces[p].block])) for_cells(d, d.stored[p], [&](std::size_t k) { ++d.cell_first[k + 1]; });
     for (std::size_t k = 0; k + 1 < d.cell_first.size(); ++k) d.cell_first[k + 1] += d.cell_first[k];
     d.cell_piece.resize(d.cell_first.back());
     for (int p = 0; p < np; ++p)
         if (!(in.removed && in.removed[d.pieces[p].block]))
-            for_cells(d.stored[p], [&](std::size_t k) { d.cell_piece[d.cell_first[k]++] = p; });
+            for_cells(d, d.stored[p], [&](std::size_t k) { d.cell_piece[d.cell_first[k]++] = p; });
     for (std::size_t k = d.cell_first.size() - 1; k > 0; --k) d.cell_first[k] = d.cell_first[k - 1];
     d.cell_first[0] = 0;
+}
+
+void build_grid(Detector& d, const DetectionInput& in) {
+    split_into_pieces(d, in);
+    const double extent = store_piece_boxes(d, in);
+    d.cell = std::max(extent + 2.0 * d.margin, 1e-12);
+    d.nx = std::clamp(int(d.grid_box.width() / d.cell) + 1, 1, 1 << 14);
+    d.ny = std::clamp(int(d.grid_box.height() / d.cell) + 1, 1, 1 << 14);
+    sort_pieces_into_cells(d, in);
     d.grid_valid = true;
+}
+
+/// The edge of Q nearest the vertex x, within the tolerance of its line and of
+/// its ends; -1 if none.
+inline int nearest_edge(Vec2 x, const Detector::Piece& Q, const BlockView& b, double tol) {
+    const int B = Q.block;
+    int best = -1;
+    double best_gap = INFINITY;
+    for (std::uint32_t e = Q.v0; e < Q.v1; ++e) {
+        const int e1 = next_vertex(b.first, B, int(e));
+        const EdgeFrame f = frame(x, b.vertex[e], b.vertex[e1]);
+        const double len = 1.0 / b.inv_edge_length[e];
+        const double beyond = std::max({0.0, -f.s, f.s - 1.0}) * len;
+        if (f.gap > tol || f.gap < -tol || beyond > tol) continue;
+        const double dist = std::abs(f.gap) + beyond;
+        if (dist < best_gap) best_gap = dist, best = int(e);
+    }
+    return best;
+}
+
+/// Still on the point vertex v touched block B at in the tessellation?
+inline bool on_its_junction(const std::vector<Junction>& J, int v, int B, const BlockView& b, Vec2 x, double tol) {
+    const auto it = std::lower_bound(J.begin(), J.end(), Junction{v, B, 0, 0, 0.0});
+    if (it != J.end() && it->vertex == v && it->block == B) {
+        const Vec2 touched = b.vertex[it->e0] + it->s * (b.vertex[it->e1] - b.vertex[it->e0]);
+        if (norm(x - touched) <= tol) return true;
+    }
+    return false;
+}
+
+/// The edge of B the vertex x faces, from its nearest edge `best`. Past an end of
+/// the nearest edge, inside its line but outside the line of the edge across the
+/// corner (a convex one): the vertex is outside B and faces that other edge. Taken
+/// against the first, it was born in overlap with the rounded corner (a circle
+/// tangent to the first edge reaches past an acute corner: 344 of 515 contacts
+/// born below -0.1 mm in a 3 x 6 m area trigon specimen were outside B), and its
+/// later approach across the other edge went unseen. It is the other edge's.
+inline int edge_faced(const BlockView& b, int B, int best, Vec2 x) {
+    const int e_end = next_vertex(b.first, B, best);
+    const EdgeFrame f = frame(x, b.vertex[best], b.vertex[e_end]);
+    if (f.gap < 0.0 && (f.s < 0.0 || f.s > 1.0)) {
+        const int c0 = f.s < 0.0 ? prev_vertex(b.first, B, best) : e_end; // the other edge
+        const int c1 = next_vertex(b.first, B, c0);
+        const Vec2 arriving = f.s < 0.0 ? b.vertex[c1] - b.vertex[c0] : b.vertex[e_end] - b.vertex[best];
+        const Vec2 leaving = f.s < 0.0 ? b.vertex[e_end] - b.vertex[best] : b.vertex[c1] - b.vertex[c0];
+        if (cross(arriving, leaving) > 0.0 && frame(x, b.vertex[c0], b.vertex[c1]).gap > 0.0) return c0;
+    }
+    return best;
+}
+
+/// The length of the contact of vertex v of A (at x, s_on along B's edge `best`
+/// of unit tangent tb): the vertex's share, half of its adjacent edge that lies
+/// most along B's edge.
+inline double contact_length(const DetectionInput& in, int A, int v, Vec2 x, int best, Vec2 tb, double s_on) {
+    const BlockView& b = in.blocks;
+    const int vp = prev_vertex(b.first, A, v), vn = next_vertex(b.first, A, v);
+    const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
+    const Vec2 along = std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? ep : en;
+    double l = 0.5 * norm(along);
+    if (in.overlap_length) {
+        // The part of B's edge that the vertex's edge covers, shared with the
+        // contact at its other end; a corner touching a corner gets the arc of
+        // its rounding.
+        const double s_far = s_on + dot(along, tb) * b.inv_edge_length[best];
+        const double overlap =
+            std::max(0.0, std::min(std::max(s_on, s_far), 1.0) - std::max(std::min(s_on, s_far), 0.0)) /
+            b.inv_edge_length[best];
+        l = 0.5 * std::max(overlap, in.corner_radius);
+    }
+    return l;
+}
+
+/// The gap and normal of a vertex at x past an end of B's edge best → e1 (s_on
+/// outside [0, 1]) at a rounded corner. Past the end of the edge the contact's
+/// surface is the rounded corner (contact_kinematics), not the edge's line: a
+/// vertex beside the corner but inside that line is not in overlap. Measured
+/// against the line it would start compressed by up to the tolerance — at kn,
+/// hundreds of MPa on a fresh vertex-vertex contact (docs/calibration.md, After
+/// the peak). Past a node along a deformable face, the line goes on (contact_frame).
+inline void gap_at_corner(const DetectionInput& in, int best, int e1, double s_on, Vec2 x, double& gap, Vec2& n) {
+    const BlockView& b = in.blocks;
+    if ((s_on < 0.0 || s_on > 1.0) && b.corner[s_on < 0.0 ? best : e1]) {
+        const Vec2 centre = (s_on < 0.0 ? b.vertex[best] : b.vertex[e1]) - in.corner_radius * n;
+        const Vec2 r = x - centre;
+        const double rl = norm(r);
+        if (rl > 0.0) gap = rl - in.corner_radius, n = r / rl;
+    }
 }
 
 void add_candidates(const Detector::Piece& P, const Detector::Piece& Q, const Box2& q_box, const DetectionInput& in,
@@ -176,78 +284,18 @@ void add_candidates(const Detector::Piece& P, const Detector::Piece& Q, const Bo
     for (std::uint32_t v = P.v0; v < P.v1; ++v) {
         const Vec2 x = b.vertex[v];
         if (x.x < q_box.lo.x || x.x > q_box.hi.x || x.y < q_box.lo.y || x.y > q_box.hi.y) continue;
-        int best = -1;
-        double best_gap = INFINITY;
-        for (std::uint32_t e = Q.v0; e < Q.v1; ++e) {
-            const int e1 = next_vertex(b.first, B, int(e));
-            const EdgeFrame f = frame(x, b.vertex[e], b.vertex[e1]);
-            const double len = 1.0 / b.inv_edge_length[e];
-            const double beyond = std::max({0.0, -f.s, f.s - 1.0}) * len;
-            if (f.gap > tol || f.gap < -tol || beyond > tol) continue;
-            const double dist = std::abs(f.gap) + beyond;
-            if (dist < best_gap) best_gap = dist, best = int(e);
-        }
+        int best = nearest_edge(x, Q, b, tol);
         if (best < 0) continue;
-        if (in.junctions) {
-            // Still on the point it touched in the tessellation?
-            const auto& J = *in.junctions;
-            const auto it = std::lower_bound(J.begin(), J.end(), Junction{int(v), B, 0, 0, 0.0});
-            if (it != J.end() && it->vertex == int(v) && it->block == B) {
-                const Vec2 touched = b.vertex[it->e0] + it->s * (b.vertex[it->e1] - b.vertex[it->e0]);
-                if (norm(x - touched) <= tol) continue;
-            }
-        }
-        {
-            // Past an end of the nearest edge, inside its line but outside the line
-            // of the edge across the corner (a convex one): the vertex is outside B
-            // and faces that other edge. Taken against the first, it was born in
-            // overlap with the rounded corner (a circle tangent to the first edge
-            // reaches past an acute corner: 344 of 515 contacts born below -0.1 mm
-            // in a 3 x 6 m area trigon specimen were outside B), and its later
-            // approach across the other edge went unseen. It is the other edge's.
-            const int e_end = next_vertex(b.first, B, best);
-            const EdgeFrame f = frame(x, b.vertex[best], b.vertex[e_end]);
-            if (f.gap < 0.0 && (f.s < 0.0 || f.s > 1.0)) {
-                const int c0 = f.s < 0.0 ? prev_vertex(b.first, B, best) : e_end; // the other edge
-                const int c1 = next_vertex(b.first, B, c0);
-                const Vec2 arriving = f.s < 0.0 ? b.vertex[c1] - b.vertex[c0] : b.vertex[e_end] - b.vertex[best];
-                const Vec2 leaving = f.s < 0.0 ? b.vertex[e_end] - b.vertex[best] : b.vertex[c1] - b.vertex[c0];
-                if (cross(arriving, leaving) > 0.0 && frame(x, b.vertex[c0], b.vertex[c1]).gap > 0.0) best = c0;
-            }
-        }
+        if (in.junctions && on_its_junction(*in.junctions, int(v), B, b, x, tol)) continue;
+        best = edge_faced(b, B, best, x);
         const int e1 = next_vertex(b.first, B, best);
         const Vec2 tb = b.inv_edge_length[best] * (b.vertex[e1] - b.vertex[best]);
-        // The vertex's share: half of its adjacent edge that lies most along B's edge.
-        const int vp = prev_vertex(b.first, A, int(v)), vn = next_vertex(b.first, A, int(v));
-        const Vec2 ep = b.vertex[vp] - x, en = b.vertex[vn] - x;
-        const Vec2 along = std::abs(cross(tb, ep)) / norm(ep) < std::abs(cross(tb, en)) / norm(en) ? ep : en;
         Vec2 n{tb.y, -tb.x};
         const double s_on = dot(x - b.vertex[best], tb) * b.inv_edge_length[best];
-        double l = 0.5 * norm(along);
-        if (in.overlap_length) {
-            // The part of B's edge that the vertex's edge covers, shared with the
-            // contact at its other end; a corner touching a corner gets the arc of
-            // its rounding.
-            const double s_far = s_on + dot(along, tb) * b.inv_edge_length[best];
-            const double overlap =
-                std::max(0.0, std::min(std::max(s_on, s_far), 1.0) - std::max(std::min(s_on, s_far), 0.0)) /
-                b.inv_edge_length[best];
-            l = 0.5 * std::max(overlap, in.corner_radius);
-        }
+        const double l = contact_length(in, A, int(v), x, best, tb, s_on);
         const Vec2 vr = vertex_velocity(b, A, int(v), x) - edge_velocity(b, B, best, e1, s_on, x);
         double gap = frame(x, b.vertex[best], b.vertex[e1]).gap;
-        if ((s_on < 0.0 || s_on > 1.0) && b.corner[s_on < 0.0 ? best : e1]) {
-            // Past the end of the edge the contact's surface is the rounded corner
-            // (contact_kinematics), not the edge's line: a vertex beside the corner
-            // but inside that line is not in overlap. Measured against the line it
-            // would start compressed by up to the tolerance — at kn, hundreds of MPa
-            // on a fresh vertex-vertex contact (docs/calibration.md, After the peak).
-            // Past a node along a deformable face, the line goes on (contact_frame).
-            const Vec2 centre = (s_on < 0.0 ? b.vertex[best] : b.vertex[e1]) - in.corner_radius * n;
-            const Vec2 r = x - centre;
-            const double rl = norm(r);
-            if (rl > 0.0) gap = rl - in.corner_radius, n = r / rl;
-        }
+        gap_at_corner(in, best, e1, s_on, x, gap, n);
         const double un = gap - dot(vr, n) * in.dt;
         out.push_back({block_pair_key(A, B), A, int(v), B, best, e1, l, un});
     }

@@ -212,28 +212,31 @@ double solve_clusters(const Network& n, const FluidSpec& f, State& s, const std:
     return solved.relative_residual;
 }
 
-} // namespace
+/// The root of i's tree in the union-find `up`, halving the path on the way.
+int find_root(std::vector<int>& up, int i) {
+    while (up[i] != i) i = up[i] = up[up[i]];
+    return i;
+}
 
-SteadyReport solve_steady(const Network& n, const FluidSpec& f, State& s) {
-    // Parts of the network joined by conducting pipes (union-find); a part with a
-    // held domain is solved, one without keeps its pressures.
+/// Each pipe's conductance (into c), and each domain's part of the network: the
+/// domains joined by conducting pipes (union-find) share it.
+std::vector<int> conducting_parts(const Network& n, const FluidSpec& f, const State& s, std::vector<double>& c) {
     std::vector<int> parent(n.domains());
     for (int i = 0; i < n.domains(); ++i) parent[i] = i;
-    auto root = [&](std::vector<int>& up, int i) {
-        while (up[i] != i) i = up[i] = up[up[i]];
-        return i;
-    };
-    std::vector<double> c(n.pipes());
+    c.resize(n.pipes());
     for (int k = 0; k < n.pipes(); ++k) {
         c[k] = conductance(n, f, s, k);
-        if (c[k] > 0.0) parent[root(parent, n.pipe_from[k])] = root(parent, n.pipe_to[k]);
+        if (c[k] > 0.0) parent[find_root(parent, n.pipe_from[k])] = find_root(parent, n.pipe_to[k]);
     }
     std::vector<int> part(n.domains());
-    for (int i = 0; i < n.domains(); ++i) part[i] = root(parent, i);
-    std::vector<std::uint8_t> anchored(n.domains(), 0);
-    for (int i = 0; i < n.domains(); ++i)
-        if (s.held[i]) anchored[part[i]] = 1;
-    SteadyReport report;
+    for (int i = 0; i < n.domains(); ++i) part[i] = find_root(parent, i);
+    return part;
+}
+
+/// The domains of a part with no held domain, counted; none may have a rate
+/// injected (there is no steady state).
+void check_isolated_domains(const Network& n, const State& s, const std::vector<int>& part,
+                            const std::vector<std::uint8_t>& anchored, SteadyReport& report) {
     for (int i = 0; i < n.domains(); ++i) {
         if (s.held[i] || anchored[part[i]]) continue;
         ++report.isolated_domains;
@@ -243,39 +246,59 @@ SteadyReport solve_steady(const Network& n, const FluidSpec& f, State& s) {
                              "(domain at " + std::to_string(n.domain_position[i].x) + ", " +
                                  std::to_string(n.domain_position[i].y) + ")");
     }
-    // Conductances over more decades than double precision resolves (intact bonds
-    // of 0.05 μm beside blocks parted by 1 cm: 16 decades): a strong pipe whose
-    // end has only weak ones beside it floats on them, and eliminating it cancels
-    // their conductance to rounding — a solution with a small residual and wrong
-    // pressures (tests/test_flow.cpp). Such a pipe's ends are at one head (its
-    // pressure drop is below 1e-10 of those across the weak pipes) and are merged,
-    // unless that joins two held pressures. Only where the network's conductances
-    // span more than 10 decades: a network within them keeps its bits.
+}
+
+/// Per domain, the representative of the cluster it is merged into (itself if
+/// none). Conductances over more decades than double precision resolves (intact
+/// bonds of 0.05 μm beside blocks parted by 1 cm: 16 decades): a strong pipe whose
+/// end has only weak ones beside it floats on them, and eliminating it cancels
+/// their conductance to rounding — a solution with a small residual and wrong
+/// pressures (tests/test_flow.cpp). Such a pipe's ends are at one head (its
+/// pressure drop is below 1e-10 of those across the weak pipes) and are merged,
+/// unless that joins two held pressures. Only where the network's conductances
+/// span more than 10 decades: a network within them keeps its bits.
+std::vector<int> merge_floating_pipes(const Network& n, const State& s, const std::vector<double>& c,
+                                      SteadyReport& report) {
     constexpr double kappa = 1e10;
     std::vector<int> cluster(n.domains());
     for (int i = 0; i < n.domains(); ++i) cluster[i] = i;
     double weakest = INFINITY, strongest = 0.0;
     for (double ck : c)
         if (ck > 0.0) weakest = std::min(weakest, ck), strongest = std::max(strongest, ck);
-    if (strongest > kappa * weakest) {
-        std::vector<double> total(n.domains(), 0.0);
-        for (int k = 0; k < n.pipes(); ++k) total[n.pipe_from[k]] += c[k], total[n.pipe_to[k]] += c[k];
-        std::vector<std::uint8_t> has_held(s.held.begin(), s.held.end());
-        for (int k = 0; k < n.pipes(); ++k) {
-            const int i = n.pipe_from[k], j = n.pipe_to[k];
-            // A held end is tied to its boundary as strongly as to anything: not the end that floats.
-            const double others_i = s.held[i] ? INFINITY : total[i] - c[k];
-            const double others_j = s.held[j] ? INFINITY : total[j] - c[k];
-            // A sealed pipe (c = 0, e.g. an intact bond without an aperture) joins nothing.
-            if (!(c[k] > 0.0) || !(c[k] >= kappa * std::min(others_i, others_j))) continue;
-            const int a = root(cluster, i), b = root(cluster, j);
-            if (a == b || (has_held[a] && has_held[b])) continue;
-            const int keep = std::min(a, b), gone = std::max(a, b);
-            cluster[gone] = keep, has_held[keep] = has_held[keep] || has_held[gone];
-            ++report.merged_pipes;
-        }
-        for (int i = 0; i < n.domains(); ++i) cluster[i] = root(cluster, i);
+    if (!(strongest > kappa * weakest)) return cluster;
+    std::vector<double> total(n.domains(), 0.0);
+    for (int k = 0; k < n.pipes(); ++k) total[n.pipe_from[k]] += c[k], total[n.pipe_to[k]] += c[k];
+    std::vector<std::uint8_t> has_held(s.held.begin(), s.held.end());
+    for (int k = 0; k < n.pipes(); ++k) {
+        const int i = n.pipe_from[k], j = n.pipe_to[k];
+        // A held end is tied to its boundary as strongly as to anything: not the end that floats.
+        const double others_i = s.held[i] ? INFINITY : total[i] - c[k];
+        const double others_j = s.held[j] ? INFINITY : total[j] - c[k];
+        // A sealed pipe (c = 0, e.g. an intact bond without an aperture) joins nothing.
+        if (!(c[k] > 0.0) || !(c[k] >= kappa * std::min(others_i, others_j))) continue;
+        const int a = find_root(cluster, i), b = find_root(cluster, j);
+        if (a == b || (has_held[a] && has_held[b])) continue;
+        const int keep = std::min(a, b), gone = std::max(a, b);
+        cluster[gone] = keep, has_held[keep] = has_held[keep] || has_held[gone];
+        ++report.merged_pipes;
     }
+    for (int i = 0; i < n.domains(); ++i) cluster[i] = find_root(cluster, i);
+    return cluster;
+}
+
+} // namespace
+
+SteadyReport solve_steady(const Network& n, const FluidSpec& f, State& s) {
+    // Parts of the network joined by conducting pipes (union-find); a part with a
+    // held domain is solved, one without keeps its pressures.
+    std::vector<double> c;
+    const std::vector<int> part = conducting_parts(n, f, s, c);
+    std::vector<std::uint8_t> anchored(n.domains(), 0);
+    for (int i = 0; i < n.domains(); ++i)
+        if (s.held[i]) anchored[part[i]] = 1;
+    SteadyReport report;
+    check_isolated_domains(n, s, part, anchored, report);
+    const std::vector<int> cluster = merge_floating_pipes(n, s, c, report);
     try {
         report.relative_residual = solve_clusters(n, f, s, c, cluster, anchored, part, report);
     } catch (const std::runtime_error& e) {

@@ -43,103 +43,146 @@ SupportPath support_path_of(const std::vector<StageSpec>& stages, int index) {
     return path;
 }
 
-} // namespace
-
-std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs,
-                                    StageCursor start) {
-    World& w = s.world();
-    std::vector<StageReport> reports;
-    for (int index = start.stage; index < int(stages.size()); ++index) {
-        const StageSpec& st = stages[index];
-        const bool resumed = index == start.stage && start.started;
-        const auto t0 = std::chrono::steady_clock::now();
-        StageReport r;
-        r.name = st.name;
-        r.kind = to_string(st.kind);
-        StageCursor cursor{index, true, resumed ? start.step : 0};
-        r.steps = cursor.step;
-        // Solve and cycle stages are judged (core/verdict.hpp): the monitor samples
-        // at fixed steps of the run, so a resumed stage samples where the
-        // uninterrupted one does.
-        const bool judged = st.kind == StageSpec::Kind::solve || st.kind == StageSpec::Kind::cycle;
-        // Where a solve stage ends (StageSpec::Until): its ratio reached (after a
-        // few steps: at rest the ratio is 0 before anything moves), or, asked for,
-        // the rock at rest, or only the verdict of equilibrium.
-        auto solved = [&](long k) {
-            using U = StageSpec::Until;
-            const bool sampled = w.clock.steps % StageMonitor::sample_every == 0;
-            if (st.until == U::equilibrium) {
-                if (!sampled) return false;
-                const auto kind = verdict(w.monitor, st.ratio).kind;
-                return kind == Verdict::Kind::equilibrium || kind == Verdict::Kind::equilibrium_with_fragments;
-            }
-            if (k >= 10 && w.clock.ratio <= st.ratio) return true;
-            return st.until == U::rest && sampled && at_rest(w.monitor, st.ratio, st.quiet_steps);
-        };
+/// One stage of run_stages: started (unless resumed inside it), stepped to its
+/// end, judged, and reported.
+class StageRun {
+public:
+    StageRun(Solver& s, const std::vector<StageSpec>& stages, int index, StageObserver& obs, const StageCursor& start)
+        : s_(s), w_(s.world()), stages_(stages), index_(index), st_(stages[index]), obs_(obs),
+          resumed_(index == start.stage && start.started), t0_(std::chrono::steady_clock::now()),
+          cursor_{index, true, resumed_ ? start.step : 0},
+          // Solve and cycle stages are judged (core/verdict.hpp): the monitor samples
+          // at fixed steps of the run, so a resumed stage samples where the
+          // uninterrupted one does.
+          judged_(st_.kind == StageSpec::Kind::solve || st_.kind == StageSpec::Kind::cycle) {
+        r_.name = st_.name;
+        r_.kind = to_string(st_.kind);
+        r_.steps = cursor_.step;
         // A pressurise stage's ramp: the pressure at its step k (1 ... steps).
-        // (Plain variables, not a structured binding: lambdas capture them in C++20's clang 14.)
         const std::pair<double, double> before =
-            st.kind == StageSpec::Kind::pressurise ? opening_pressures_before(stages, index) : std::pair{0.0, 0.0};
-        const double pressure_before = before.first, excavation_pressure = before.second;
-        auto run = [&](long max_steps, bool solve) {
-            for (long k = cursor.step + 1; k <= max_steps; ++k) {
-                if (st.kind == StageSpec::Kind::pressurise)
-                    set_opening_pressure(w, pressure_before + (st.pressure - pressure_before) * double(k) / double(max_steps),
-                                         excavation_pressure, true);
-                s.step();
-                ++r.steps;
-                cursor.step = k;
-                if (judged && w.clock.steps % StageMonitor::sample_every == 0) sample_monitor(w.monitor, w);
-                obs.step_done(s, st, k);
-                obs.at(s, cursor);
-                if (obs.stop_requested() || (solve && solved(k))) return;
-            }
-        };
-        if (!resumed) {
-            if (judged) {
-                start_stage(w.monitor);
-                sample_monitor(w.monitor, w);
-            }
-            obs.stage_started(s, st);
-            switch (st.kind) {
-            case StageSpec::Kind::initialize: initialize_stress(w, st.stress); break;
-            case StageSpec::Kind::excavate:
-                excavate(w, st.regions, st.relax_steps, st.keep, st.pressure, support_path_of(stages, index));
-                break;
-            case StageSpec::Kind::elastic: r.method = solve_elastic(w).method; break;
-            case StageSpec::Kind::install: install_supports(w, st.supports); break;
-            case StageSpec::Kind::pressurise:
-                if (st.steps == 0) set_opening_pressure(w, st.pressure, excavation_pressure, true);
-                break;
-            case StageSpec::Kind::solve:
-            case StageSpec::Kind::cycle: break;
-            }
-            obs.at(s, cursor);
+            st_.kind == StageSpec::Kind::pressurise ? opening_pressures_before(stages, index) : std::pair{0.0, 0.0};
+        pressure_before_ = before.first, excavation_pressure_ = before.second;
+    }
+
+    /// The stage from its start, or from where it was resumed; its report.
+    StageReport run() {
+        if (!resumed_) start();
+        step_to_end();
+        r_.ratio = w_.clock.ratio;
+        r_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+        stopped_ = obs_.stop_requested();
+        if (judged_ && !stopped_) judge();
+        if (!stopped_) obs_.stage_done(s_, r_);
+        return r_;
+    }
+
+    /// Stopped by the observer before the stage's end.
+    bool stopped() const { return stopped_; }
+
+private:
+    /// What the stage does before its steps.
+    void start() {
+        if (judged_) {
+            start_stage(w_.monitor);
+            sample_monitor(w_.monitor, w_);
         }
-        switch (st.kind) {
-        case StageSpec::Kind::solve:
-            if (!(resumed && solved(cursor.step))) run(st.max_steps, true);
-            r.converged = w.clock.ratio <= st.ratio;
+        obs_.stage_started(s_, st_);
+        switch (st_.kind) {
+        case StageSpec::Kind::initialize: initialize_stress(w_, st_.stress); break;
+        case StageSpec::Kind::excavate:
+            excavate(w_, st_.regions, st_.relax_steps, st_.keep, st_.pressure, support_path_of(stages_, index_));
             break;
-        case StageSpec::Kind::excavate: run(st.steps, false); break;
-        case StageSpec::Kind::cycle: run(st.steps, false); break;
-        case StageSpec::Kind::pressurise: run(st.steps, false); break;
+        case StageSpec::Kind::elastic: r_.method = solve_elastic(w_).method; break;
+        case StageSpec::Kind::install: install_supports(w_, st_.supports); break;
+        case StageSpec::Kind::pressurise:
+            if (st_.steps == 0) set_opening_pressure(w_, st_.pressure, excavation_pressure_, true);
+            break;
+        case StageSpec::Kind::solve:
+        case StageSpec::Kind::cycle: break;
+        }
+        obs_.at(s_, cursor_);
+    }
+
+    /// The stage's steps: a solve stage's until solved, the others' all of them.
+    void step_to_end() {
+        switch (st_.kind) {
+        case StageSpec::Kind::solve:
+            if (!(resumed_ && solved(cursor_.step))) run_steps(st_.max_steps, true);
+            r_.converged = w_.clock.ratio <= st_.ratio;
+            break;
+        case StageSpec::Kind::excavate: run_steps(st_.steps, false); break;
+        case StageSpec::Kind::cycle: run_steps(st_.steps, false); break;
+        case StageSpec::Kind::pressurise: run_steps(st_.steps, false); break;
         case StageSpec::Kind::initialize:
         case StageSpec::Kind::install:
         case StageSpec::Kind::elastic: break;
         }
-        r.ratio = w.clock.ratio;
-        r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const bool stopped = obs.stop_requested();
-        if (judged && !stopped) {
-            const auto& samples = w.monitor.samples;
-            if (samples.empty() || samples.back().step != w.clock.steps) sample_monitor(w.monitor, w);
-            r.verdict = verdict(w.monitor, st.kind == StageSpec::Kind::solve ? st.ratio : StageSpec{}.ratio);
+    }
+
+    /// Where a solve stage ends (StageSpec::Until): its ratio reached (after a
+    /// few steps: at rest the ratio is 0 before anything moves), or, asked for,
+    /// the rock at rest, or only the verdict of equilibrium.
+    bool solved(long k) const {
+        using U = StageSpec::Until;
+        const bool sampled = w_.clock.steps % StageMonitor::sample_every == 0;
+        if (st_.until == U::equilibrium) {
+            if (!sampled) return false;
+            const auto kind = verdict(w_.monitor, st_.ratio).kind;
+            return kind == Verdict::Kind::equilibrium || kind == Verdict::Kind::equilibrium_with_fragments;
         }
-        if (!stopped) obs.stage_done(s, r);
-        reports.push_back(r);
+        if (k >= 10 && w_.clock.ratio <= st_.ratio) return true;
+        return st_.until == U::rest && sampled && at_rest(w_.monitor, st_.ratio, st_.quiet_steps);
+    }
+
+    /// Steps up to max_steps from the cursor, the observer told of each; stops
+    /// early when it asks, or (`solve`) once solved.
+    void run_steps(long max_steps, bool solve) {
+        for (long k = cursor_.step + 1; k <= max_steps; ++k) {
+            if (st_.kind == StageSpec::Kind::pressurise)
+                set_opening_pressure(w_, pressure_before_ + (st_.pressure - pressure_before_) * double(k) / double(max_steps),
+                                     excavation_pressure_, true);
+            s_.step();
+            ++r_.steps;
+            cursor_.step = k;
+            if (judged_ && w_.clock.steps % StageMonitor::sample_every == 0) sample_monitor(w_.monitor, w_);
+            obs_.step_done(s_, st_, k);
+            obs_.at(s_, cursor_);
+            if (obs_.stop_requested() || (solve && solved(k))) return;
+        }
+    }
+
+    /// The stage's verdict, from a last sample at its end.
+    void judge() {
+        const auto& samples = w_.monitor.samples;
+        if (samples.empty() || samples.back().step != w_.clock.steps) sample_monitor(w_.monitor, w_);
+        r_.verdict = verdict(w_.monitor, st_.kind == StageSpec::Kind::solve ? st_.ratio : StageSpec{}.ratio);
+    }
+
+    Solver& s_;
+    World& w_;
+    const std::vector<StageSpec>& stages_;
+    int index_;
+    const StageSpec& st_;
+    StageObserver& obs_;
+    bool resumed_;
+    std::chrono::steady_clock::time_point t0_;
+    StageCursor cursor_;
+    bool judged_;
+    double pressure_before_ = 0.0, excavation_pressure_ = 0.0;
+    StageReport r_;
+    bool stopped_ = false;
+};
+
+} // namespace
+
+std::vector<StageReport> run_stages(Solver& s, const std::vector<StageSpec>& stages, StageObserver& obs,
+                                    StageCursor start) {
+    std::vector<StageReport> reports;
+    for (int index = start.stage; index < int(stages.size()); ++index) {
+        StageRun stage(s, stages, index, obs, start);
+        reports.push_back(stage.run());
         // A stop asked for at the stage's end (by the observer) holds too.
-        if (stopped || obs.stop_requested()) break;
+        if (stage.stopped() || obs.stop_requested()) break;
     }
     return reports;
 }

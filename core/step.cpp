@@ -452,20 +452,44 @@ void bookkeeping_stage(World& w, const StepContext&, Range) {
 
 // The table. SPEC §5: 1 detection, 2 contact forces, 3 zone stresses, 4 loads
 // and the sums per body, 5 damping and integration, 6 the convergence measure.
-const std::array<Stage, 12> step_stages{{
-    {"vertices", "—", place_stage, Share::team, place_share, true},
-    {"detection", "1", detection_stage, Share::team},
-    {"flow", "—", flow_stage, Share::one_thread, nullptr, false, false, has_flow},
-    {"face slip", "2", face_slip_stage, Share::team, face_share, true, true, has_faces},
-    {"supports", "4", support_stage, Share::one_thread_nowait, nullptr, false, true, has_ties},
-    {"contacts", "2", contact_stage, Share::team, contact_share, false, true},
-    {"zones", "3", zone_stage, Share::team, zone_share, true, true},
-    {"gather blocks", "4", gather_block_stage, Share::team, gather_block_share, false, true},
-    {"gather nodes", "4", gather_node_stage, Share::team, node_share, true, true},
-    {"integrate", "5", integrate_stage, Share::team, chunk_share, true},
-    {"unbalanced", "6", ratio_stage, Share::one_thread},
-    {"bookkeeping", "—", bookkeeping_stage, Share::one_thread},
-}};
+namespace {
+const Stage stage_table[] = {
+    {"vertices", "—", "world vertices of every body from its position", place_stage, Share::team, place_share, true},
+    {"detection", "1", "new contacts, those that left their edges moved on or dropped, when due", detection_stage,
+     Share::team},
+    {"flow", "—", "water in the joints: apertures, pressures, each contact's fluid pressure (core/joint_flow.hpp)",
+     flow_stage, Share::one_thread, nullptr, false, false, has_flow},
+    {"face slip", "2", "the mean slip of rigid faces on the far field (face_shear)", face_slip_stage, Share::team,
+     face_share, true, true, has_faces},
+    {"supports", "4", "each support type's force pass and its ties' reactions", support_stage,
+     Share::one_thread_nowait, nullptr, false, true, has_ties},
+    {"contacts", "2", "the joint laws, one dispatch per batch of contacts sharing a law", contact_stage, Share::team,
+     contact_share, false, true},
+    {"zones", "3", "the constant-strain triangles' stresses and nodal forces", zone_stage, Share::team, zone_share,
+     true, true},
+    {"gather blocks", "4", "each block's force and moment over its contacts, ties and loads, in a fixed order",
+     gather_block_stage, Share::team, gather_block_share, false, true},
+    {"gather nodes", "4", "each FE node's force over its zones, contacts and ties, in a fixed order",
+     gather_node_stage, Share::team, node_share, true, true},
+    {"integrate", "5", "damping, central differences, prescribed velocities", integrate_stage, Share::team,
+     chunk_share, true},
+    {"unbalanced", "6", "the unbalanced-force ratio, the convergence measure", ratio_stage, Share::one_thread},
+    {"bookkeeping", "—", "the relaxation's release, time, the contact pass's thread balance", bookkeeping_stage,
+     Share::one_thread},
+};
+} // namespace
+
+const std::span<const Stage> step_stages{stage_table};
+
+std::string step_stages_markdown() {
+    std::string md = "| stage | SPEC §5 | threads | what it does |\n|---|---|---|---|\n";
+    for (const Stage& s : step_stages) {
+        const char* share = s.share == Share::team ? "team" : "one";
+        md += "| " + std::string(s.name) + " | " + std::string(s.spec) + " | " + share + " | " + std::string(s.does) +
+              (s.active ? " (only where the model has it)" : "") + " |\n";
+    }
+    return md;
+}
 
 namespace {
 

@@ -42,7 +42,10 @@
 #include <array>
 #include <cstddef>
 #include <exception>
+#include <span>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace bbm {
 
@@ -68,6 +71,7 @@ enum class Share : std::uint8_t {
 struct Stage {
     std::string_view name;
     std::string_view spec; ///< its item of SPEC §5's list
+    std::string_view does; ///< what it does, for docs/architecture.md's list
     void (*run)(World&, const StepContext&, Range);
     Share share = Share::team;
     /// The thread's share (team rows); null: the whole of nothing ({0, 0}).
@@ -81,8 +85,12 @@ struct Stage {
     bool (*active)(const World&) = nullptr;
 };
 
-/// The stages of a step, in order (core/step.cpp).
-extern const std::array<Stage, 12> step_stages;
+/// The stages of a step, in order (core/step.cpp): a new stage is one row there.
+extern const std::span<const Stage> step_stages;
+
+/// docs/architecture.md's list of the stages: a Markdown table of the rows
+/// (tests/test_reference.cpp fails when the page's copy is stale).
+std::string step_stages_markdown();
 
 /// Wall time per row of the table (`bbm run --profile`): measured on the team's
 /// first thread between rows, so a row's time includes its wait at the barrier
@@ -90,7 +98,7 @@ extern const std::array<Stage, 12> step_stages;
 struct StepProfile {
     bool enabled = false;
     long steps = 0;
-    std::array<double, step_stages.size()> seconds{};
+    std::vector<double> seconds = std::vector<double>(step_stages.size(), 0.0);
     double last = 0.0;
 };
 

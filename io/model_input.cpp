@@ -60,6 +60,73 @@ void check_arc(const Ctx& c, const toml::node& n, const Path& p, Vec2 from,
                    " m from it; the two must agree within 1e-6 relative");
 }
 
+void read_rectangle_outline(const Ctx& c, const toml::table& t, const Path& p, OutlineSpec& o) {
+    o.min = required_point(c, t, p, "min");
+    o.max = required_point(c, t, p, "max");
+    if (!(o.max.x > o.min.x && o.max.y > o.min.y))
+        c.fail(*t.get("max"), p.key("max"),
+               "must exceed min = " + fmt(o.min) + " in both x and y, got " + fmt(o.max));
+}
+
+void read_polygon_outline(const Ctx& c, const toml::table& t, const Path& p, OutlineSpec& o) {
+    const Path pp = p.key("points");
+    const toml::array& pts =
+        to_array(c, need(c, t, p, "points", "an array of points [[x, y], ...]"), pp,
+                 "an array of points [[x, y], ...]");
+    if (pts.size() < 3)
+        c.fail(pts, pp, "a polygon needs at least 3 points, got " + std::to_string(pts.size()));
+    for_each_element(c, pts, pp, [&](const toml::node& n, const Path& ep) {
+        o.points.push_back(to_position(c, n, ep));
+    });
+}
+
+/// One step of a path outline, from the point `from`: straight, or an arc (with a center).
+OutlineSpec::Step read_path_step(const Ctx& c, const toml::node& n, const Path& ep, Vec2 from) {
+    const toml::table& st =
+        to_table(c, n, ep, "a step { to = [x, y] } or { to = [x, y], center = [x, y] }");
+    static constexpr std::array<std::string_view, 3> step_keys{"to", "center", "clockwise"};
+    check_keys(c, st, ep, step_keys);
+    OutlineSpec::Step s;
+    s.to = required_point(c, st, ep, "to");
+    const auto center = point(c, st, ep, "center");
+    const auto clockwise = boolean(c, st, ep, "clockwise");
+    if (clockwise && !center)
+        c.fail(*st.get("clockwise"), ep.key("clockwise"),
+               "applies only to an arc step (one with a center); this step is straight");
+    if (center) {
+        s.arc = true;
+        s.center = *center;
+        s.clockwise = clockwise.value_or(false);
+        check_arc(c, n, ep, from, s);
+    }
+    return s;
+}
+
+void read_path_outline(const Ctx& c, const toml::table& t, const Path& p, OutlineSpec& o) {
+    o.start = required_point(c, t, p, "start");
+    const Path sp = p.key("steps");
+    const std::string expected = "an array of steps [{ to = [x, y] }, ...]";
+    const toml::array& steps = to_array(c, need(c, t, p, "steps", expected), sp, expected);
+    if (steps.empty()) c.fail(steps, sp, "a path needs at least one step, got none");
+    Vec2 from = o.start;
+    for_each_element(c, steps, sp, [&](const toml::node& n, const Path& ep) {
+        o.steps.push_back(read_path_step(c, n, ep, from));
+        from = o.steps.back().to;
+    });
+}
+
+void read_opening_outline(const Ctx& c, const toml::table& t, const Path& p, OutlineSpec& o) {
+    const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(meshing::outline_keys, key); };
+    o.center = required_point(c, t, p, "center");
+    o.width = required_number(c, t, p, "width", bounds("width"));
+    o.floor_y = required_number(c, t, p, "floor", bounds("floor"));
+    if (!(o.floor_y < o.center.y))
+        c.fail(*t.get("floor"), p.key("floor"),
+               "must be below the springline center.y = " + fmt(o.center.y) + " m, got " +
+                   fmt(o.floor_y));
+    o.half = boolean(c, t, p, "half").value_or(false);
+}
+
 OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
     const toml::table& t = to_table(c, node, p, "an outline table { type = ..., ... }");
     static constexpr auto all_keys = key_names(meshing::outline_keys);
@@ -70,71 +137,14 @@ OutlineSpec read_outline(const Ctx& c, const toml::node& node, const Path& p) {
     const auto bounds = [](std::string_view key) -> const Bounds& { return bounds_of(meshing::outline_keys, key); };
 
     switch (o.kind) {
-    case OutlineSpec::Kind::rectangle: {
-        o.min = required_point(c, t, p, "min");
-        o.max = required_point(c, t, p, "max");
-        if (!(o.max.x > o.min.x && o.max.y > o.min.y))
-            c.fail(*t.get("max"), p.key("max"),
-                   "must exceed min = " + fmt(o.min) + " in both x and y, got " + fmt(o.max));
-        break;
-    }
-    case OutlineSpec::Kind::polygon: {
-        const Path pp = p.key("points");
-        const toml::array& pts =
-            to_array(c, need(c, t, p, "points", "an array of points [[x, y], ...]"), pp,
-                     "an array of points [[x, y], ...]");
-        if (pts.size() < 3)
-            c.fail(pts, pp, "a polygon needs at least 3 points, got " + std::to_string(pts.size()));
-        for_each_element(c, pts, pp, [&](const toml::node& n, const Path& ep) {
-            o.points.push_back(to_vec2(c, n, ep));
-        });
-        break;
-    }
+    case OutlineSpec::Kind::rectangle: read_rectangle_outline(c, t, p, o); break;
+    case OutlineSpec::Kind::polygon: read_polygon_outline(c, t, p, o); break;
     case OutlineSpec::Kind::circle:
         o.center = required_point(c, t, p, "center");
         o.radius = required_number(c, t, p, "radius", bounds("radius"));
         break;
-    case OutlineSpec::Kind::path: {
-        o.start = required_point(c, t, p, "start");
-        const Path sp = p.key("steps");
-        const std::string expected = "an array of steps [{ to = [x, y] }, ...]";
-        const toml::array& steps = to_array(c, need(c, t, p, "steps", expected), sp, expected);
-        if (steps.empty()) c.fail(steps, sp, "a path needs at least one step, got none");
-        Vec2 from = o.start;
-        for_each_element(c, steps, sp, [&](const toml::node& n, const Path& ep) {
-            const toml::table& st =
-                to_table(c, n, ep, "a step { to = [x, y] } or { to = [x, y], center = [x, y] }");
-            static constexpr std::array<std::string_view, 3> step_keys{"to", "center", "clockwise"};
-            check_keys(c, st, ep, step_keys);
-            OutlineSpec::Step s;
-            s.to = required_point(c, st, ep, "to");
-            const auto center = point(c, st, ep, "center");
-            const auto clockwise = boolean(c, st, ep, "clockwise");
-            if (clockwise && !center)
-                c.fail(*st.get("clockwise"), ep.key("clockwise"),
-                       "applies only to an arc step (one with a center); this step is straight");
-            if (center) {
-                s.arc = true;
-                s.center = *center;
-                s.clockwise = clockwise.value_or(false);
-                check_arc(c, n, ep, from, s);
-            }
-            o.steps.push_back(s);
-            from = s.to;
-        });
-        break;
-    }
-    case OutlineSpec::Kind::opening: {
-        o.center = required_point(c, t, p, "center");
-        o.width = required_number(c, t, p, "width", bounds("width"));
-        o.floor_y = required_number(c, t, p, "floor", bounds("floor"));
-        if (!(o.floor_y < o.center.y))
-            c.fail(*t.get("floor"), p.key("floor"),
-                   "must be below the springline center.y = " + fmt(o.center.y) + " m, got " +
-                       fmt(o.floor_y));
-        o.half = boolean(c, t, p, "half").value_or(false);
-        break;
-    }
+    case OutlineSpec::Kind::path: read_path_outline(c, t, p, o); break;
+    case OutlineSpec::Kind::opening: read_opening_outline(c, t, p, o); break;
     }
     if (key_applies(*find_key(meshing::outline_keys, "max_segment"),
                     key_words(meshing::outline_type_words)[static_cast<std::size_t>(o.kind)]))
@@ -308,10 +318,18 @@ void check_names(const Ctx& c, const ModelFile& mf) {
 
 // --- the analysis tables -----------------------------------------------------------
 
-
-// In the order of the enums of core/model_spec.hpp and meshing::JointTag.
-
-
+/// A length of [solver] that is a fraction of a block (the corners' rounding, the
+/// detection's reach): one of `most` of the smallest block size or more is no
+/// longer a corner's or a gap's (a length in another unit?), refused.
+void check_within_block(const Ctx& c, const toml::table& t, const Path& p, std::string_view key, double v,
+                        double most, std::string_view what) {
+    const double d = c.scale ? c.scale->block_size : 0.0;
+    if (d > 0.0 && v >= most * d)
+        c.fail(*t.get(key), p.key(key),
+               shortest_text(v) + " m is not below " + shortest_text(most) + " of the model's smallest block size (" +
+                   shortest_text(d) + " m), so it is no longer " + std::string(what) +
+                   ": a length in another unit? Give it in metres");
+}
 
 SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
                        const Names& properties) {
@@ -321,10 +339,12 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
     SolverSpec s;
     for (const SolverKey& k : solver_keys)
         if (k.set) read_declared_key(c, t, p, k, s);
+    check_within_block(c, t, p, "corner_radius", s.corner_radius, 0.5, "a corner's rounding");
+    check_within_block(c, t, p, "detection_tolerance", s.detection_tolerance, 1.0, "the reach of a contact's gap");
     if (t.contains("mode"))
         s.mode = static_cast<SolverSpec::Mode>(
             choice(c, t, p, "mode", key_words(find_key(solver_keys, "mode")->words), "solver mode"));
-    s.gravity = point(c, t, p, "gravity").value_or(s.gravity);
+    s.gravity = vector(c, t, p, "gravity").value_or(s.gravity);
     if (t.contains("new_contact_length"))
         s.new_contact_length = static_cast<SolverSpec::NewContactLength>(choice(
             c, t, p, "new_contact_length", key_words(find_key(solver_keys, "new_contact_length")->words),
@@ -485,7 +505,7 @@ BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& n
 
 /// A deformable region (one with a mesh) needs the elasticity of its material. A region
 /// takes the material it names; if no region names one, every region takes the first
-/// [[material]] (as core/solver.cpp resolves them); otherwise it has none (rigid).
+/// [[material]] (as core/build_world.cpp resolves them); otherwise it has none (rigid).
 void check_deformable_materials(const Ctx& c, const ModelFile& mf) {
     const AnalysisSpec& an = mf.analysis;
     const auto& rs = mf.geometry.regions;
@@ -580,15 +600,10 @@ ModelScale model_scale(const meshing::ModelGeometrySpec& g) {
     return scale;
 }
 
-/// The analysis tables, after the regions (whose names they refer to) are read.
-/// `region_material` is the `material` key of each region, if given.
-void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
-                   const std::vector<std::optional<std::string>>& region_material) {
+/// The [[material]] tables, and the regions' `material` keys that name them.
+void read_materials(Ctx& c, const toml::table& doc, ModelFile& mf, const Names& regions,
+                    const std::vector<std::optional<std::string>>& region_material) {
     AnalysisSpec& an = mf.analysis;
-    Names regions{"region", "regions", "region", {}, mf.source.region_line};
-    for (const RegionSpec& r : mf.geometry.regions)
-        regions.names.push_back(r.name);
-
     Names materials{"material", "materials", "material", {}, {}};
     read_tables(c, doc, "material", [&](const toml::table& t, const Path& p, std::size_t) {
         an.materials.push_back(read_material(c, t, p, materials));
@@ -600,7 +615,12 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
         an.region_material.emplace_back(regions.names[i], *region_material[i]);
     }
     check_deformable_materials(c, mf);
+}
 
+/// The [[joint_property]] and [[joint_assignment]] tables, and the regions'
+/// fracture sets' `property` keys that name them; the properties' names.
+Names read_joint_properties(Ctx& c, const toml::table& doc, ModelFile& mf, const Names& regions) {
+    AnalysisSpec& an = mf.analysis;
     Names properties{"joint property", "joint properties", "joint_property", {}, {}};
     read_tables(c, doc, "joint_property", [&](const toml::table& t, const Path& p, std::size_t) {
         an.joint_properties.push_back(read_joint_property(c, t, p, properties));
@@ -615,6 +635,40 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
                 check_ref(c, mf.source.key_line[i].at(rel), Path{"region[" + std::to_string(i) + "]." + rel, ""}, name,
                           properties);
             }
+    return properties;
+}
+
+/// What needs water in the joints: an inflow history needs a [flow] table, and
+/// transient flow a dynamic solver.
+void check_flow_needs(const Ctx& c, const ModelFile& mf) {
+    const AnalysisSpec& an = mf.analysis;
+    for (std::size_t i = 0; i < an.histories.size(); ++i)
+        if (an.histories[i].quantity == HistorySpec::Quantity::inflow && !an.flow.on) {
+            const Path hp = Path{}.key("history").at(i).key("quantity");
+            c.fail(mf.source.line_of(hp.full), hp, "an inflow history needs a [flow] table (water in the joints)");
+        }
+    if (an.flow.on && an.flow.mode == FlowSpec::Mode::transient && an.solver.mode != SolverSpec::Mode::dynamic) {
+        const Path mp = Path{}.key("flow").key("mode");
+        c.fail(mf.source.line_of(mp.full), mp,
+               "transient flow needs [solver] mode = \"dynamic\": a quasi-static run's time is not real time "
+               "(use mode = \"steady\": drained)");
+    }
+}
+
+/// The analysis tables, after the regions (whose names they refer to) are read.
+/// `region_material` is the `material` key of each region, if given.
+void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
+                   const std::vector<std::optional<std::string>>& region_material) {
+    AnalysisSpec& an = mf.analysis;
+    Names regions{"region", "regions", "region", {}, mf.source.region_line};
+    for (const RegionSpec& r : mf.geometry.regions)
+        regions.names.push_back(r.name);
+    // Every point and box from here on is checked against the regions' extent.
+    const ModelScale scale = model_scale(mf.geometry);
+    c.scale = &scale;
+
+    read_materials(c, doc, mf, regions, region_material);
+    Names properties = read_joint_properties(c, doc, mf, regions);
     Names boundaries{"boundary", "boundaries", "boundary", {}, {}};
     read_tables(c, doc, "boundary", [&](const toml::table& t, const Path& p, std::size_t) {
         an.boundaries.push_back(read_boundary(c, t, p, boundaries, regions));
@@ -631,21 +685,12 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     for (const std::string_view t : support_tables())
         support_tables_text += (support_tables_text.empty() ? "" : "]], [[") + std::string(t);
     Names supports{"support", "supports", support_tables_text, {}, {}};
-    read_supports(c, doc, an.supports, supports, model_scale(mf.geometry));
+    read_supports(c, doc, an.supports, supports, scale);
     read_flow(c, doc, an.flow, regions);
-    for (std::size_t i = 0; i < an.histories.size(); ++i)
-        if (an.histories[i].quantity == HistorySpec::Quantity::inflow && !an.flow.on) {
-            const Path hp = Path{}.key("history").at(i).key("quantity");
-            c.fail(mf.source.line_of(hp.full), hp, "an inflow history needs a [flow] table (water in the joints)");
-        }
-    if (an.flow.on && an.flow.mode == FlowSpec::Mode::transient && an.solver.mode != SolverSpec::Mode::dynamic) {
-        const Path mp = Path{}.key("flow").key("mode");
-        c.fail(mf.source.line_of(mp.full), mp,
-               "transient flow needs [solver] mode = \"dynamic\": a quasi-static run's time is not real time "
-               "(use mode = \"steady\": drained)");
-    }
+    check_flow_needs(c, mf);
     read_stages(c, doc, an.stages, regions, supports);
     read_report(c, doc, an.report);
+    c.scale = nullptr;
 }
 
 } // namespace
@@ -930,83 +975,99 @@ toml::node_view<toml::node> parse_value(const std::string& text, toml::table& ho
     return holder["v"];
 }
 
+/// Sets `key` (a dotted key, [i] after an array; its tables and arrays must
+/// exist) of `doc` to `value` read as TOML.
+void set_model_key(toml::table& doc, const std::string& name, const std::string& key, const std::string& value) {
+    const auto steps = split_key(key, "--set");
+    toml::table* table = &doc;
+    std::string walked;
+    for (std::size_t k = 0; k + 1 <= steps.size(); ++k) {
+        const auto& s = steps[k];
+        if (!walked.empty()) walked += '.';
+        walked += s.name;
+        const bool last = k + 1 == steps.size();
+        if (last && s.index < 0) {
+            toml::table holder;
+            auto v = parse_value(value, holder);
+            table->insert_or_assign(s.name, *v.node());
+            break;
+        }
+        toml::node* node = table->get(s.name);
+        if (!node)
+            throw InputError("--set", 0, key, "the model " + name + " has no '" + walked + "' (" +
+                             (k == 0 ? "a top-level table" : "a key") + " must exist to be set inside)");
+        if (s.index >= 0) {
+            auto* array = node->as_array();
+            if (!array) throw InputError("--set", 0, key, "'" + walked + "' is not an array");
+            if (std::size_t(s.index) >= array->size())
+                throw InputError("--set", 0, key,
+                                 "'" + walked + "' has " + std::to_string(array->size()) + " entries (index from 0)");
+            walked += '[';
+            walked += std::to_string(s.index);
+            walked += ']';
+            if (last) {
+                toml::table holder;
+                auto v = parse_value(value, holder);
+                array->replace(array->begin() + s.index, *v.node());
+                break;
+            }
+            node = array->get(std::size_t(s.index));
+        }
+        table = node->as_table();
+        if (!table) throw InputError("--set", 0, key, "'" + walked + "' is not a table");
+    }
+}
+
+/// Random patterns (voronoi, trigon, delaunay) of every region draw from seed + offset.
+void offset_pattern_seeds(toml::table& doc, long seed_offset) {
+    if (auto* regions = doc["region"].as_array())
+        for (auto& r : *regions) {
+            auto* pattern = r.as_table() ? (*r.as_table())["pattern"].as_table() : nullptr;
+            if (!pattern) continue;
+            const auto type = (*pattern)["type"].value_or(std::string{});
+            if (type != "voronoi" && type != "trigon" && type != "delaunay") continue;
+            const auto seed = (*pattern)["seed"].value_or(std::int64_t{1});
+            pattern->insert_or_assign("seed", seed + seed_offset);
+        }
+}
+
+/// Generated fracture sets (region.dfn, not those read from a file) too: a seed
+/// study of a jointed rock mass is over networks as well as patterns.
+void offset_dfn_seeds(toml::table& doc, long seed_offset) {
+    if (auto* regions = doc["region"].as_array())
+        for (auto& r : *regions) {
+            auto* sets = r.as_table() ? (*r.as_table())["dfn"].as_array() : nullptr;
+            if (!sets) continue;
+            for (auto& d : *sets) {
+                auto* t = d.as_table();
+                if (!t || (*t)["file"]) continue;
+                const auto seed = (*t)["seed"].value_or(std::int64_t{1});
+                t->insert_or_assign("seed", seed + seed_offset);
+            }
+        }
+}
+
+/// Heterogeneous joint strengths draw from strength_seed + offset.
+void offset_strength_seeds(toml::table& doc, long seed_offset) {
+    if (auto* properties = doc["joint_property"].as_array())
+        for (auto& j : *properties) {
+            auto* t = j.as_table();
+            if (!t || !(*t)["weibull_modulus"]) continue;
+            const auto seed = (*t)["strength_seed"].value_or(std::int64_t{1});
+            t->insert_or_assign("strength_seed", seed + seed_offset);
+        }
+}
+
 } // namespace
 
 std::string edit_model_text(std::string_view text, const std::string& name,
                             const std::vector<std::pair<std::string, std::string>>& set, long seed_offset) {
     toml::table doc = parse_toml(text, name);
-    for (const auto& [key, value] : set) {
-        const auto steps = split_key(key, "--set");
-        toml::table* table = &doc;
-        std::string walked;
-        for (std::size_t k = 0; k + 1 <= steps.size(); ++k) {
-            const auto& s = steps[k];
-            if (!walked.empty()) walked += '.';
-            walked += s.name;
-            const bool last = k + 1 == steps.size();
-            if (last && s.index < 0) {
-                toml::table holder;
-                auto v = parse_value(value, holder);
-                table->insert_or_assign(s.name, *v.node());
-                break;
-            }
-            toml::node* node = table->get(s.name);
-            if (!node)
-                throw InputError("--set", 0, key, "the model " + name + " has no '" + walked + "' (" +
-                                 (k == 0 ? "a top-level table" : "a key") + " must exist to be set inside)");
-            if (s.index >= 0) {
-                auto* array = node->as_array();
-                if (!array) throw InputError("--set", 0, key, "'" + walked + "' is not an array");
-                if (std::size_t(s.index) >= array->size())
-                    throw InputError("--set", 0, key,
-                                     "'" + walked + "' has " + std::to_string(array->size()) + " entries (index from 0)");
-                walked += '[';
-                walked += std::to_string(s.index);
-                walked += ']';
-                if (last) {
-                    toml::table holder;
-                    auto v = parse_value(value, holder);
-                    array->replace(array->begin() + s.index, *v.node());
-                    break;
-                }
-                node = array->get(std::size_t(s.index));
-            }
-            table = node->as_table();
-            if (!table) throw InputError("--set", 0, key, "'" + walked + "' is not a table");
-        }
-    }
+    for (const auto& [key, value] : set) set_model_key(doc, name, key, value);
     if (seed_offset != 0) {
-        // Random patterns (voronoi, trigon, delaunay) of every region draw from seed + offset.
-        if (auto* regions = doc["region"].as_array())
-            for (auto& r : *regions) {
-                auto* pattern = r.as_table() ? (*r.as_table())["pattern"].as_table() : nullptr;
-                if (!pattern) continue;
-                const auto type = (*pattern)["type"].value_or(std::string{});
-                if (type != "voronoi" && type != "trigon" && type != "delaunay") continue;
-                const auto seed = (*pattern)["seed"].value_or(std::int64_t{1});
-                pattern->insert_or_assign("seed", seed + seed_offset);
-            }
-        // Generated fracture sets (region.dfn, not those read from a file) too: a seed
-        // study of a jointed rock mass is over networks as well as patterns.
-        if (auto* regions = doc["region"].as_array())
-            for (auto& r : *regions) {
-                auto* sets = r.as_table() ? (*r.as_table())["dfn"].as_array() : nullptr;
-                if (!sets) continue;
-                for (auto& d : *sets) {
-                    auto* t = d.as_table();
-                    if (!t || (*t)["file"]) continue;
-                    const auto seed = (*t)["seed"].value_or(std::int64_t{1});
-                    t->insert_or_assign("seed", seed + seed_offset);
-                }
-            }
-        // Heterogeneous joint strengths draw from strength_seed + offset.
-        if (auto* properties = doc["joint_property"].as_array())
-            for (auto& j : *properties) {
-                auto* t = j.as_table();
-                if (!t || !(*t)["weibull_modulus"]) continue;
-                const auto seed = (*t)["strength_seed"].value_or(std::int64_t{1});
-                t->insert_or_assign("strength_seed", seed + seed_offset);
-            }
+        offset_pattern_seeds(doc, seed_offset);
+        offset_dfn_seeds(doc, seed_offset);
+        offset_strength_seeds(doc, seed_offset);
     }
     std::ostringstream out;
     out << "# " << name << (set.empty() && seed_offset == 0 ? "" : ", edited by bbm sweep") << "\n"

@@ -386,6 +386,124 @@ void draw_outline(cairo_t* cr, const std::vector<Vec2>& outline, double px) {
     cairo_set_dash(cr, nullptr, 0, 0.0);
 }
 
+/// The plot area of draw_curves() and where a value lands on it: the data's
+/// range (log10 of y on a log axis), pixels from the data.
+struct CurveFrame {
+    static constexpr int w = 900, h = 600;
+    static constexpr double left = 100, right = 30, top = 50, bottom = 70;
+    bool log_y = false;
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+
+    double ty(double y) const { return log_y ? std::log10(std::max(y, 1e-300)) : y; }
+    double px(double x) const { return left + (x - x0) / (x1 - x0) * (w - left - right); }
+    double py(double y) const { return h - bottom - (ty(y) - y0) / (y1 - y0) * (h - top - bottom); }
+    double py_raw(double yt) const { return h - bottom - (yt - y0) / (y1 - y0) * (h - top - bottom); }
+};
+
+/// The range of every series' points (on a log axis, the positive ones).
+CurveFrame curve_frame(const std::vector<Series>& series, bool log_y) {
+    CurveFrame f;
+    f.log_y = log_y;
+    for (const auto& s : series)
+        for (std::size_t i = 0; i < s.x.size(); ++i) {
+            if (log_y && !(s.y[i] > 0)) continue;
+            f.x0 = std::min(f.x0, s.x[i]), f.x1 = std::max(f.x1, s.x[i]);
+            f.y0 = std::min(f.y0, f.ty(s.y[i])), f.y1 = std::max(f.y1, f.ty(s.y[i]));
+        }
+    // Nothing to draw (a run stopped at its first record: one ratio of 0, which a
+    // log axis leaves out) gives empty unit axes; infinite bounds made the tick
+    // loops of draw_axes() endless (a run stopped by a signal hung drawing history.png).
+    if (!std::isfinite(f.x0) || !std::isfinite(f.x1)) f.x0 = 0, f.x1 = 1;
+    if (!std::isfinite(f.y0) || !std::isfinite(f.y1)) f.y0 = 0, f.y1 = 1;
+    if (!(f.x1 > f.x0)) f.x1 = f.x0 + 1;
+    if (!(f.y1 > f.y0)) f.y1 = f.y0 + 1;
+    if (!log_y) f.y0 = std::min(f.y0, 0.0);
+    return f;
+}
+
+/// Ticks at 1, 2 or 5 times a power of ten, about five per axis.
+double nice_step(double range) {
+    const double raw = range / 5.0, p = std::pow(10.0, std::floor(std::log10(raw)));
+    const double f = raw / p;
+    return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
+}
+
+/// The plot's box, its ticks and their values, the axes' labels and the title.
+void draw_axes(cairo_t* cr, const CurveFrame& f, const std::string& x_label, const std::string& y_label,
+               const std::string& title) {
+    constexpr int w = CurveFrame::w, h = CurveFrame::h;
+    constexpr double left = CurveFrame::left, right = CurveFrame::right, top = CurveFrame::top,
+                     bottom = CurveFrame::bottom;
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 1);
+    cairo_rectangle(cr, left, top, w - left - right, h - top - bottom);
+    cairo_stroke(cr);
+    char buf[64];
+    const double xs = nice_step(f.x1 - f.x0), ys = f.log_y ? 1.0 : nice_step(f.y1 - f.y0);
+    // At most a few dozen ticks whatever the values (a huge range over a tiny step
+    // would not advance xv).
+    int ticks = 0;
+    for (double xv = std::ceil(f.x0 / xs) * xs; xv <= f.x1 + 1e-9 * xs && ticks < 50; xv += xs, ++ticks) {
+        cairo_move_to(cr, f.px(xv), h - bottom), cairo_line_to(cr, f.px(xv), h - bottom + 5), cairo_stroke(cr);
+        std::snprintf(buf, sizeof buf, "%g", std::abs(xv) < 1e-12 * xs ? 0.0 : xv);
+        text(cr, f.px(xv), h - bottom + 20, buf, 12, true);
+    }
+    ticks = 0;
+    for (double yv = std::ceil(f.y0 / ys) * ys; yv <= f.y1 + 1e-9 * ys && ticks < 50; yv += ys, ++ticks) {
+        cairo_move_to(cr, left - 5, f.py_raw(yv)), cairo_line_to(cr, left, f.py_raw(yv)), cairo_stroke(cr);
+        std::snprintf(buf, sizeof buf, f.log_y ? "1e%g" : "%g", std::abs(yv) < 1e-12 * ys ? 0.0 : yv);
+        cairo_text_extents_t e;
+        cairo_set_font_size(cr, 12);
+        cairo_text_extents(cr, buf, &e);
+        text(cr, left - 9 - e.width, f.py_raw(yv) + 4, buf, 12);
+    }
+    text(cr, 0.5 * (left + w - right), h - 20, x_label, 14, true);
+    cairo_save(cr);
+    cairo_translate(cr, 18, 0.5 * (top + h - bottom));
+    cairo_rotate(cr, -M_PI / 2);
+    text(cr, 0, 0, y_label, 14, true);
+    cairo_restore(cr);
+    if (!title.empty()) text(cr, 0.5 * w, 30, title, 16, true);
+}
+
+void curve_marker(cairo_t* cr, double x, double y) {
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, x, y, 3.5, 0, 2 * M_PI);
+}
+
+/// One series in its colour: a line (broken where a log axis leaves a point
+/// out) or dots.
+void draw_series(cairo_t* cr, const CurveFrame& f, const Series& s, Rgb col) {
+    const bool points = s.style == Series::Style::points;
+    cairo_set_source_rgb(cr, col.r, col.g, col.b);
+    cairo_set_line_width(cr, 1.8);
+    bool pen = false;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+        if (f.log_y && !(s.y[i] > 0)) { pen = false; continue; }
+        if (points) curve_marker(cr, f.px(s.x[i]), f.py(s.y[i]));
+        else if (pen) cairo_line_to(cr, f.px(s.x[i]), f.py(s.y[i]));
+        else cairo_move_to(cr, f.px(s.x[i]), f.py(s.y[i]));
+        pen = true;
+    }
+    if (points) cairo_fill(cr);
+    else cairo_stroke(cr);
+}
+
+/// The legend's line `k` for series `s`, drawn in its colour (set by draw_series()).
+void draw_legend_entry(cairo_t* cr, const Series& s, std::size_t k, bool legend_left) {
+    const double ly = CurveFrame::top + 20 + 18 * k,
+                 lx = legend_left ? CurveFrame::left + 215 : CurveFrame::w - CurveFrame::right;
+    if (s.style == Series::Style::points) {
+        curve_marker(cr, lx - 187.5, ly);
+        cairo_fill(cr);
+    } else {
+        cairo_move_to(cr, lx - 200, ly), cairo_line_to(cr, lx - 175, ly);
+        cairo_stroke(cr);
+    }
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    text(cr, lx - 168, ly + 5, s.label, 12);
+}
+
 } // namespace
 
 void draw_failure(const World& w, const std::filesystem::path& file, const FailurePlotOptions& o) {
@@ -424,100 +542,15 @@ void draw_failure(const World& w, const std::filesystem::path& file, const Failu
 
 void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
                  const std::filesystem::path& file, const std::string& title, bool log_y, bool legend_left) {
-    const int w = 900, h = 600;
-    const double left = 100, right = 30, top = 50, bottom = 70;
-    Canvas canvas(file, w, h);
+    Canvas canvas(file, CurveFrame::w, CurveFrame::h);
     cairo_t* cr = canvas.cr;
-    auto ty = [&](double y) { return log_y ? std::log10(std::max(y, 1e-300)) : y; };
-    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-    for (const auto& s : series)
-        for (std::size_t i = 0; i < s.x.size(); ++i) {
-            if (log_y && !(s.y[i] > 0)) continue;
-            x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
-            y0 = std::min(y0, ty(s.y[i])), y1 = std::max(y1, ty(s.y[i]));
-        }
-    // Nothing to draw (a run stopped at its first record: one ratio of 0, which a
-    // log axis leaves out) gives empty unit axes; infinite bounds made the tick
-    // loop below endless (a run stopped by a signal hung drawing history.png).
-    if (!std::isfinite(x0) || !std::isfinite(x1)) x0 = 0, x1 = 1;
-    if (!std::isfinite(y0) || !std::isfinite(y1)) y0 = 0, y1 = 1;
-    if (!(x1 > x0)) x1 = x0 + 1;
-    if (!(y1 > y0)) y1 = y0 + 1;
-    if (!log_y) y0 = std::min(y0, 0.0);
-    auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * (w - left - right); };
-    auto py = [&](double y) { return h - bottom - (ty(y) - y0) / (y1 - y0) * (h - top - bottom); };
-    auto py_raw = [&](double yt) { return h - bottom - (yt - y0) / (y1 - y0) * (h - top - bottom); };
-    // Axes, ticks and labels.
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    cairo_set_line_width(cr, 1);
-    cairo_rectangle(cr, left, top, w - left - right, h - top - bottom);
-    cairo_stroke(cr);
-    char buf[64];
-    // Ticks at 1, 2 or 5 times a power of ten, about five per axis.
-    auto nice_step = [](double range) {
-        const double raw = range / 5.0, p = std::pow(10.0, std::floor(std::log10(raw)));
-        const double f = raw / p;
-        return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
-    };
-    const double xs = nice_step(x1 - x0), ys = log_y ? 1.0 : nice_step(y1 - y0);
-    // At most a few dozen ticks whatever the values (a huge range over a tiny step
-    // would not advance xv).
-    int ticks = 0;
-    for (double xv = std::ceil(x0 / xs) * xs; xv <= x1 + 1e-9 * xs && ticks < 50; xv += xs, ++ticks) {
-        cairo_move_to(cr, px(xv), h - bottom), cairo_line_to(cr, px(xv), h - bottom + 5), cairo_stroke(cr);
-        std::snprintf(buf, sizeof buf, "%g", std::abs(xv) < 1e-12 * xs ? 0.0 : xv);
-        text(cr, px(xv), h - bottom + 20, buf, 12, true);
-    }
-    ticks = 0;
-    for (double yv = std::ceil(y0 / ys) * ys; yv <= y1 + 1e-9 * ys && ticks < 50; yv += ys, ++ticks) {
-        cairo_move_to(cr, left - 5, py_raw(yv)), cairo_line_to(cr, left, py_raw(yv)), cairo_stroke(cr);
-        std::snprintf(buf, sizeof buf, log_y ? "1e%g" : "%g", std::abs(yv) < 1e-12 * ys ? 0.0 : yv);
-        cairo_text_extents_t e;
-        cairo_set_font_size(cr, 12);
-        cairo_text_extents(cr, buf, &e);
-        text(cr, left - 9 - e.width, py_raw(yv) + 4, buf, 12);
-    }
-    text(cr, 0.5 * (left + w - right), h - 20, x_label, 14, true);
-    cairo_save(cr);
-    cairo_translate(cr, 18, 0.5 * (top + h - bottom));
-    cairo_rotate(cr, -M_PI / 2);
-    text(cr, 0, 0, y_label, 14, true);
-    cairo_restore(cr);
-    if (!title.empty()) text(cr, 0.5 * w, 30, title, 16, true);
+    const CurveFrame frame = curve_frame(series, log_y);
+    draw_axes(cr, frame, x_label, y_label, title);
     constexpr std::array<Rgb, 6> colours{
         {{0.1, 0.2, 0.7}, {0.8, 0.1, 0.1}, {0.1, 0.55, 0.2}, {0.5, 0.3, 0.6}, {0.9, 0.55, 0.0}, {0.3, 0.3, 0.3}}};
-    auto marker = [&](double x, double y) {
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x, y, 3.5, 0, 2 * M_PI);
-    };
     for (std::size_t k = 0; k < series.size(); ++k) {
-        const auto& s = series[k];
-        const Rgb col = colours[k % colours.size()];
-        const bool points = s.style == Series::Style::points;
-        cairo_set_source_rgb(cr, col.r, col.g, col.b);
-        cairo_set_line_width(cr, 1.8);
-        bool pen = false;
-        for (std::size_t i = 0; i < s.x.size(); ++i) {
-            if (log_y && !(s.y[i] > 0)) { pen = false; continue; }
-            if (points) marker(px(s.x[i]), py(s.y[i]));
-            else if (pen) cairo_line_to(cr, px(s.x[i]), py(s.y[i]));
-            else cairo_move_to(cr, px(s.x[i]), py(s.y[i]));
-            pen = true;
-        }
-        if (points) cairo_fill(cr);
-        else cairo_stroke(cr);
-        if (series.size() > 1) {
-            const double ly = top + 20 + 18 * k, lx = legend_left ? left + 215 : w - right;
-            if (points) {
-                marker(lx - 187.5, ly);
-                cairo_fill(cr);
-            } else {
-                cairo_move_to(cr, lx - 200, ly), cairo_line_to(cr, lx - 175, ly);
-                cairo_stroke(cr);
-            }
-            cairo_set_source_rgb(cr, 0, 0, 0);
-            text(cr, lx - 168, ly + 5, s.label, 12);
-        }
+        draw_series(cr, frame, series[k], colours[k % colours.size()]);
+        if (series.size() > 1) draw_legend_entry(cr, series[k], k, legend_left);
     }
     canvas.finish();
 }

@@ -200,16 +200,9 @@ void check_reaches_region(const Ctx& c, const toml::node& n, const Path& p, cons
 }
 
 
-} // namespace
-
-meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier,
-                                 const meshing::OutlineSpec& outline) {
-    const toml::table& t = to_table(c, node, p, "a fracture set table ([[region.dfn]])");
-    static constexpr auto all = key_names(dfn_keys);
-    const bool from_file = t.contains("file");
-    check_keys(c, t, p, keys_of_type(dfn_keys, from_file ? "file" : "generated"), all,
-               from_file ? "a fracture set read from a file" : "a generated fracture set");
-    DfnSetSpec s;
+/// The set's name (new in its region) and the joint property it names, if any.
+void read_dfn_names(const Ctx& c, const toml::table& t, const Path& p, const std::vector<std::string>& earlier,
+                    DfnSetSpec& s) {
     const Path np = p.key("name");
     const toml::node& name = need(c, t, p, "name", "a non-empty string");
     s.name = to_str(c, name, np);
@@ -221,32 +214,37 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
         s.property = to_str(c, *n, p.key("property"));
         if (s.property.empty()) c.fail(*n, p.key("property"), "must be a non-empty string, got \"\"");
     }
-    if (from_file) {
-        const toml::node& f = *find(c, t, p, "file");
-        const Path fp = p.key("file");
-        s.file = to_str(c, f, fp);
-        std::optional<std::string> only;
-        if (const toml::node* n = find(c, t, p, "set")) only = to_str(c, *n, p.key("set"));
-        double scale = 0.0; // metres per file unit; 0 = the file's own (a DXF's header) or metres
-        if (const toml::node* n = find(c, t, p, "units"))
-            scale = meshing::length_unit_metres[to_choice(c, *n, p.key("units"),
-                                                          key_words(meshing::length_unit_words), "length unit")];
-        const std::string path = (std::filesystem::path(c.file).parent_path() / s.file).string();
-        std::string ext = std::filesystem::path(s.file).extension().string();
-        for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-        if (ext == ".dxf") {
-            if (!std::filesystem::exists(path)) c.fail(f, fp, "cannot open the trace file " + path);
-            s.traces = read_trace_dxf(c, f, fp, path, only, scale, s.import_note);
-        } else {
-            s.traces = read_trace_csv(c, f, fp, path, only, scale > 0.0 ? scale : 1.0);
-        }
-        if (s.traces.empty())
-            c.fail(f, fp, "the trace file " + path + " has no traces" + (only ? " of set " + reader::quoted(*only) : std::string()));
-        check_reaches_region(c, f, fp, s.traces, outline);
-        earlier.push_back(s.name);
-        return s;
+}
+
+/// A set read from a trace file (DXF or CSV, beside the model file), which must
+/// reach the region.
+void read_dfn_file(Ctx& c, const toml::table& t, const Path& p, const meshing::OutlineSpec& outline, DfnSetSpec& s) {
+    const toml::node& f = *find(c, t, p, "file");
+    const Path fp = p.key("file");
+    s.file = to_str(c, f, fp);
+    std::optional<std::string> only;
+    if (const toml::node* n = find(c, t, p, "set")) only = to_str(c, *n, p.key("set"));
+    double scale = 0.0; // metres per file unit; 0 = the file's own (a DXF's header) or metres
+    if (const toml::node* n = find(c, t, p, "units"))
+        scale = meshing::length_unit_metres[to_choice(c, *n, p.key("units"),
+                                                      key_words(meshing::length_unit_words), "length unit")];
+    const std::string path = (std::filesystem::path(c.file).parent_path() / s.file).string();
+    std::string ext = std::filesystem::path(s.file).extension().string();
+    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext == ".dxf") {
+        if (!std::filesystem::exists(path)) c.fail(f, fp, "cannot open the trace file " + path);
+        s.traces = read_trace_dxf(c, f, fp, path, only, scale, s.import_note);
+    } else {
+        s.traces = read_trace_csv(c, f, fp, path, only, scale > 0.0 ? scale : 1.0);
     }
-    s.seed = seed(c, t, p).value_or(1);
+    if (s.traces.empty())
+        c.fail(f, fp, "the trace file " + path + " has no traces" + (only ? " of set " + reader::quoted(*only) : std::string()));
+    check_reaches_region(c, f, fp, s.traces, outline);
+}
+
+/// Where a generated set's fractures are centred: the `centres` key, and the
+/// cluster table clustered centres need (and no other takes).
+void read_dfn_centres(const Ctx& c, const toml::table& t, const Path& p, DfnSetSpec& s) {
     if (const toml::node* n = find(c, t, p, "centres"))
         s.centres = static_cast<DfnSetSpec::Centres>(
             to_choice(c, *n, p.key("centres"), key_words(meshing::centre_words), "centres"));
@@ -262,14 +260,12 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
     } else if (cluster) {
         c.fail(*cluster, p.key("cluster"), "applies to clustered centres only (centres = \"clustered\")");
     }
-    s.orientation = read_orientation(c, need(c, t, p, "orientation", "an orientation table"), p.key("orientation"));
-    s.length = read_length(c, need(c, t, p, "length", "a length table"), p.key("length"));
-    const auto p21 = number(c, t, p, "p21", bounds_of(dfn_keys, "p21"));
-    const auto count = whole_number(c, t, p, "count", bounds_of(dfn_keys, "count"));
-    if (p21.has_value() == count.has_value())
-        c.fail(t, p, c.in_owner() + "give the set's intensity as 'p21' (trace length per m²) or 'count', one of them");
-    s.p21 = p21.value_or(0.0);
-    s.count = long(count.value_or(0));
+}
+
+/// The optional terminate table: the earlier sets of the region the set's
+/// fractures end at, and how likely.
+void read_dfn_termination(const Ctx& c, const toml::table& t, const Path& p, const std::vector<std::string>& earlier,
+                          DfnSetSpec& s) {
     if (const toml::node* n = find(c, t, p, "terminate")) {
         const Path tp = p.key("terminate");
         const toml::table& tt = to_table(c, *n, tp, "a table { at = [set names], probability = ... }");
@@ -287,6 +283,37 @@ meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, 
         });
         s.terminate_probability = required_number(c, tt, tp, "probability", Range{.lo = 0, .hi = 1, .lo_open = true, .unit = ""});
     }
+}
+
+/// A generated set: its seed, centres, orientation, lengths, intensity and terminations.
+void read_generated_dfn(const Ctx& c, const toml::table& t, const Path& p, const std::vector<std::string>& earlier,
+                        DfnSetSpec& s) {
+    s.seed = seed(c, t, p).value_or(1);
+    read_dfn_centres(c, t, p, s);
+    s.orientation = read_orientation(c, need(c, t, p, "orientation", "an orientation table"), p.key("orientation"));
+    s.length = read_length(c, need(c, t, p, "length", "a length table"), p.key("length"));
+    const auto p21 = number(c, t, p, "p21", bounds_of(dfn_keys, "p21"));
+    const auto count = whole_number(c, t, p, "count", bounds_of(dfn_keys, "count"));
+    if (p21.has_value() == count.has_value())
+        c.fail(t, p, c.in_owner() + "give the set's intensity as 'p21' (trace length per m²) or 'count', one of them");
+    s.p21 = p21.value_or(0.0);
+    s.count = long(count.value_or(0));
+    read_dfn_termination(c, t, p, earlier, s);
+}
+
+} // namespace
+
+meshing::DfnSetSpec read_dfn_set(Ctx& c, const toml::node& node, const Path& p, std::vector<std::string>& earlier,
+                                 const meshing::OutlineSpec& outline) {
+    const toml::table& t = to_table(c, node, p, "a fracture set table ([[region.dfn]])");
+    static constexpr auto all = key_names(dfn_keys);
+    const bool from_file = t.contains("file");
+    check_keys(c, t, p, keys_of_type(dfn_keys, from_file ? "file" : "generated"), all,
+               from_file ? "a fracture set read from a file" : "a generated fracture set");
+    DfnSetSpec s;
+    read_dfn_names(c, t, p, earlier, s);
+    if (from_file) read_dfn_file(c, t, p, outline, s);
+    else read_generated_dfn(c, t, p, earlier, s);
     earlier.push_back(s.name);
     return s;
 }

@@ -244,6 +244,95 @@ private:
     DxfDrawing& out_;
 };
 
+/// The walk through a file's groups: the section it is in, the entity being
+/// gathered (its groups follow its 0 group), an open POLYLINE, the header's units.
+struct DxfWalk {
+    GroupReader& in;
+    DxfDrawing& out;
+    DrawingReader reader;
+    enum class Section { none, header, entities, other } section = Section::none;
+    bool any_section = false, ended = false, units_next = false;
+    std::optional<Entity> entity;
+    std::optional<Polyline> polyline; // an open POLYLINE, gathering its VERTEXes
+    int units_line = 0;
+
+    DxfWalk(GroupReader& i, DxfDrawing& o) : in(i), out(o), reader(i, o) {}
+
+    /// The entity gathered so far, its groups all read: its traces, or a VERTEX of
+    /// the open POLYLINE.
+    void finish() {
+        if (!entity) return;
+        const Entity& e = *entity;
+        if (polyline) {
+            if (e.type == "VERTEX") reader.vertex(e, *polyline);
+            else if (e.type == "SEQEND") reader.emit(*polyline, "POLYLINE"), polyline.reset();
+            else in.fail(e.line, "a " + e.type + " inside the POLYLINE at line " + std::to_string(polyline->line) + " (no SEQEND)");
+        } else if (e.type == "LINE") {
+            reader.line(e);
+        } else if (e.type == "LWPOLYLINE") {
+            reader.emit(reader.polyline(e, true), "LWPOLYLINE");
+        } else if (e.type == "POLYLINE") {
+            polyline = reader.polyline(e, false);
+        } else {
+            ++out.entities_skipped[e.type];
+        }
+        entity.reset();
+    }
+
+    /// A group whose code is not 0: the entity's, or in the header the value of $INSUNITS.
+    void value(const Group& g) {
+        if (entity) entity->groups.push_back(g);
+        else if (section == Section::header) {
+            if (g.code == 9) units_next = g.value == "$INSUNITS";
+            else if (units_next && g.code == 70) {
+                const Entity header{"HEADER", g.line, {}};
+                out.insunits = reader.integer(header, g);
+                units_line = g.line;
+                units_next = false;
+            }
+        }
+    }
+
+    /// A 0 group (after the entity before it is finished): a section's start or
+    /// end, the file's end, or in the entities an entity's start.
+    void start(const Group& g) {
+        if (g.value == "SECTION") {
+            Group name;
+            if (!in.next(name) || name.code != 2) in.fail(g.line, "a SECTION without its name (group code 2)");
+            section = name.value == "HEADER" ? Section::header : name.value == "ENTITIES" ? Section::entities : Section::other;
+            any_section = true;
+        } else if (g.value == "ENDSEC") {
+            if (polyline) in.fail(polyline->line, "the POLYLINE has no SEQEND before the section ends");
+            section = Section::none;
+        } else if (g.value == "EOF") {
+            ended = true;
+        } else if (section == Section::entities) {
+            entity = Entity{g.value, g.line, {}};
+        }
+    }
+};
+
+/// The traces from drawing units to metres: `metres_per_unit` if given, else the
+/// header's $INSUNITS (at `units_line`).
+void scale_to_metres(const GroupReader& in, DxfDrawing& out, double metres_per_unit, int units_line) {
+    if (metres_per_unit > 0.0) {
+        out.metres_per_unit = metres_per_unit;
+    } else {
+        const auto m = metres_per(out.insunits);
+        if (!m)
+            in.fail(units_line, "drawing units $INSUNITS = " + std::to_string(out.insunits) +
+                                    " are not a length bbm converts (in, ft, mi, mm, cm, dm, m, km, yd); "
+                                    "give the model file's 'units' key");
+        out.metres_per_unit = *m;
+    }
+    for (DxfTrace& t : out.traces) {
+        t.a = out.metres_per_unit * t.a, t.b = out.metres_per_unit * t.b;
+        if (!std::isfinite(t.a.x) || !std::isfinite(t.a.y) || !std::isfinite(t.b.x) || !std::isfinite(t.b.y) ||
+            std::max({std::abs(t.a.x), std::abs(t.a.y), std::abs(t.b.x), std::abs(t.b.y)}) > 1e12)
+            in.fail(t.line, "the entity's coordinates lie beyond 1e12 m once in metres");
+    }
+}
+
 } // namespace
 
 std::string dxf_unit_name(int insunits) {
@@ -265,80 +354,19 @@ std::string dxf_unit_name(int insunits) {
 DxfDrawing read_dxf(const std::string& path, const std::string& key, double metres_per_unit) {
     GroupReader in(path, key);
     DxfDrawing out;
-    DrawingReader reader(in, out);
-    enum class Section { none, header, entities, other } section = Section::none;
-    bool any_section = false, ended = false, units_next = false;
-    std::optional<Entity> entity;
-    std::optional<Polyline> polyline; // an open POLYLINE, gathering its VERTEXes
-    int units_line = 0;
-
-    auto finish = [&] {
-        if (!entity) return;
-        const Entity& e = *entity;
-        if (polyline) {
-            if (e.type == "VERTEX") reader.vertex(e, *polyline);
-            else if (e.type == "SEQEND") reader.emit(*polyline, "POLYLINE"), polyline.reset();
-            else in.fail(e.line, "a " + e.type + " inside the POLYLINE at line " + std::to_string(polyline->line) + " (no SEQEND)");
-        } else if (e.type == "LINE") {
-            reader.line(e);
-        } else if (e.type == "LWPOLYLINE") {
-            reader.emit(reader.polyline(e, true), "LWPOLYLINE");
-        } else if (e.type == "POLYLINE") {
-            polyline = reader.polyline(e, false);
-        } else {
-            ++out.entities_skipped[e.type];
-        }
-        entity.reset();
-    };
-
+    DxfWalk walk(in, out);
     Group g;
-    while (!ended && in.next(g)) {
+    while (!walk.ended && in.next(g)) {
         if (g.code != 0) {
-            if (entity) entity->groups.push_back(g);
-            else if (section == Section::header) {
-                if (g.code == 9) units_next = g.value == "$INSUNITS";
-                else if (units_next && g.code == 70) {
-                    const Entity header{"HEADER", g.line, {}};
-                    out.insunits = reader.integer(header, g);
-                    units_line = g.line;
-                    units_next = false;
-                }
-            }
+            walk.value(g);
             continue;
         }
-        finish();
-        if (g.value == "SECTION") {
-            Group name;
-            if (!in.next(name) || name.code != 2) in.fail(g.line, "a SECTION without its name (group code 2)");
-            section = name.value == "HEADER" ? Section::header : name.value == "ENTITIES" ? Section::entities : Section::other;
-            any_section = true;
-        } else if (g.value == "ENDSEC") {
-            if (polyline) in.fail(polyline->line, "the POLYLINE has no SEQEND before the section ends");
-            section = Section::none;
-        } else if (g.value == "EOF") {
-            ended = true;
-        } else if (section == Section::entities) {
-            entity = Entity{g.value, g.line, {}};
-        }
+        walk.finish();
+        walk.start(g);
     }
-    finish();
-    if (!any_section) in.fail(1, "no SECTION in the file: not a DXF drawing");
-    if (metres_per_unit > 0.0) {
-        out.metres_per_unit = metres_per_unit;
-    } else {
-        const auto m = metres_per(out.insunits);
-        if (!m)
-            in.fail(units_line, "drawing units $INSUNITS = " + std::to_string(out.insunits) +
-                                    " are not a length bbm converts (in, ft, mi, mm, cm, dm, m, km, yd); "
-                                    "give the model file's 'units' key");
-        out.metres_per_unit = *m;
-    }
-    for (DxfTrace& t : out.traces) {
-        t.a = out.metres_per_unit * t.a, t.b = out.metres_per_unit * t.b;
-        if (!std::isfinite(t.a.x) || !std::isfinite(t.a.y) || !std::isfinite(t.b.x) || !std::isfinite(t.b.y) ||
-            std::max({std::abs(t.a.x), std::abs(t.a.y), std::abs(t.b.x), std::abs(t.b.y)}) > 1e12)
-            in.fail(t.line, "the entity's coordinates lie beyond 1e12 m once in metres");
-    }
+    walk.finish();
+    if (!walk.any_section) in.fail(1, "no SECTION in the file: not a DXF drawing");
+    scale_to_metres(in, out, metres_per_unit, walk.units_line);
     return out;
 }
 

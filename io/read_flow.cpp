@@ -14,7 +14,7 @@ void read_flow_table(Ctx& c, const toml::table& t, const Path& p, FlowSpec& f, c
     for (const FlowKey& k : flow_keys)
         if (k.set) read_declared_key(c, t, p, k, f);
     auto& fl = f.fluid;
-    if (const auto g = point(c, t, p, "gravity")) fl.gravity = *g, f.gravity_given = true;
+    if (const auto g = vector(c, t, p, "gravity")) fl.gravity = *g, f.gravity_given = true;
     if (!(fl.max_aperture > fl.residual_aperture))
         c.fail(t, p.key("max_aperture"),
                "must exceed residual_aperture = " + fmt(fl.residual_aperture) + " m, got " + fmt(fl.max_aperture));

@@ -30,7 +30,7 @@ HistorySpec read_history(Ctx& c, const toml::table& t, const Path& p, Names& nam
         const toml::node& n = need(c, t, p, "point",
                                    "a point [x, y]: the " + std::string(q) +
                                        " of the block containing (or nearest to) it is recorded");
-        h.point = to_vec2(c, n, p.key("point"));
+        h.point = to_position(c, n, p.key("point"));
     }
     if (at_boundary) {
         const Path bp = p.key("boundary");
@@ -74,14 +74,9 @@ std::vector<std::array<double, 3>> read_support_path(Ctx& c, const toml::table& 
     return rows;
 }
 
-} // namespace
-
-StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
-                     const Names& regions, const Names& supports) {
-    static constexpr auto all_keys = key_names(stage_keys);
-    check_keys(c, t, p, all_keys);
-    StageSpec s;
-    using Kind = StageSpec::Kind;
+/// The stage's name (by default "stage N"), new among the stages; messages
+/// about the stage name it from here on.
+void read_stage_name(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names, StageSpec& s) {
     const Path np = p.key("name");
     int name_line = line(t);
     if (const toml::node* n = find(c, t, p, "name")) {
@@ -93,6 +88,50 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
     }
     add_name(c, names, s.name, name_line, np, line(t));
     c.owner = "stage " + quoted(s.name);
+}
+
+void read_solve_stage(Ctx& c, const toml::table& t, const Path& p, StageSpec& s) {
+    const auto bounds = stage_key_bounds;
+    s.ratio = number(c, t, p, "ratio", bounds("ratio")).value_or(s.ratio);
+    s.max_steps = whole_number(c, t, p, "max_steps", bounds("max_steps")).value_or(s.max_steps);
+    if (const toml::node* n = find(c, t, p, "until"))
+        s.until = StageSpec::Until(
+            to_choice(c, *n, p.key("until"), key_words(find_key(stage_keys, "until")->words), "stopping rule"));
+    s.quiet_steps = whole_number(c, t, p, "quiet_steps", bounds("quiet_steps")).value_or(s.quiet_steps);
+}
+
+void read_excavate_stage(Ctx& c, const toml::table& t, const Path& p, const Names& regions, StageSpec& s) {
+    const auto bounds = stage_key_bounds;
+    s.regions = name_list(c, t, p, "regions", regions, "");
+    s.relax_steps = whole_number(c, t, p, "relax_steps", bounds("relax_steps")).value_or(0);
+    // Steps run in this stage: fewer than relax_steps stops part-way through the
+    // relaxation (which goes on in the next stages), e.g. to install support.
+    s.steps = whole_number(c, t, p, "steps", bounds("steps")).value_or(s.relax_steps);
+    s.keep = number(c, t, p, "keep", bounds("keep")).value_or(0.0);
+    s.pressure = number(c, t, p, "pressure", bounds("pressure")).value_or(0.0);
+    if (s.steps > s.relax_steps)
+        c.fail(*find(c, t, p, "steps"), p.key("steps"),
+               "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));
+    s.support_path = read_support_path(c, t, p);
+    if (!s.support_path.empty()) {
+        const toml::node& n = *find(c, t, p, "support_path");
+        if (s.relax_steps < 1)
+            c.fail(n, p.key("support_path"), "needs relax_steps >= 1: the steps the path is run over");
+        if (find(c, t, p, "keep"))
+            c.fail(*find(c, t, p, "keep"), p.key("keep"),
+                   "cannot go with support_path: the path's last row is the support kept");
+    }
+}
+
+} // namespace
+
+StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t index, Names& names,
+                     const Names& regions, const Names& supports) {
+    static constexpr auto all_keys = key_names(stage_keys);
+    check_keys(c, t, p, all_keys);
+    StageSpec s;
+    using Kind = StageSpec::Kind;
+    read_stage_name(c, t, p, index, names, s);
     s.kind = static_cast<Kind>(read_typed_keys(c, t, p, stage_keys, "type", "stage type", "stage"));
     const auto bounds = stage_key_bounds;
     switch (s.kind) {
@@ -100,33 +139,10 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         s.stress = read_stress(c, t, p);
         break;
     case Kind::solve:
-        s.ratio = number(c, t, p, "ratio", bounds("ratio")).value_or(s.ratio);
-        s.max_steps = whole_number(c, t, p, "max_steps", bounds("max_steps")).value_or(s.max_steps);
-        if (const toml::node* n = find(c, t, p, "until"))
-            s.until = StageSpec::Until(
-                to_choice(c, *n, p.key("until"), key_words(find_key(stage_keys, "until")->words), "stopping rule"));
-        s.quiet_steps = whole_number(c, t, p, "quiet_steps", bounds("quiet_steps")).value_or(s.quiet_steps);
+        read_solve_stage(c, t, p, s);
         break;
     case Kind::excavate:
-        s.regions = name_list(c, t, p, "regions", regions, "");
-        s.relax_steps = whole_number(c, t, p, "relax_steps", bounds("relax_steps")).value_or(0);
-        // Steps run in this stage: fewer than relax_steps stops part-way through the
-        // relaxation (which goes on in the next stages), e.g. to install support.
-        s.steps = whole_number(c, t, p, "steps", bounds("steps")).value_or(s.relax_steps);
-        s.keep = number(c, t, p, "keep", bounds("keep")).value_or(0.0);
-        s.pressure = number(c, t, p, "pressure", bounds("pressure")).value_or(0.0);
-        if (s.steps > s.relax_steps)
-            c.fail(*find(c, t, p, "steps"), p.key("steps"),
-                   "must be at most relax_steps (" + std::to_string(s.relax_steps) + "), got " + std::to_string(s.steps));
-        s.support_path = read_support_path(c, t, p);
-        if (!s.support_path.empty()) {
-            const toml::node& n = *find(c, t, p, "support_path");
-            if (s.relax_steps < 1)
-                c.fail(n, p.key("support_path"), "needs relax_steps >= 1: the steps the path is run over");
-            if (find(c, t, p, "keep"))
-                c.fail(*find(c, t, p, "keep"), p.key("keep"),
-                       "cannot go with support_path: the path's last row is the support kept");
-        }
+        read_excavate_stage(c, t, p, regions, s);
         break;
     case Kind::cycle:
         // A cycle runs at least one step.

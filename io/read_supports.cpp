@@ -34,16 +34,9 @@ public:
         return whole_number(c_, t_, p_, key, b);
     }
     std::optional<bool> boolean(std::string_view key) override { return reader::boolean(c_, t_, p_, key); }
-    std::optional<Vec2> point(std::string_view key) override {
-        const auto v = reader::point(c_, t_, p_, key);
-        if (v) check_near(key, *v);
-        return v;
-    }
-    Vec2 required_point(std::string_view key) override {
-        const Vec2 v = reader::required_point(c_, t_, p_, key);
-        check_near(key, v);
-        return v;
-    }
+    // Near the model: reader::to_position checks every point against Ctx::scale.
+    std::optional<Vec2> point(std::string_view key) override { return reader::point(c_, t_, p_, key); }
+    Vec2 required_point(std::string_view key) override { return reader::required_point(c_, t_, p_, key); }
     std::optional<std::vector<std::array<Vec2, 2>>> segments(std::string_view key, std::string_view what,
                                                              std::string_view ends) override {
         const toml::node* n = find(c_, t_, p_, key);
@@ -54,11 +47,8 @@ public:
         for_each_element(c_, a, kp, [&](const toml::node& e, const Path& ep) {
             const toml::array& pair = to_array(c_, e, ep, "a segment [[x1, y1], [x2, y2]]");
             if (pair.size() != 2) c_.fail(e, ep, "a segment is 2 points [from, to], got " + std::to_string(pair.size()));
-            const Vec2 from = to_vec2(c_, pair[0], ep.at(0)), to = to_vec2(c_, pair[1], ep.at(1));
+            const Vec2 from = to_position(c_, pair[0], ep.at(0)), to = to_position(c_, pair[1], ep.at(1));
             if (!(norm(to - from) > 0)) c_.fail(e, ep, std::string(ends) + " are the same point " + fmt(from));
-            for (const auto& [end, at] : {std::pair{from, 0}, std::pair{to, 1}})
-                if (!scale_.near(end))
-                    c_.fail(e, ep.at(std::size_t(at)), far_message(end));
             out.push_back({from, to});
         });
         return out;
@@ -78,14 +68,6 @@ public:
     const ModelScale& scale() const override { return scale_; }
 
 private:
-    std::string far_message(Vec2 v) const {
-        const Box2& e = scale_.extent;
-        return "the point " + fmt(v) + " lies far outside the model (its regions span " + fmt(e.lo) + " to " +
-               fmt(e.hi) + "): a position in another unit?";
-    }
-    void check_near(std::string_view key, Vec2 v) {
-        if (!scale_.near(v)) fail(key, far_message(v));
-    }
     Ctx& c_;
     const toml::table& t_;
     Path p_;

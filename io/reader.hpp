@@ -147,6 +147,9 @@ struct Ctx {
     int region = -1; ///< region being read, -1 outside regions
     /// The named table being read, for messages: "region 'bonded'", "boundary 'top'".
     std::string owner;
+    /// The model's extent and block size once its regions are read: every point
+    /// and box of the analysis tables is checked against it (ModelScale::near).
+    const ModelScale* scale = nullptr;
 
     [[noreturn]] void fail(int at_line, const Path& p, const std::string& message) const {
         throw InputError(file, at_line, p.full, message);
@@ -336,14 +339,34 @@ inline std::optional<bool> boolean(const Ctx& c, const toml::table& t, const Pat
     return b->get();
 }
 
-inline std::optional<Vec2> point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
+/// "the point (x, y) lies far outside the model ...": a position in another unit.
+inline std::string far_from_model(const ModelScale& scale, const std::string& what) {
+    return what + " lies far outside the model (its regions span " + fmt(scale.extent.lo) + " to " +
+           fmt(scale.extent.hi) + "): a position in another unit? Give it in metres";
+}
+
+/// A position [x, y]: near the model once its regions are read (Ctx::scale).
+inline Vec2 to_position(const Ctx& c, const toml::node& n, const Path& p) {
+    const Vec2 v = to_vec2(c, n, p);
+    if (c.scale && !c.scale->near(v)) c.fail(n, p, far_from_model(*c.scale, "the point " + fmt(v)));
+    return v;
+}
+
+/// A vector [x, y] (gravity): any direction and size.
+inline std::optional<Vec2> vector(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
     const toml::node* n = find(c, t, p, key);
     if (!n) return std::nullopt;
     return to_vec2(c, *n, p.key(key));
 }
 
+inline std::optional<Vec2> point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
+    const toml::node* n = find(c, t, p, key);
+    if (!n) return std::nullopt;
+    return to_position(c, *n, p.key(key));
+}
+
 inline Vec2 required_point(const Ctx& c, const toml::table& t, const Path& p, std::string_view key) {
-    return to_vec2(c, need(c, t, p, key, "a point [x, y]"), p.key(key));
+    return to_position(c, need(c, t, p, key, "a point [x, y]"), p.key(key));
 }
 
 /// Index of the string at node n in `options`; `what` names the choice.
@@ -491,11 +514,14 @@ inline Box2 read_box(const Ctx& c, const toml::node& node, const Path& p) {
     static constexpr std::array<std::string_view, 2> keys{"min", "max"};
     check_keys(c, t, p, keys);
     Box2 b;
-    b.lo = required_point(c, t, p, "min");
-    b.hi = required_point(c, t, p, "max");
+    // Its corners may lie far out (a box taking all of one side): the box as a whole is checked.
+    b.lo = to_vec2(c, need(c, t, p, "min", "a point [x, y]"), p.key("min"));
+    b.hi = to_vec2(c, need(c, t, p, "max", "a point [x, y]"), p.key("max"));
     if (!(b.hi.x > b.lo.x && b.hi.y > b.lo.y))
         c.fail(*t.get("max"), p.key("max"),
                "must exceed min = " + fmt(b.lo) + " in both x and y, got " + fmt(b.hi));
+    if (c.scale && !c.scale->near(b))
+        c.fail(node, p, far_from_model(*c.scale, "the box " + fmt(b.lo) + " to " + fmt(b.hi)));
     return b;
 }
 

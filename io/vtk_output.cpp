@@ -396,11 +396,82 @@ void add_state_cells(vtkUnstructuredGrid* grid, const World& w, const std::vecto
     grid->GetPointData()->AddArray(point_disp);
 }
 
+/// The cell arrays of the state's blocks.vtu, one tuple per cell: the rigid blocks, then the zones.
+struct StateCellArrays {
+    vtkNew<vtkIntArray> id, region, material, kind;
+    vtkNew<vtkDoubleArray> rotation, disp, vel, sig, eps;
+
+    explicit StateCellArrays(vtkIdType n)
+        : id(int_array("block_id", n)), region(int_array("region", n)), material(int_array("material", n)),
+          kind(int_array("zone", n)), rotation(double_array("rotation", n)), disp(double_array("cell_displacement", 0)),
+          vel(double_array("velocity", 0)), sig(double_array("stress", 0)), eps(double_array("strain", 0)) {
+        disp->SetNumberOfComponents(3), disp->SetNumberOfTuples(n);
+        vel->SetNumberOfComponents(3), vel->SetNumberOfTuples(n);
+        sig->SetNumberOfComponents(6), sig->SetNumberOfTuples(n);
+        eps->SetNumberOfComponents(6), eps->SetNumberOfTuples(n);
+        // Symmetric tensors in VTK's order, named so ParaView offers XX, YY, ... to colour by.
+        static const char* tensor[6] = {"XX", "YY", "ZZ", "XY", "YZ", "XZ"};
+        for (int k = 0; k < 6; ++k) sig->SetComponentName(k, tensor[k]), eps->SetComponentName(k, tensor[k]);
+    }
+};
+
+/// The cells 0 .. kept-1: the rigid blocks `kept`, their motion and block-averaged stress.
+void set_rigid_block_cells(StateCellArrays& a, const World& w, const std::vector<int>& kept,
+                           const std::vector<std::array<double, 3>>& stress) {
+    const auto& b = w.blocks;
+    const auto nk = static_cast<vtkIdType>(kept.size());
+    for (vtkIdType k = 0; k < nk; ++k) {
+        const int i = kept[k];
+        a.id->SetValue(k, i);
+        a.region->SetValue(k, b.region[i]);
+        a.material->SetValue(k, b.material[i]);
+        a.kind->SetValue(k, 0);
+        const auto& body = w.bodies.state[i];
+        a.rotation->SetValue(k, body.theta);
+        const Vec2 u = body.centroid - b.centroid0[i];
+        a.disp->SetTuple3(k, u.x, u.y, 0.0);
+        a.vel->SetTuple3(k, body.velocity.x, body.velocity.y, 0.0);
+        const double t[6] = {stress[i][0], stress[i][1], 0.0, stress[i][2], 0.0, 0.0};
+        a.sig->SetTuple(k, t);
+        const double e[6] = {0, 0, 0, 0, 0, 0}; // rigid: the strain lives in the joints
+        a.eps->SetTuple(k, e);
+    }
+}
+
+/// The cells from `first` on: the zones of deformable blocks, their nodes' mean
+/// motion, stress and strain.
+void set_zone_cells(StateCellArrays& a, const World& w, const std::vector<int>& zones, vtkIdType first) {
+    const auto& b = w.blocks;
+    const auto& nodes = w.nodes;
+    const auto& z = w.zones;
+    for (std::size_t q = 0; q < zones.size(); ++q) {
+        const vtkIdType k = first + vtkIdType(q);
+        const int zi = zones[q], blk = z.block[zi];
+        a.id->SetValue(k, blk);
+        a.region->SetValue(k, b.region[blk]);
+        a.material->SetValue(k, b.material[blk]);
+        a.kind->SetValue(k, 1);
+        a.rotation->SetValue(k, 0.0);
+        Vec2 u{}, v{};
+        for (int nd : z.node[zi]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0, v += nodes.velocity[nd] / 3.0;
+        a.disp->SetTuple3(k, u.x, u.y, 0.0);
+        a.vel->SetTuple3(k, v.x, v.y, 0.0);
+        const auto& st = z.stress[zi];
+        // Plane strain: σzz = ν(σxx + σyy) = λ/(2(λ+G)) (σxx + σyy) for a stress from zero.
+        const auto& el = z.elasticity[zi];
+        const double szz = el.lambda / (2.0 * (el.lambda + el.shear)) * (st[0] + st[1]);
+        const double t[6] = {st[0], st[1], szz, st[2], 0.0, 0.0};
+        a.sig->SetTuple(k, t);
+        const auto& sn = z.strain[zi];
+        const double e[6] = {sn[0], sn[1], 0.0, sn[2], 0.0, 0.0};
+        a.eps->SetTuple(k, e);
+    }
+}
+
 } // namespace
 
 void write_state_blocks_vtu(const World& w, const fs::path& file) {
     const auto& b = w.blocks;
-    const auto& nodes = w.nodes;
     const auto& z = w.zones;
     const auto stress = block_stresses(w);
     std::vector<int> kept, zones; // the rigid blocks and the zones not removed
@@ -411,58 +482,10 @@ void write_state_blocks_vtu(const World& w, const fs::path& file) {
     vtkNew<vtkUnstructuredGrid> grid;
     add_state_cells(grid, w, kept, zones);
     const auto nk = static_cast<vtkIdType>(kept.size());
-    const auto n = nk + static_cast<vtkIdType>(zones.size());
-    auto id = int_array("block_id", n), region = int_array("region", n), material = int_array("material", n);
-    auto kind = int_array("zone", n);
-    auto rotation = double_array("rotation", n);
-    auto disp = double_array("cell_displacement", 0), vel = double_array("velocity", 0), sig = double_array("stress", 0);
-    auto eps = double_array("strain", 0);
-    disp->SetNumberOfComponents(3), disp->SetNumberOfTuples(n);
-    vel->SetNumberOfComponents(3), vel->SetNumberOfTuples(n);
-    sig->SetNumberOfComponents(6), sig->SetNumberOfTuples(n);
-    eps->SetNumberOfComponents(6), eps->SetNumberOfTuples(n);
-    // Symmetric tensors in VTK's order, named so ParaView offers XX, YY, ... to colour by.
-    static const char* tensor[6] = {"XX", "YY", "ZZ", "XY", "YZ", "XZ"};
-    for (int k = 0; k < 6; ++k) sig->SetComponentName(k, tensor[k]), eps->SetComponentName(k, tensor[k]);
-    for (vtkIdType k = 0; k < nk; ++k) {
-        const int i = kept[k];
-        id->SetValue(k, i);
-        region->SetValue(k, b.region[i]);
-        material->SetValue(k, b.material[i]);
-        kind->SetValue(k, 0);
-        const auto& body = w.bodies.state[i];
-        rotation->SetValue(k, body.theta);
-        const Vec2 u = body.centroid - b.centroid0[i];
-        disp->SetTuple3(k, u.x, u.y, 0.0);
-        vel->SetTuple3(k, body.velocity.x, body.velocity.y, 0.0);
-        const double t[6] = {stress[i][0], stress[i][1], 0.0, stress[i][2], 0.0, 0.0};
-        sig->SetTuple(k, t);
-        const double e[6] = {0, 0, 0, 0, 0, 0}; // rigid: the strain lives in the joints
-        eps->SetTuple(k, e);
-    }
-    for (std::size_t q = 0; q < zones.size(); ++q) {
-        const vtkIdType k = nk + vtkIdType(q);
-        const int zi = zones[q], blk = z.block[zi];
-        id->SetValue(k, blk);
-        region->SetValue(k, b.region[blk]);
-        material->SetValue(k, b.material[blk]);
-        kind->SetValue(k, 1);
-        rotation->SetValue(k, 0.0);
-        Vec2 u{}, v{};
-        for (int nd : z.node[zi]) u += (nodes.position[nd] - nodes.position0[nd]) / 3.0, v += nodes.velocity[nd] / 3.0;
-        disp->SetTuple3(k, u.x, u.y, 0.0);
-        vel->SetTuple3(k, v.x, v.y, 0.0);
-        const auto& st = z.stress[zi];
-        // Plane strain: σzz = ν(σxx + σyy) = λ/(2(λ+G)) (σxx + σyy) for a stress from zero.
-        const auto& el = z.elasticity[zi];
-        const double szz = el.lambda / (2.0 * (el.lambda + el.shear)) * (st[0] + st[1]);
-        const double t[6] = {st[0], st[1], szz, st[2], 0.0, 0.0};
-        sig->SetTuple(k, t);
-        const auto& sn = z.strain[zi];
-        const double e[6] = {sn[0], sn[1], 0.0, sn[2], 0.0, 0.0};
-        eps->SetTuple(k, e);
-    }
-    add_cell_arrays(grid, id, region, material, kind, disp, vel, rotation, sig, eps);
+    StateCellArrays a(nk + static_cast<vtkIdType>(zones.size()));
+    set_rigid_block_cells(a, w, kept, stress);
+    set_zone_cells(a, w, zones, nk);
+    add_cell_arrays(grid, a.id, a.region, a.material, a.kind, a.disp, a.vel, a.rotation, a.sig, a.eps);
     grid->GetFieldData()->AddArray(string_array("region_names", w.region_names, [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }

@@ -460,67 +460,11 @@ public:
     void add_cells(const Cells& cells, const cgal::PolygonWithHoles& rounded, bool tiled = false) {
         cells_ = &cells;
         has_cells_ = !cells.empty();
-        whole_.assign(cells.size(), 0);
-        std::vector<char> near(cells.size(), 0);
-        const cgal::Domain face{rounded};
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (cells[c].size() < 3) continue;
-            if (tiled && thinner_than_rounding(cells[c])) {
-                whole_[c] = 2; // a piece of no width (a sliver the rounding flattened): its neighbours cover it
-                continue;
-            }
-            Box2 b = bounding_box(cells[c]);
-            b.lo = b.lo - Vec2{tol_, tol_};
-            b.hi = b.hi + Vec2{tol_, tol_};
-            bool touches = false;
-            boundary_->for_each_near(b, [&](int e) {
-                const auto& [p, q] = boundary_->segments()[e];
-                touches = touches || (std::max(p.x, q.x) >= b.lo.x && std::min(p.x, q.x) <= b.hi.x &&
-                                      std::max(p.y, q.y) >= b.lo.y && std::min(p.y, q.y) <= b.hi.y);
-            });
-            near[c] = touches;
-            // Far from every edge of the block: wholly inside it or wholly outside.
-            if (!touches) whole_[c] = tiled || domain_contains(face, centroid(cells[c])) ? 1 : 2;
-        }
-        // Each edge once, with the cells on its two sides (those whose own edge it
-        // is, running the same way or the other).
-        std::vector<std::vector<Vec2>> rings(cells.size());
-        std::unordered_map<std::pair<Vec2, Vec2>, int, EdgeHash> owner;
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (cells[c].size() < 3 || whole_[c] == 2) continue;
-            auto& r = rings[c];
-            for (Vec2 q : cells[c])
-                if (r.empty() || !(r.back() == q)) r.push_back(q);
-            while (r.size() > 1 && r.front() == r.back()) r.pop_back();
-            if (signed_area(r) < 0) std::reverse(r.begin(), r.end());
-            for (std::size_t i = 0; i < r.size(); ++i) owner[{r[i], r[(i + 1) % r.size()]}] = int(c);
-        }
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (!near[c]) continue;
-            const auto& r = rings[c];
-            for (std::size_t i = 0; i < r.size(); ++i) {
-                const Vec2 p = r[i], q = r[(i + 1) % r.size()];
-                const auto back = owner.find({q, p});
-                // An edge two inserted cells share is inserted once, by the lower.
-                if (back != owner.end() && near[std::size_t(back->second)] && std::size_t(back->second) < c) continue;
-                // A piece's edge along the rock block's boundary: that boundary itself.
-                if (tiled && on_boundary(p) && on_boundary(q) && on_boundary(0.5 * (p + q))) continue;
-                Origin o;
-                o.kind = Kind::cell;
-                o.from = tiled ? onto_boundary(p) : exact(p);
-                o.to = tiled ? onto_boundary(q) : exact(q);
-                o.left = int(c);
-                o.right = back != owner.end() ? back->second : -1;
-                if (o.from == o.to) continue;
-                ov_.origins.push_back(std::move(o));
-                const Origin& added = ov_.origins.back();
-                boundary_curves_.emplace_back(SegmentTraits::X_monotone_curve_2(Segment(added.from, added.to)),
-                                              Traits::Data_container(int(ov_.origins.size()) - 1));
-            }
-        }
-        CGAL::insert(ov_.arr, boundary_curves_.begin(), boundary_curves_.end());
-        boundary_curves_.clear();
-        ov_.classify();
+        const std::vector<char> near = cells_near_boundary(cells, rounded, tiled);
+        std::vector<std::vector<Vec2>> rings;
+        EdgeOwners owner;
+        cell_rings(cells, rings, owner);
+        insert_cell_edges(cells, near, rings, owner, tiled);
         label_faces(cells, near);
     }
 
@@ -626,6 +570,87 @@ public:
     }
 
 private:
+    /// Each edge of the cells, keyed by its two ends, and the cell whose own edge
+    /// it is (its ring running that way).
+    using EdgeOwners = std::unordered_map<std::pair<Vec2, Vec2>, int, EdgeHash>;
+
+    /// The cells near the block's boundary (inserted); the others kept whole
+    /// inside or dropped outside (whole_). A tiled piece of no width (a sliver the
+    /// rounding flattened) is dropped: its neighbours cover it.
+    std::vector<char> cells_near_boundary(const Cells& cells, const cgal::PolygonWithHoles& rounded, bool tiled) {
+        whole_.assign(cells.size(), 0);
+        std::vector<char> near(cells.size(), 0);
+        const cgal::Domain face{rounded};
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+            if (cells[c].size() < 3) continue;
+            if (tiled && thinner_than_rounding(cells[c])) {
+                whole_[c] = 2; // a piece of no width (a sliver the rounding flattened): its neighbours cover it
+                continue;
+            }
+            Box2 b = bounding_box(cells[c]);
+            b.lo = b.lo - Vec2{tol_, tol_};
+            b.hi = b.hi + Vec2{tol_, tol_};
+            bool touches = false;
+            boundary_->for_each_near(b, [&](int e) {
+                const auto& [p, q] = boundary_->segments()[e];
+                touches = touches || (std::max(p.x, q.x) >= b.lo.x && std::min(p.x, q.x) <= b.hi.x &&
+                                      std::max(p.y, q.y) >= b.lo.y && std::min(p.y, q.y) <= b.hi.y);
+            });
+            near[c] = touches;
+            // Far from every edge of the block: wholly inside it or wholly outside.
+            if (!touches) whole_[c] = tiled || domain_contains(face, centroid(cells[c])) ? 1 : 2;
+        }
+        return near;
+    }
+
+    /// Each cell not dropped as a counter-clockwise ring without repeated points,
+    /// and the owner of each of its edges.
+    void cell_rings(const Cells& cells, std::vector<std::vector<Vec2>>& rings, EdgeOwners& owner) const {
+        rings.assign(cells.size(), {});
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+            if (cells[c].size() < 3 || whole_[c] == 2) continue;
+            auto& r = rings[c];
+            for (Vec2 q : cells[c])
+                if (r.empty() || !(r.back() == q)) r.push_back(q);
+            while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+            if (signed_area(r) < 0) std::reverse(r.begin(), r.end());
+            for (std::size_t i = 0; i < r.size(); ++i) owner[{r[i], r[(i + 1) % r.size()]}] = int(c);
+        }
+    }
+
+    /// The edges of the cells near the boundary, each once with the cells on its
+    /// two sides (those whose own edge it is, running the same way or the other),
+    /// inserted with the block's boundary in one sweep.
+    void insert_cell_edges(const Cells& cells, const std::vector<char>& near, const std::vector<std::vector<Vec2>>& rings,
+                           const EdgeOwners& owner, bool tiled) {
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+            if (!near[c]) continue;
+            const auto& r = rings[c];
+            for (std::size_t i = 0; i < r.size(); ++i) {
+                const Vec2 p = r[i], q = r[(i + 1) % r.size()];
+                const auto back = owner.find({q, p});
+                // An edge two inserted cells share is inserted once, by the lower.
+                if (back != owner.end() && near[std::size_t(back->second)] && std::size_t(back->second) < c) continue;
+                // A piece's edge along the rock block's boundary: that boundary itself.
+                if (tiled && on_boundary(p) && on_boundary(q) && on_boundary(0.5 * (p + q))) continue;
+                Origin o;
+                o.kind = Kind::cell;
+                o.from = tiled ? onto_boundary(p) : exact(p);
+                o.to = tiled ? onto_boundary(q) : exact(q);
+                o.left = int(c);
+                o.right = back != owner.end() ? back->second : -1;
+                if (o.from == o.to) continue;
+                ov_.origins.push_back(std::move(o));
+                const Origin& added = ov_.origins.back();
+                boundary_curves_.emplace_back(SegmentTraits::X_monotone_curve_2(Segment(added.from, added.to)),
+                                              Traits::Data_container(int(ov_.origins.size()) - 1));
+            }
+        }
+        CGAL::insert(ov_.arr, boundary_curves_.begin(), boundary_curves_.end());
+        boundary_curves_.clear();
+        ov_.classify();
+    }
+
     int add_boundary_origin(Halfedge h) {
         Origin o;
         o.kind = Kind::boundary;
@@ -956,13 +981,11 @@ struct RegionCut::Impl {
     }
 };
 
-RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> traces, double min_area,
-                     double min_face_area, double tol)
-    : impl_(std::make_unique<Impl>()) {
-    Impl& m = *impl_;
-    m.min_area = min_area;
-    m.min_face_area = min_face_area;
-    m.tol = tol;
+namespace {
+
+/// The domain's rings as boundary origins on the overlay, outer rings
+/// counter-clockwise and holes clockwise; the box they span.
+Box2 queue_domain_boundary(Overlay& ov, const cgal::Domain& domain) {
     Box2 box;
     auto ring = [&](std::vector<Vec2> r, bool outer) {
         if ((signed_area(r) > 0) != outer) std::reverse(r.begin(), r.end());
@@ -972,15 +995,18 @@ RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> trace
             o.kind = Kind::boundary;
             o.from = exact(r[i]);
             o.to = exact(r[(i + 1) % r.size()]);
-            m.ov.queue(std::move(o));
+            ov.queue(std::move(o));
         }
     };
     for (const auto& p : domain) {
         ring(p.outer, true);
         for (const auto& h : p.holes) ring(h, false);
     }
-    // The region's edges, to put a clipped fracture's end exactly on the one it
-    // crosses (the rounded clip point lies off both lines by an ulp).
+    return box;
+}
+
+/// The domain's edges, outer rings and holes.
+std::vector<std::pair<Vec2, Vec2>> domain_edges(const cgal::Domain& domain) {
     std::vector<std::pair<Vec2, Vec2>> edges;
     for (const auto& p : domain) {
         auto add = [&](const std::vector<Vec2>& r) {
@@ -989,36 +1015,72 @@ RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> trace
         add(p.outer);
         for (const auto& h : p.holes) add(h);
     }
-    const SegmentGrid boundary(edges, std::max(box.width(), box.height()) / 64.0);
-    auto line_of = [&](const CutTrace& t) { return EK::Line_2(exact(t.line_a), exact(t.line_b)); };
-    auto meet = [](const EK::Line_2& l, const EK::Line_2& l2) -> std::optional<Point> {
-        const auto x = CGAL::intersection(l, l2);
-        if (x)
-            if (const Point* p = boost::get<Point>(&*x)) return *p;
-        return std::nullopt;
-    };
-    auto end_of = [&](const CutTrace& t, bool b) {
+    return edges;
+}
+
+EK::Line_2 line_of(const CutTrace& t) { return EK::Line_2(exact(t.line_a), exact(t.line_b)); }
+
+std::optional<Point> meet(const EK::Line_2& l, const EK::Line_2& l2) {
+    const auto x = CGAL::intersection(l, l2);
+    if (x)
+        if (const Point* p = boost::get<Point>(&*x)) return *p;
+    return std::nullopt;
+}
+
+/// A trace's ends, exactly: where its line meets that of the trace it ends at, or
+/// of the region's edge it was clipped at (the region's edges, to put a clipped
+/// fracture's end exactly on the one it crosses: the rounded clip point lies off
+/// both lines by an ulp); else as given.
+class TraceEnds {
+public:
+    TraceEnds(std::span<const CutTrace> traces, std::vector<std::pair<Vec2, Vec2>> edges, double cell, double tol)
+        : traces_(traces), edges_(std::move(edges)), boundary_(edges_, cell), tol_(tol) {}
+
+    Point operator()(const CutTrace& t, bool b) const {
         const int at = b ? t.b_at : t.a_at;
         const Vec2 given = b ? t.b : t.a;
-        if (at >= 0 && at < int(traces.size()))
-            if (const auto p = meet(line_of(t), line_of(traces[std::size_t(at)]))) return *p;
-        if (at == CutTrace::on_boundary) {
-            int best = -1;
-            double best_d = INFINITY;
-            Box2 near;
-            near.add(given - Vec2{tol, tol});
-            near.add(given + Vec2{tol, tol});
-            boundary.for_each_near(near, [&](int e) {
-                const double d = distance_to_segment(given, edges[std::size_t(e)].first, edges[std::size_t(e)].second);
-                if (d < best_d) best = e, best_d = d;
-            });
-            if (best >= 0 && best_d <= tol)
-                if (const auto p = meet(line_of(t), EK::Line_2(exact(edges[std::size_t(best)].first),
-                                                               exact(edges[std::size_t(best)].second))))
-                    return *p;
-        }
+        if (at >= 0 && at < int(traces_.size()))
+            if (const auto p = meet(line_of(t), line_of(traces_[std::size_t(at)]))) return *p;
+        if (at == CutTrace::on_boundary)
+            if (const auto p = on_region_edge(t, given)) return *p;
         return exact(given);
-    };
+    }
+
+private:
+    /// Where the trace's line meets that of the region's edge nearest the given
+    /// end (within the tolerance).
+    std::optional<Point> on_region_edge(const CutTrace& t, Vec2 given) const {
+        int best = -1;
+        double best_d = INFINITY;
+        Box2 near;
+        near.add(given - Vec2{tol_, tol_});
+        near.add(given + Vec2{tol_, tol_});
+        boundary_.for_each_near(near, [&](int e) {
+            const double d = distance_to_segment(given, edges_[std::size_t(e)].first, edges_[std::size_t(e)].second);
+            if (d < best_d) best = e, best_d = d;
+        });
+        if (best >= 0 && best_d <= tol_)
+            return meet(line_of(t), EK::Line_2(exact(edges_[std::size_t(best)].first), exact(edges_[std::size_t(best)].second)));
+        return std::nullopt;
+    }
+
+    std::span<const CutTrace> traces_;
+    std::vector<std::pair<Vec2, Vec2>> edges_;
+    SegmentGrid boundary_;
+    double tol_;
+};
+
+} // namespace
+
+RegionCut::RegionCut(const cgal::Domain& domain, std::span<const CutTrace> traces, double min_area,
+                     double min_face_area, double tol)
+    : impl_(std::make_unique<Impl>()) {
+    Impl& m = *impl_;
+    m.min_area = min_area;
+    m.min_face_area = min_face_area;
+    m.tol = tol;
+    const Box2 box = queue_domain_boundary(m.ov, domain);
+    const TraceEnds end_of(traces, domain_edges(domain), std::max(box.width(), box.height()) / 64.0, tol);
     for (const CutTrace& t : traces) {
         Origin o;
         o.kind = Kind::trace;

@@ -297,18 +297,17 @@ private:
     SegmentGrid real_, fracture_;
 };
 
-} // namespace
+/// An edge of a block: its ends, the block and its index there.
+struct BlockEdge {
+    Vec2 p, q;
+    int block, index;
+};
 
-void build_joints(BlockAssembly& a) {
-    a.joints.clear();
-    const int nb = a.block_count();
-    if (nb < 2) return;
-    struct Edge { Vec2 p, q; int block, index; };
-    std::vector<Edge> edges;
+/// Every block's edges, the box of the blocks and the edges' total length.
+std::vector<BlockEdge> block_edges(const BlockAssembly& a, Box2& all, double& total) {
+    std::vector<BlockEdge> edges;
     edges.reserve(a.points.size());
-    Box2 all;
-    double total = 0.0;
-    for (int b = 0; b < nb; ++b) {
+    for (int b = 0; b < a.block_count(); ++b) {
         const auto poly = a.block(b);
         for (int i = 0; i < int(poly.size()); ++i) {
             const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
@@ -317,6 +316,72 @@ void build_joints(BlockAssembly& a) {
             total += norm(q - p);
         }
     }
+    return edges;
+}
+
+/// The joints of edge e1 with the edges of other blocks that run against it along
+/// its line (within tol) and overlap it; each pair from its lower-numbered edge.
+void add_joints_of_edge(BlockAssembly& a, const std::vector<BlockEdge>& edges, const SegmentGrid& grid,
+                        const JointClassifier& classifier, double tol, int e1) {
+    const BlockEdge& E = edges[e1];
+    const Vec2 d = E.q - E.p;
+    const double len = norm(d);
+    if (len <= tol) return;
+    const Vec2 t = d / len;
+    Box2 b;
+    b.add(E.p);
+    b.add(E.q);
+    int last = -1;
+    grid.for_each_near(b, [&](int e2) {
+        // A pair is visited from its lower-numbered edge only; the grid can
+        // report the same neighbour from several cells, hence `last`.
+        if (e2 <= e1 || e2 == last) return;
+        const BlockEdge& F = edges[e2];
+        if (F.block == E.block) return;
+        const Vec2 f = F.q - F.p;
+        if (dot(f, d) >= 0) return; // shared boundaries of two CCW polygons run opposite ways
+        if (std::abs(cross(t, F.p - E.p)) > tol || std::abs(cross(t, F.q - E.p)) > tol) return;
+        const double sp = dot(F.p - E.p, t), sq = dot(F.q - E.p, t);
+        // F runs against E, so F.q is the start of the overlap along E.
+        const double lo = std::max(0.0, sq), hi = std::min(len, sp);
+        if (hi - lo <= tol) return;
+        last = e2;
+        JointRecord j;
+        j.block_a = E.block;
+        j.edge_a = E.index;
+        j.block_b = F.block;
+        j.edge_b = F.index;
+        j.p0 = (sq > 0.0) ? F.q : E.p; // actual vertices, never re-rounded projections
+        j.p1 = (sp < len) ? F.p : E.q;
+        classifier.classify(j);
+        a.joints.push_back(j);
+    });
+}
+
+/// A pair of edges might be reported twice if the grid gave it from two cells
+/// between other candidates: remove exact duplicates.
+void remove_duplicate_joints(std::vector<JointRecord>& joints) {
+    std::sort(joints.begin(), joints.end(), [](const JointRecord& x, const JointRecord& y) {
+        return std::tie(x.block_a, x.edge_a, x.block_b, x.edge_b) <
+               std::tie(y.block_a, y.edge_a, y.block_b, y.edge_b);
+    });
+    joints.erase(std::unique(joints.begin(), joints.end(),
+                             [](const JointRecord& x, const JointRecord& y) {
+                                 return x.block_a == y.block_a && x.edge_a == y.edge_a &&
+                                        x.block_b == y.block_b && x.edge_b == y.edge_b;
+                             }),
+                 joints.end());
+}
+
+} // namespace
+
+void build_joints(BlockAssembly& a) {
+    a.joints.clear();
+    const int nb = a.block_count();
+    if (nb < 2) return;
+    Box2 all;
+    double total = 0.0;
+    const std::vector<BlockEdge> edges = block_edges(a, all, total);
     const double tol = 1e-9 * std::max(all.width(), all.height());
     std::vector<std::pair<Vec2, Vec2>> segs;
     segs.reserve(edges.size());
@@ -326,53 +391,8 @@ void build_joints(BlockAssembly& a) {
 
     const JointClassifier classifier(a, tol, cell);
 
-    for (int e1 = 0; e1 < int(edges.size()); ++e1) {
-        const Edge& E = edges[e1];
-        const Vec2 d = E.q - E.p;
-        const double len = norm(d);
-        if (len <= tol) continue;
-        const Vec2 t = d / len;
-        Box2 b;
-        b.add(E.p);
-        b.add(E.q);
-        int last = -1;
-        grid.for_each_near(b, [&](int e2) {
-            // A pair is visited from its lower-numbered edge only; the grid can
-            // report the same neighbour from several cells, hence `last`.
-            if (e2 <= e1 || e2 == last) return;
-            const Edge& F = edges[e2];
-            if (F.block == E.block) return;
-            const Vec2 f = F.q - F.p;
-            if (dot(f, d) >= 0) return; // shared boundaries of two CCW polygons run opposite ways
-            if (std::abs(cross(t, F.p - E.p)) > tol || std::abs(cross(t, F.q - E.p)) > tol) return;
-            const double sp = dot(F.p - E.p, t), sq = dot(F.q - E.p, t);
-            // F runs against E, so F.q is the start of the overlap along E.
-            const double lo = std::max(0.0, sq), hi = std::min(len, sp);
-            if (hi - lo <= tol) return;
-            last = e2;
-            JointRecord j;
-            j.block_a = E.block;
-            j.edge_a = E.index;
-            j.block_b = F.block;
-            j.edge_b = F.index;
-            j.p0 = (sq > 0.0) ? F.q : E.p; // actual vertices, never re-rounded projections
-            j.p1 = (sp < len) ? F.p : E.q;
-            classifier.classify(j);
-            a.joints.push_back(j);
-        });
-    }
-    // A pair of edges might be reported twice if the grid gave it from two cells
-    // between other candidates: remove exact duplicates.
-    std::sort(a.joints.begin(), a.joints.end(), [](const JointRecord& x, const JointRecord& y) {
-        return std::tie(x.block_a, x.edge_a, x.block_b, x.edge_b) <
-               std::tie(y.block_a, y.edge_a, y.block_b, y.edge_b);
-    });
-    a.joints.erase(std::unique(a.joints.begin(), a.joints.end(),
-                               [](const JointRecord& x, const JointRecord& y) {
-                                   return x.block_a == y.block_a && x.edge_a == y.edge_a &&
-                                          x.block_b == y.block_b && x.edge_b == y.edge_b;
-                               }),
-                   a.joints.end());
+    for (int e1 = 0; e1 < int(edges.size()); ++e1) add_joints_of_edge(a, edges, grid, classifier, tol, e1);
+    remove_duplicate_joints(a.joints);
 }
 
 } // namespace bbm::meshing::detail

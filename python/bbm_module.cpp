@@ -229,11 +229,128 @@ const char* group_name(MemoryGroup g) {
     return "other";
 }
 
-} // namespace
+/// A fresh array of the contacts' hydraulic apertures (0 in a dry model).
+py::array_t<double> contact_aperture(const ContactArrays& a) {
+    const World& w = world_of(a);
+    const auto values = w.flow ? contact_apertures(*w.flow, contacts(w)) : std::vector<double>(w.contacts.size(), 0.0);
+    auto out = fresh<double>(py::ssize_t(values.size()), 0);
+    std::copy(values.begin(), values.end(), out.mutable_data());
+    return out;
+}
 
-PYBIND11_MODULE(_bbm, mod) {
-    mod.doc() = "bbm: bonded-block models of rock failure (2D, plane strain) — the compiled core of the bbm package";
+/// A fresh array of each contact's vertex position along its edge.
+py::array_t<double> contact_edge_parameter(const ContactArrays& a) {
+    using contact::Contacts;
+    return per_contact<double>(a, [](const World& w, const Contacts& c, int i, double* o) {
+        const auto& v = w.vertices.position;
+        const Vec2 p = v[c.edge_id[i]], e = v[c.edge_end[i]] - p;
+        *o = dot(v[c.vertex_id[i]] - p, e) / dot(e, e);
+    });
+}
 
+/// The water in the joints, copied (None when dry): Model.flow.
+py::object flow_arrays(const Model& m) {
+    const auto& flow = m.solver().world().flow;
+    if (!flow) return py::none();
+    const JointFlow* f = &*flow;
+    const auto& net = f->net;
+    const auto& st = f->state;
+    auto domains = fresh<double>(net.domains(), 2), pressure = fresh<double>(net.domains(), 0);
+    auto aperture = fresh<double>(net.pipes(), 0), rate = fresh<double>(net.pipes(), 0);
+    auto pipes = fresh<std::int32_t>(net.pipes(), 2);
+    const auto q = flow::pipe_flows(net, f->fluid, st);
+    for (int d = 0; d < net.domains(); ++d) {
+        domains.mutable_data()[2 * d] = net.domain_position[d].x, domains.mutable_data()[2 * d + 1] = net.domain_position[d].y;
+        pressure.mutable_data()[d] = st.pressure[d];
+    }
+    for (int k = 0; k < net.pipes(); ++k) {
+        aperture.mutable_data()[k] = flow::hydraulic_aperture(f->fluid, st.aperture[k]);
+        rate.mutable_data()[k] = q[k];
+        pipes.mutable_data()[2 * k] = net.pipe_from[k], pipes.mutable_data()[2 * k + 1] = net.pipe_to[k];
+    }
+    py::dict d;
+    d["domain_position"] = domains, d["pressure"] = pressure, d["pipes"] = pipes, d["aperture"] = aperture;
+    d["flow_rate"] = rate, d["inflow"] = inflow(*f);
+    return d;
+}
+
+/// A lab test run as its command with these options, the GIL released; a callback
+/// gets every frame's snapshot (one at a time), and an exception it raises is
+/// raised here once the test is done.
+studies::LabTestStudy run_labtest_study(const std::string& command, const std::vector<std::string>& args, bool quiet,
+                                        const std::optional<py::function>& callback) {
+    studies::LabTestStudy study;
+    std::function<void(const Solver&, const StressStrainPoint&, int)> on_frame;
+    std::optional<py::error_already_set> failure;
+    std::mutex once; // realizations on several threads: one callback at a time
+    if (callback)
+        on_frame = [&](const Solver& s, const StressStrainPoint& p, int realization) {
+            std::lock_guard lock(once);
+            py::gil_scoped_acquire gil;
+            if (failure) return;
+            try {
+                (*callback)(frame_snapshot(s, p, realization));
+            } catch (py::error_already_set& e) {
+                failure.emplace(std::move(e));
+            }
+        };
+    {
+        py::gil_scoped_release release;
+        study = cli::run_labtest_args(command, args, quiet, on_frame);
+    }
+    if (failure) throw std::move(*failure);
+    return study;
+}
+
+/// Every realization's curve as numpy arrays, in the order of summary["runs"].
+py::list labtest_curves(const studies::LabTestStudy& study) {
+    py::list curves;
+    for (const auto& r : study.results) {
+        const auto n = py::ssize_t(r.curve.size());
+        auto step = fresh<std::int64_t>(n);
+        auto axial_strain = fresh<double>(n), axial_stress = fresh<double>(n), lateral_strain = fresh<double>(n);
+        auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
+        auto ratio = fresh<double>(n), rate = fresh<double>(n);
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const auto& p = r.curve[i];
+            step.mutable_at(i) = p.step, axial_strain.mutable_at(i) = p.axial_strain;
+            axial_stress.mutable_at(i) = p.axial_stress, lateral_strain.mutable_at(i) = p.lateral_strain;
+            tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
+            ratio.mutable_at(i) = p.unbalanced_ratio, rate.mutable_at(i) = p.strain_per_step;
+        }
+        py::dict c;
+        c["step"] = step, c["axial_strain"] = axial_strain, c["axial_stress"] = axial_stress;
+        c["lateral_strain"] = lateral_strain, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
+        c["unbalanced_ratio"] = ratio, c["strain_per_step"] = rate;
+        curves.append(c);
+    }
+    return curves;
+}
+
+/// Every run's curve as numpy arrays, in the order of summary["runs"].
+py::list shear_curves(const studies::ShearStudy& study) {
+    py::list curves;
+    for (const auto& r : study.results) {
+        const auto n = py::ssize_t(r.curve.size());
+        auto step = fresh<std::int64_t>(n);
+        auto u = fresh<double>(n), tau = fresh<double>(n), sn = fresh<double>(n), dv = fresh<double>(n);
+        auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const auto& p = r.curve[i];
+            step.mutable_at(i) = p.step, u.mutable_at(i) = p.displacement, tau.mutable_at(i) = p.shear_stress;
+            sn.mutable_at(i) = p.normal_stress, dv.mutable_at(i) = p.dilation;
+            tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
+        }
+        py::dict c;
+        c["step"] = step, c["shear_displacement"] = u, c["shear_stress"] = tau, c["normal_stress"] = sn;
+        c["dilation"] = dv, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
+        curves.append(c);
+    }
+    return curves;
+}
+
+/// bbm.InputError and bbm.NumericalError, and the library's exceptions translated to them.
+void bind_errors(py::module_& mod) {
     // Exceptions: bbm.InputError (a ValueError) carries file, line and key.
     static py::exception<InputError> input_error(mod, "InputError", PyExc_ValueError);
     static py::exception<NumericalError> numerical_error(mod, "NumericalError", PyExc_RuntimeError);
@@ -258,10 +375,17 @@ PYBIND11_MODULE(_bbm, mod) {
             numerical_error(e.what());
         }
     });
+}
 
+/// FieldGroup: any group of the state list.
+void bind_field_group(py::module_& mod) {
     group_class<FieldGroup>(mod, "FieldGroup",
                             "A group of the state list (Model.group(prefix)): every field '<prefix>.*' of "
                             "Model.state_fields() as an attribute, a fresh copy");
+}
+
+/// BlockArrays: Model.blocks.
+void bind_block_arrays(py::module_& mod) {
     group_class<BlockArrays>(mod, "BlockArrays",
                              "Per-block arrays (N = blocks, excavated ones included): every field 'blocks.*' of "
                              "Model.state_fields() (centroid, velocity, theta, omega, mass, area, region, …) as a "
@@ -292,7 +416,10 @@ PYBIND11_MODULE(_bbm, mod) {
                 for (int k = 0; k < 3; ++k) o(i, k) = s[i][k];
             return out;
         }, "N×3 block-averaged stress sxx, syy, sxy, Pa, tension positive (SPEC §7; computed)");
+}
 
+/// ContactArrays: Model.contacts.
+void bind_contact_arrays(py::module_& mod) {
     using contact::Contacts;
     group_class<ContactArrays>(mod, "ContactArrays",
                                "Per-contact arrays (M = contacts now): every field 'contacts.*' of "
@@ -339,21 +466,15 @@ PYBIND11_MODULE(_bbm, mod) {
                 *o = c.wet() ? c.fluid_pressure[i] : 0.0;
             });
         }, "M water pressures on the contacts, Pa ([flow]; 0 in a dry model): the law's normal_stress is the effective one")
-        .def_property_readonly("aperture", [](const ContactArrays& a) {
-            const World& w = world_of(a);
-            const auto values = w.flow ? contact_apertures(*w.flow, contacts(w)) : std::vector<double>(w.contacts.size(), 0.0);
-            auto out = fresh<double>(py::ssize_t(values.size()), 0);
-            std::copy(values.begin(), values.end(), out.mutable_data());
-            return out;
-        }, "M hydraulic apertures of the contacts' joints, m ([flow]; 0: none or sealed)")
-        .def_property_readonly("edge_parameter", [](const ContactArrays& a) {
-            return per_contact<double>(a, [](const World& w, const Contacts& c, int i, double* o) {
-                const auto& v = w.vertices.position;
-                const Vec2 p = v[c.edge_id[i]], e = v[c.edge_end[i]] - p;
-                *o = dot(v[c.vertex_id[i]] - p, e) / dot(e, e);
-            });
-        }, "M positions of the vertex along its edge, 0 to 1 (outside: a vertex past the edge's end, on the rounded corner)");
+        .def_property_readonly("aperture", &contact_aperture,
+                               "M hydraulic apertures of the contacts' joints, m ([flow]; 0: none or sealed)")
+        .def_property_readonly("edge_parameter", &contact_edge_parameter,
+                               "M positions of the vertex along its edge, 0 to 1 (outside: a vertex past the edge's "
+                               "end, on the rounded corner)");
+}
 
+/// ZoneArrays: Model.zones.
+void bind_zone_arrays(py::module_& mod) {
     group_class<ZoneArrays>(mod, "ZoneArrays",
                             "Per-zone arrays of deformable blocks (K = constant-strain triangles): every field "
                             "'zones.*' of Model.state_fields() (node, stress, strain, block, …) as a read-only numpy "
@@ -390,7 +511,10 @@ PYBIND11_MODULE(_bbm, mod) {
                 o(i) = 0.5 * cross(p[z.node[i][1]] - p[z.node[i][0]], p[z.node[i][2]] - p[z.node[i][0]]);
             return out;
         }, "K current areas, m² (computed)");
+}
 
+/// NodeArrays: Model.nodes.
+void bind_node_arrays(py::module_& mod) {
     group_class<NodeArrays>(mod, "NodeArrays",
                             "Per-node arrays of deformable blocks: every field 'nodes.*' of Model.state_fields() "
                             "(position, velocity, mass, …) as a read-only numpy view")
@@ -405,7 +529,10 @@ PYBIND11_MODULE(_bbm, mod) {
             }
             return out;
         }, "n×2 displacements since the start, m (computed)");
+}
 
+/// SupportArrays: one registered support type, Model.<type>.
+void bind_support_arrays(py::module_& mod) {
     group_class<SupportArrays>(mod, "SupportArrays",
                                "One registered support type (a property of Model per type of the registry, "
                                "core/supports/registry.hpp): every field '<type>.*' of Model.state_fields() "
@@ -455,7 +582,10 @@ PYBIND11_MODULE(_bbm, mod) {
             });
             return names;
         }, "Its sets (model-file tables) by name, in file order");
+}
 
+/// Model: its construction, its runs and checkpoints, its summary and VTK output.
+py::class_<Model> bind_model_runs(py::module_& mod) {
     py::class_<Model> model(mod, "Model");
     model
         .def(py::init([](const std::string& path, int threads, double max_elements) {
@@ -491,7 +621,13 @@ PYBIND11_MODULE(_bbm, mod) {
         .def("summary", [](const Model& m) { return json_to_python(m.summary()); },
              "The dict of summary.json (as `bbm run` writes it) for the state now.")
         .def("write_vtk", [](const Model& m, const std::filesystem::path& dir) { m.write_vtk(dir); }, py::arg("dir"),
-             "Writes DIR/blocks.vtu, contacts.vtu and result.pvd of the state now, for ParaView.")
+             "Writes DIR/blocks.vtu, contacts.vtu and result.pvd of the state now, for ParaView.");
+    return model;
+}
+
+/// Model's arrays: blocks, contacts, zones, nodes, any group of the state list, the water in the joints.
+void add_model_groups(py::class_<Model>& model) {
+    model
         .def_property_readonly("blocks", [](py::object self) { return group_of<BlockArrays>(self, "blocks", true); })
         .def_property_readonly("contacts", [](py::object self) { return group_of<ContactArrays>(self, "contacts", false); })
         .def_property_readonly("zones", [](py::object self) { return group_of<ZoneArrays>(self, "zones", true); })
@@ -500,32 +636,15 @@ PYBIND11_MODULE(_bbm, mod) {
             return group_of<FieldGroup>(self, prefix, false);
         }, py::arg("prefix"), "Any group of the state list (Model.state_fields(): 'relax', 'detection', 'flow', "
                               "…) with its fields as attributes (fresh copies)")
-        .def_property_readonly("flow", [](const Model& m) -> py::object {
-            const auto& flow = m.solver().world().flow;
-            if (!flow) return py::none();
-            const JointFlow* f = &*flow;
-            const auto& net = f->net;
-            const auto& st = f->state;
-            auto domains = fresh<double>(net.domains(), 2), pressure = fresh<double>(net.domains(), 0);
-            auto aperture = fresh<double>(net.pipes(), 0), rate = fresh<double>(net.pipes(), 0);
-            auto pipes = fresh<std::int32_t>(net.pipes(), 2);
-            const auto q = flow::pipe_flows(net, f->fluid, st);
-            for (int d = 0; d < net.domains(); ++d) {
-                domains.mutable_data()[2 * d] = net.domain_position[d].x, domains.mutable_data()[2 * d + 1] = net.domain_position[d].y;
-                pressure.mutable_data()[d] = st.pressure[d];
-            }
-            for (int k = 0; k < net.pipes(); ++k) {
-                aperture.mutable_data()[k] = flow::hydraulic_aperture(f->fluid, st.aperture[k]);
-                rate.mutable_data()[k] = q[k];
-                pipes.mutable_data()[2 * k] = net.pipe_from[k], pipes.mutable_data()[2 * k + 1] = net.pipe_to[k];
-            }
-            py::dict d;
-            d["domain_position"] = domains, d["pressure"] = pressure, d["pipes"] = pipes, d["aperture"] = aperture;
-            d["flow_rate"] = rate, d["inflow"] = inflow(*f);
-            return d;
-        }, "Water in the joints ([flow]; None when dry), copied: domain_position (D×2, m), pressure (D, Pa), pipes "
-           "(P×2 domains), aperture (P, m), flow_rate (P, m²/s per m, from the first domain to the second), inflow "
-           "(into the drained openings, m²/s per m)")
+        .def_property_readonly("flow", &flow_arrays,
+                               "Water in the joints ([flow]; None when dry), copied: domain_position (D×2, m), "
+                               "pressure (D, Pa), pipes (P×2 domains), aperture (P, m), flow_rate (P, m²/s per m, "
+                               "from the first domain to the second), inflow (into the drained openings, m²/s per m)");
+}
+
+/// Model's clock, state list, hash, cracks, stages and names.
+void add_model_state(py::class_<Model>& model) {
+    model
         .def_property_readonly("steps", [](const Model& m) { return m.solver().world().clock.steps; })
         .def_property_readonly("time", [](const Model& m) { return m.solver().world().clock.time; })
         .def_property_readonly("unbalanced_ratio", [](const Model& m) { return m.solver().world().clock.ratio; })
@@ -565,7 +684,10 @@ PYBIND11_MODULE(_bbm, mod) {
         .def_property_readonly("region_names", [](const Model& m) { return m.solver().world().region_names; })
         .def_property_readonly("property_names", [](const Model& m) { return m.solver().world().properties.names; })
         .def_property_readonly("name", &Model::name);
-    // One property per registered support type (core/supports/registry.hpp).
+}
+
+/// One property per registered support type (core/supports/registry.hpp).
+void add_support_properties(py::class_<Model>& model) {
     static std::deque<std::string> words; // its name and doc, alive with the module
     for_each_support_type([&](auto type) {
         using T = typename decltype(type)::type;
@@ -575,50 +697,22 @@ PYBIND11_MODULE(_bbm, mod) {
             name.c_str(), [](py::object self) { return group_of<SupportArrays>(self, std::string(T::name), false); },
             doc.c_str());
     });
+}
 
+/// Model and its properties.
+void bind_model(py::module_& mod) {
+    py::class_<Model> model = bind_model_runs(mod);
+    add_model_groups(model);
+    add_model_state(model);
+    add_support_properties(model);
+}
+
+/// The lab tests, envelope, shear and calibration: their summaries and curves.
+void bind_lab_tests(py::module_& mod) {
     mod.def("_labtest", [](const std::string& command, const std::vector<std::string>& args, bool quiet,
                            std::optional<py::function> callback) {
-        studies::LabTestStudy study;
-        std::function<void(const Solver&, const StressStrainPoint&, int)> on_frame;
-        std::optional<py::error_already_set> failure;
-        std::mutex once; // realizations on several threads: one callback at a time
-        if (callback)
-            on_frame = [&](const Solver& s, const StressStrainPoint& p, int realization) {
-                std::lock_guard lock(once);
-                py::gil_scoped_acquire gil;
-                if (failure) return;
-                try {
-                    (*callback)(frame_snapshot(s, p, realization));
-                } catch (py::error_already_set& e) {
-                    failure.emplace(std::move(e));
-                }
-            };
-        {
-            py::gil_scoped_release release;
-            study = cli::run_labtest_args(command, args, quiet, on_frame);
-        }
-        if (failure) throw std::move(*failure);
-        py::list curves;
-        for (const auto& r : study.results) {
-            const auto n = py::ssize_t(r.curve.size());
-            auto step = fresh<std::int64_t>(n);
-            auto axial_strain = fresh<double>(n), axial_stress = fresh<double>(n), lateral_strain = fresh<double>(n);
-            auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
-            auto ratio = fresh<double>(n), rate = fresh<double>(n);
-            for (py::ssize_t i = 0; i < n; ++i) {
-                const auto& p = r.curve[i];
-                step.mutable_at(i) = p.step, axial_strain.mutable_at(i) = p.axial_strain;
-                axial_stress.mutable_at(i) = p.axial_stress, lateral_strain.mutable_at(i) = p.lateral_strain;
-                tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
-                ratio.mutable_at(i) = p.unbalanced_ratio, rate.mutable_at(i) = p.strain_per_step;
-            }
-            py::dict c;
-            c["step"] = step, c["axial_strain"] = axial_strain, c["axial_stress"] = axial_stress;
-            c["lateral_strain"] = lateral_strain, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
-            c["unbalanced_ratio"] = ratio, c["strain_per_step"] = rate;
-            curves.append(c);
-        }
-        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), curves);
+        const studies::LabTestStudy study = run_labtest_study(command, args, quiet, callback);
+        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), labtest_curves(study));
     }, py::arg("command"), py::arg("args"), py::arg("quiet"), py::arg("callback") = py::none());
     mod.def("_envelope", [](const std::vector<std::string>& args, bool quiet) {
         std::string json;
@@ -634,25 +728,7 @@ PYBIND11_MODULE(_bbm, mod) {
             py::gil_scoped_release release;
             study = cli::run_shear_args(args, quiet);
         }
-        // Every run's curve as numpy arrays, in the order of summary["runs"].
-        py::list curves;
-        for (const auto& r : study.results) {
-            const auto n = py::ssize_t(r.curve.size());
-            auto step = fresh<std::int64_t>(n);
-            auto u = fresh<double>(n), tau = fresh<double>(n), sn = fresh<double>(n), dv = fresh<double>(n);
-            auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
-            for (py::ssize_t i = 0; i < n; ++i) {
-                const auto& p = r.curve[i];
-                step.mutable_at(i) = p.step, u.mutable_at(i) = p.displacement, tau.mutable_at(i) = p.shear_stress;
-                sn.mutable_at(i) = p.normal_stress, dv.mutable_at(i) = p.dilation;
-                tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
-            }
-            py::dict c;
-            c["step"] = step, c["shear_displacement"] = u, c["shear_stress"] = tau, c["normal_stress"] = sn;
-            c["dilation"] = dv, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
-            curves.append(c);
-        }
-        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), curves);
+        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), shear_curves(study));
     });
     mod.def("_calibrate", [](const std::vector<std::string>& args, bool quiet) {
         std::string json;
@@ -662,4 +738,19 @@ PYBIND11_MODULE(_bbm, mod) {
         }
         return py::module_::import("json").attr("loads")(json);
     });
+}
+
+} // namespace
+
+PYBIND11_MODULE(_bbm, mod) {
+    mod.doc() = "bbm: bonded-block models of rock failure (2D, plane strain) — the compiled core of the bbm package";
+    bind_errors(mod);
+    bind_field_group(mod);
+    bind_block_arrays(mod);
+    bind_contact_arrays(mod);
+    bind_zone_arrays(mod);
+    bind_node_arrays(mod);
+    bind_support_arrays(mod);
+    bind_model(mod);
+    bind_lab_tests(mod);
 }

@@ -85,6 +85,24 @@ def code_words(texts):
     return words, string_words
 
 
+def missing_paths(top, text):
+    """The project paths a text names that do not exist."""
+    out = []
+    for m in PATH.finditer(text):
+        p = m.group(1).rstrip(".")
+        # A glob (examples/tunnel_*.toml) names files that start so; a module
+        # (io/model_input, core/bolts.*) its .hpp and .cpp.
+        glob_like = text[m.end():m.end() + 1] in ("*", "<", "{")
+        found = os.path.exists(os.path.join(top, p)) or any(
+            os.path.exists(os.path.join(top, p + ext)) for ext in (".hpp", ".cpp"))
+        if glob_like:
+            folder, stem = os.path.split(os.path.join(top, p))
+            found = os.path.isdir(folder) and any(f.startswith(stem) for f in os.listdir(folder))
+        if not found:
+            out.append(f"{p}: no such file or folder")
+    return out
+
+
 def comments(text):
     """(line, comment text) of each comment."""
     for m in COMMENT.finditer(text):
@@ -123,18 +141,7 @@ def check(top):
         if rel.endswith(".hpp") and layer in LAYERS[:8] and not re.match(r"// bbm " + layer + r"(, internal)?: ", text):
             problems.append(f"{rel}:1: its first line is not '// bbm {layer}: what it is for'")
         for line, comment in comments(text):
-            for m in PATH.finditer(comment):
-                p = m.group(1).rstrip(".")
-                # A glob (examples/tunnel_*.toml) names files that start so; a
-                # module (io/model_input) its .hpp and .cpp.
-                glob_like = comment[m.end():m.end() + 1] in ("*", "<", "{")
-                found = os.path.exists(os.path.join(top, p)) or any(
-                    os.path.exists(os.path.join(top, p + ext)) for ext in (".hpp", ".cpp"))
-                if glob_like:
-                    folder, stem = os.path.split(os.path.join(top, p))
-                    found = os.path.isdir(folder) and any(f.startswith(stem) for f in os.listdir(folder))
-                if not found:
-                    problems.append(f"{rel}:{line}: {p}: no such file or folder")
+            problems += [f"{rel}:{line}: {p}" for p in missing_paths(top, comment)]
             named = set(BACKTICK.findall(comment)) | set(CALLED.findall(comment)) | set(QUALIFIED.findall(comment))
             named |= set(snake_names(comment))
             for name in sorted(named):
@@ -149,9 +156,25 @@ def check(top):
     return problems
 
 
+def check_docs(top):
+    """The pages of docs/ (not its dated notes, nor the history) name files that exist."""
+    problems = []
+    pages = [os.path.join(top, "README.md")]
+    for root, _, files in os.walk(os.path.join(top, "docs")):
+        if os.sep + "notes" in root:
+            continue
+        pages += [os.path.join(root, f) for f in files if f.endswith(".md")]
+    for page in sorted(pages):
+        rel = os.path.relpath(page, top)
+        with open(page, encoding="utf-8") as f:
+            for number, text in enumerate(f, 1):
+                problems += [f"{rel}:{number}: {p}" for p in missing_paths(top, text)]
+    return problems
+
+
 def main():
     top = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    problems = check(top)
+    problems = check(top) + check_docs(top)
     for p in problems:
         print(p)
     if problems:

@@ -1613,6 +1613,36 @@ TEST_CASE("the water tables ([flow], [[flow_boundary]], [[flow_source]]) refuse 
                 "history[0].quantity", "needs a [flow] table");
 }
 
+TEST_CASE("a position or a length in another unit is refused with file, line and key, not snapped to the model") {
+    // The region spans [-1, 1] m with 0.3 m blocks: a point typed in millimetres is
+    // 500 model sizes away, a length in millimetres a thousand blocks long.
+    const std::string base = std::string(one_region);
+    const std::string far = "far outside the model (its regions span [-1, -1] to [1, 1])";
+    check_error(base + "[[history]]\nname = \"ux\"\nquantity = \"displacement_x\"\npoint = [1000.0, 0.0]\n",
+                "point = [1000.0", "history[0].point", far);
+    check_error(base + "[report]\ncenter = [0, 0]\nspringline = [1000, 0]\ncrown = [0, 1]\n", "springline",
+                "report.springline", far);
+    check_error(base + "[report]\nwindow = { min = [2000, 2000], max = [3000, 3000] }\n", "window", "report.window",
+                far);
+    check_error(base + "[[boundary]]\nname = \"top\"\ntype = \"velocity\"\nbox = { min = [-1000, 990], max = [1000, "
+                       "1010] }\nvy = 0.0\n",
+                "box = ", "boundary[0].box", far);
+    check_error(base + "[flow]\n\n[[flow_source]]\nat = [0, 500]\nrate = 1e-6\n", "at = [0, 500]", "flow_source[0].at",
+                far);
+    check_error(base + "[flow]\n\n[[flow_boundary]]\nname = \"top\"\nbox = { min = [0, 900], max = [1, 1100] }\n"
+                       "pressure = 1e5\n",
+                "box = ", "flow_boundary[0].box", far);
+    check_error(base + "[solver]\ncorner_radius = 2.0\n", "corner_radius", "solver.corner_radius",
+                "is not below 0.5 of the model's smallest block size (0.3 m)");
+    check_error(base + "[solver]\ndetection_tolerance = 5.0\n", "detection_tolerance", "solver.detection_tolerance",
+                "is not below 1 of the model's smallest block size (0.3 m)");
+    // A box may reach far beyond the model to take all of one side, and a level
+    // (a boundary's y_ref) may lie far above it (the ground surface): both are right.
+    CHECK_NOTHROW(parse_model(base + "[[boundary]]\nname = \"top\"\ntype = \"stress\"\nbox = { min = [-1e6, 0.9], "
+                                     "max = [1e6, 1e6] }\nsyy = -1e6\ny_ref = 500.0\ndsyy_dy = 2.7e4\n",
+                              "t.toml"));
+}
+
 TEST_CASE("a pressurise stage needs an opening excavated with a pressure before it, and says so with file, line and key") {
     const std::string base = std::string(one_region);
     check_error(base + "[[stage]]\ntype = \"pressurise\"\npressure = 1e6\n", "type = \"pressurise\"", "stage[0].type",

@@ -14,6 +14,7 @@
 #include "core/material_keys.hpp"
 #include "core/solver_keys.hpp"
 #include "core/stage_keys.hpp"
+#include "core/step.hpp"
 #include "io/model_input.hpp"
 #include "meshing/dfn_keys.hpp"
 #include "meshing/model_keys.hpp"
@@ -113,6 +114,30 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     check_reference("model.md", meshing::model_keys_markdown());
     check_reference("region.md", meshing::region_keys_markdown());
     check_reference("dfn.md", meshing::dfn_keys_markdown());
+}
+
+TEST_CASE("docs/architecture.md lists the stages of the step as core/step.cpp's table has them") {
+    // The page's copy sits between two markers; BBM_WRITE_REFERENCE=1 rewrites it.
+    const auto file = reference_dir.parent_path() / "architecture.md";
+    std::ifstream in(file);
+    REQUIRE(in.good());
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string page = text.str();
+    const std::string begin = "<!-- stages: generated from core/step.cpp's table (tests/test_reference.cpp) -->\n",
+                      end = "<!-- /stages -->";
+    const auto a = page.find(begin), b = page.find(end);
+    const std::string no_list = file.string() + " has no stage list between its markers",
+                      stale = file.string() + "'s stage list is stale: run this test with BBM_WRITE_REFERENCE=1";
+    REQUIRE_MESSAGE(a != std::string::npos, no_list);
+    REQUIRE(b != std::string::npos);
+    const std::string generated = step_stages_markdown();
+    if (std::getenv("BBM_WRITE_REFERENCE")) {
+        page.replace(a + begin.size(), b - a - begin.size(), generated);
+        std::ofstream(file) << page;
+        return;
+    }
+    CHECK_MESSAGE(page.substr(a + begin.size(), b - a - begin.size()) == generated, stale);
 }
 
 TEST_CASE("A key and its flag refuse the same values in the same words") {

@@ -106,55 +106,69 @@ std::vector<std::pair<double, double>> hoek_brown_targets(double sigma_ci, doubl
     return points;
 }
 
-CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
-                                              std::uint64_t first_seed, const std::vector<double>& confinements) {
-    const auto t0 = std::chrono::steady_clock::now();
+namespace {
+
+/// A run of measure_macro_properties, as it travels between ranks under mpirun:
+/// the five numbers used of it.
+struct MeasuredRun {
+    double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0;
+    int still_loading = 0;
+};
+
+/// Run k's test: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests
+/// at each confinement.
+LabTestOptions calibration_run(const JointPropertySpec& joint, const CalibrationOptions& o, std::uint64_t first_seed,
+                               const std::vector<double>& confinements, bool one_at_a_time, int k) {
     const int n = o.realizations;
-    // Runs k: UCS (k < n), direct tension (n ≤ k < 2n), then n biaxial tests at
-    // each confinement; shared among the threads and ranks.
-    const int runs = (2 + int(confinements.size())) * n;
+    LabTestOptions lo = o.base;
+    lo.rock.bonds = joint;
+    lo.rock.pattern.seed = first_seed + std::uint64_t(k % n);
+    lo.threads = one_at_a_time ? o.threads : 1;
+    if (k < n) {
+        lo.kind = LabTestOptions::Kind::ucs;
+    } else if (k < 2 * n) {
+        lo.kind = LabTestOptions::Kind::tension;
+        lo.strain_per_step = 0.1 * o.base.strain_per_step; // its peak comes at a tenth of the strain
+        lo.platen_friction = -1.0;                           // tension needs platens that hold
+    } else {
+        lo.kind = LabTestOptions::Kind::biaxial;
+        const std::size_t c = std::size_t(k / n - 2);
+        lo.confinement = confinements[c];
+        as_envelope_confined_test(lo); // as bbm envelope: a confined peak is final once failed
+    }
+    return lo;
+}
+
+/// Every run of the tests, shared among the threads and ranks; every rank gets
+/// every result.
+std::vector<MeasuredRun> run_calibration_tests(const JointPropertySpec& joint, const CalibrationOptions& o,
+                                               std::uint64_t first_seed, const std::vector<double>& confinements) {
+    const int runs = (2 + int(confinements.size())) * o.realizations;
     // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
     const bool one_at_a_time = o.base.rock.material.deformable_fraction > 0.0;
-    // Each run travels (between ranks under mpirun) as the five numbers used here.
-    struct Measured {
-        double E = 0, nu = 0, peak_stress = 0, crack_initiation = 0;
-        int still_loading = 0;
-    };
     auto run = [&](int k) -> std::string {
-        LabTestOptions lo = o.base;
-        lo.rock.bonds = joint;
-        lo.rock.pattern.seed = first_seed + std::uint64_t(k % n);
-        lo.threads = one_at_a_time ? o.threads : 1;
-        if (k < n) {
-            lo.kind = LabTestOptions::Kind::ucs;
-        } else if (k < 2 * n) {
-            lo.kind = LabTestOptions::Kind::tension;
-            lo.strain_per_step = 0.1 * o.base.strain_per_step; // its peak comes at a tenth of the strain
-            lo.platen_friction = -1.0;                           // tension needs platens that hold
-        } else {
-            lo.kind = LabTestOptions::Kind::biaxial;
-            const std::size_t c = std::size_t(k / n - 2);
-            lo.confinement = confinements[c];
-            as_envelope_confined_test(lo); // as bbm envelope: a confined peak is final once failed
-        }
-        const LabTestResult r = run_labtest(lo);
+        const LabTestResult r = run_labtest(calibration_run(joint, o, first_seed, confinements, one_at_a_time, k));
         char text[128];
         std::snprintf(text, sizeof text, "%.17g %.17g %.17g %.17g %d", r.E, r.nu, r.peak_stress,
                       r.crack_initiation_stress, int(r.still_loading));
         return text;
     };
-    // Runs over ranks and threads; every rank gets every result.
-    std::vector<Measured> measured(static_cast<std::size_t>(runs));
+    std::vector<MeasuredRun> measured(static_cast<std::size_t>(runs));
     const auto texts = studies::run_spread(runs, one_at_a_time ? 1 : o.threads, run);
     for (int k = 0; k < runs; ++k) {
-        Measured& m = measured[std::size_t(k)];
+        MeasuredRun& m = measured[std::size_t(k)];
         if (std::sscanf(texts[k].c_str(), "%lf %lf %lf %lf %d", &m.E, &m.nu, &m.peak_stress, &m.crack_initiation,
                         &m.still_loading) != 5)
             throw std::runtime_error("calibration: a run's result did not arrive");
     }
-    CalibrationIteration it;
-    for (const Measured& m : measured) it.still_loading += m.still_loading;
-    it.joint = joint;
+    return measured;
+}
+
+/// The tests' means and spreads: the UCS tests' modulus, σci/UCS and peak, the
+/// tension tests' peak, the biaxial tests' peak at each confinement.
+void set_test_measures(CalibrationIteration& it, const std::vector<MeasuredRun>& measured, int n,
+                       const std::vector<double>& confinements) {
+    for (const MeasuredRun& m : measured) it.still_loading += m.still_loading;
     std::vector<double> E, peak, ten, ci;
     for (int k = 0; k < n; ++k) {
         E.push_back(measured[k].E), peak.push_back(measured[k].peak_stress);
@@ -163,18 +177,6 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
     }
     mean_std(E, it.E_test, it.E_test_std);
     mean_std(ci, it.ci_ratio, it.ci_ratio_std);
-    // E and ν from the elastic solve of each realization: the initial slope and
-    // the lateral strain of a cracking specimen are too noisy to steer by.
-    std::vector<double> nu;
-    E.clear();
-    for (int k = 0; k < n; ++k) {
-        LabTestOptions lo = o.base;
-        lo.rock.pattern.seed = first_seed + std::uint64_t(k);
-        const auto m = elastic_measure(joint, lo);
-        E.push_back(m.E), nu.push_back(m.nu);
-    }
-    mean_std(E, it.E, it.E_std);
-    mean_std(nu, it.nu, it.nu_std);
     mean_std(peak, it.ucs, it.ucs_std);
     mean_std(ten, it.tensile, it.tensile_std);
     for (std::size_t c = 0; c < confinements.size(); ++c) {
@@ -184,6 +186,33 @@ CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, co
         mean_std(s1, mean, sd);
         it.confined.push_back(mean), it.confined_std.push_back(sd);
     }
+}
+
+/// E and ν from the elastic solve of each realization: the initial slope and
+/// the lateral strain of a cracking specimen are too noisy to steer by.
+void set_elastic_measures(CalibrationIteration& it, const JointPropertySpec& joint, const CalibrationOptions& o,
+                          std::uint64_t first_seed) {
+    std::vector<double> E, nu;
+    for (int k = 0; k < o.realizations; ++k) {
+        LabTestOptions lo = o.base;
+        lo.rock.pattern.seed = first_seed + std::uint64_t(k);
+        const auto m = elastic_measure(joint, lo);
+        E.push_back(m.E), nu.push_back(m.nu);
+    }
+    mean_std(E, it.E, it.E_std);
+    mean_std(nu, it.nu, it.nu_std);
+}
+
+} // namespace
+
+CalibrationIteration measure_macro_properties(const JointPropertySpec& joint, const CalibrationOptions& o,
+                                              std::uint64_t first_seed, const std::vector<double>& confinements) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<MeasuredRun> measured = run_calibration_tests(joint, o, first_seed, confinements);
+    CalibrationIteration it;
+    it.joint = joint;
+    set_test_measures(it, measured, o.realizations, confinements);
+    set_elastic_measures(it, joint, o, first_seed);
     it.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return it;
 }
@@ -297,6 +326,63 @@ std::array<double, K> bounded_step(const std::vector<double>& predicted, const s
     return next;
 }
 
+/// A sample's unknowns: ln c, φ and, with a cap (K = 3), φ2.
+template <int K>
+std::array<double, K> strength_coordinates(const StrengthSample& sample) {
+    std::array<double, K> x{sample.log_cohesion, sample.friction};
+    if constexpr (K == 3) x[2] = sample.confined_friction;
+    return x;
+}
+
+/// Coulomb's slopes of ln σ1 at the last sample for the measure at confinement
+/// s3 (s1 its strength there, `ucs` the UCS; φ, N = (1 + sin φ)/(1 − sin φ)):
+/// UCS = 2c√N, σ1 = UCS + N σ3, d ln √N/dφ = 1/cos φ, d ln N/dφ = 2/cos φ (per
+/// radian). With a cap in two pieces, the friction's slope is shared between φ and
+/// φ2 by where the normal stress on the Coulomb failure plane, (σ1 + σ3)/2 − (σ1 −
+/// σ3)/2 sin φ, lies against σ*: a prior only, the measured planes take over.
+template <int K>
+std::array<double, K> coulomb_prior(double phi, double n_phi, double ucs, double s1, double s3, double sigma_star) {
+    constexpr double deg = std::numbers::pi / 180.0;
+    std::array<double, K> prior{ucs / s1, (ucs / std::cos(phi) + s3 * n_phi * 2.0 / std::cos(phi)) * deg / s1};
+    if constexpr (K == 3) {
+        const double normal_stress = 0.5 * (s1 + s3) - 0.5 * (s1 - s3) * std::sin(phi);
+        const double above = std::clamp(1.0 - sigma_star / normal_stress, 0.0, 1.0);
+        prior[2] = prior[1] * above, prior[1] *= 1.0 - above;
+    }
+    return prior;
+}
+
+/// The plane of measure m's ln strength over the unknowns, in coordinates centred
+/// on the last sample `at`: (its prediction there, its slopes), fitted to the
+/// samples and a prior on each slope; none when the fit is singular.
+template <int K>
+std::optional<std::array<double, K + 1>> strength_plane(const std::vector<StrengthSample>& history, std::size_t m,
+                                                        const std::array<double, K>& at,
+                                                        const std::array<double, K>& prior) {
+    constexpr double prior_c = 0.5, prior_phi = 3.0; // the prior rows' weights: ln c and degrees
+    // Normal equations of the rows: the samples (1, x − x_last) → ln s, then a
+    // prior on each slope.
+    std::array<std::array<double, K + 2>, K + 1> normal{};
+    auto add_row = [&normal](const std::array<double, K + 1>& row, double y) {
+        for (int r = 0; r <= K; ++r) {
+            for (int c = 0; c <= K; ++c) normal[r][c] += row[r] * row[c];
+            normal[r][K + 1] += row[r] * y;
+        }
+    };
+    for (const auto& sample : history) {
+        const std::array<double, K> x = strength_coordinates<K>(sample);
+        std::array<double, K + 1> row{1.0};
+        for (int k = 0; k < K; ++k) row[k + 1] = x[k] - at[k];
+        add_row(row, sample.log_strength[m]);
+    }
+    for (int k = 0; k < K; ++k) {
+        std::array<double, K + 1> row{};
+        row[k + 1] = k == 0 ? prior_c : prior_phi;
+        add_row(row, row[k + 1] * prior[k]);
+    }
+    return solve_small<K + 1>(normal);
+}
+
 /// The strength step of next_cohesion_friction (K = 2: ln c, φ) and next_bond_cap
 /// (K = 3: ln c, φ, φ2 above σ*): the unknowns after the step, in that order.
 template <int K>
@@ -308,20 +394,9 @@ std::array<double, K> strength_step(const std::vector<StrengthSample>& history, 
     const std::size_t measures = log_target.size();
     if (last.log_strength.size() != measures || sigma3.size() + 1 != measures)
         throw std::logic_error("strength step: a UCS and one σ1 per confinement");
-    auto coordinates = [](const StrengthSample& sample) {
-        std::array<double, K> x{sample.log_cohesion, sample.friction};
-        if constexpr (K == 3) x[2] = sample.confined_friction;
-        return x;
-    };
-    const std::array<double, K> at = coordinates(last);
-    // Coulomb's slopes at the last sample: UCS = 2c√N, σ1 = UCS + N σ3,
-    // d ln √N/dφ = 1/cos φ, d ln N/dφ = 2/cos φ (per radian). With a cap in two
-    // pieces, the friction's slope is shared between φ and φ2 by where the normal
-    // stress on the Coulomb failure plane, (σ1 + σ3)/2 − (σ1 − σ3)/2 sin φ, lies
-    // against σ*: a prior only, the measured planes take over.
+    const std::array<double, K> at = strength_coordinates<K>(last);
     const double phi = last.friction * deg, n_phi = (1.0 + std::sin(phi)) / (1.0 - std::sin(phi));
     const double ucs = std::exp(last.log_strength[0]);
-    constexpr double prior_c = 0.5, prior_phi = 3.0; // the prior rows' weights: ln c and degrees
     // Each plane in coordinates centred on the last sample, (1, x − x_last): its
     // intercept is the strength predicted there, and the normal equations stay well
     // conditioned. Small systems solved by hand: Eigen here would put its template
@@ -331,33 +406,7 @@ std::array<double, K> strength_step(const std::vector<StrengthSample>& history, 
     std::vector<std::array<double, K>> slope(measures);
     for (std::size_t m = 0; m < measures; ++m) {
         const double s3 = m == 0 ? 0.0 : sigma3[m - 1], s1 = std::exp(last.log_strength[m]);
-        std::array<double, K> prior{ucs / s1, (ucs / std::cos(phi) + s3 * n_phi * 2.0 / std::cos(phi)) * deg / s1};
-        if constexpr (K == 3) {
-            const double normal_stress = 0.5 * (s1 + s3) - 0.5 * (s1 - s3) * std::sin(phi);
-            const double above = std::clamp(1.0 - sigma_star / normal_stress, 0.0, 1.0);
-            prior[2] = prior[1] * above, prior[1] *= 1.0 - above;
-        }
-        // Normal equations of the rows: the samples (1, x − x_last) → ln s, then a
-        // prior on each slope.
-        std::array<std::array<double, K + 2>, K + 1> normal{};
-        auto add_row = [&normal](const std::array<double, K + 1>& row, double y) {
-            for (int r = 0; r <= K; ++r) {
-                for (int c = 0; c <= K; ++c) normal[r][c] += row[r] * row[c];
-                normal[r][K + 1] += row[r] * y;
-            }
-        };
-        for (const auto& sample : history) {
-            const std::array<double, K> x = coordinates(sample);
-            std::array<double, K + 1> row{1.0};
-            for (int k = 0; k < K; ++k) row[k + 1] = x[k] - at[k];
-            add_row(row, sample.log_strength[m]);
-        }
-        for (int k = 0; k < K; ++k) {
-            std::array<double, K + 1> row{};
-            row[k + 1] = k == 0 ? prior_c : prior_phi;
-            add_row(row, row[k + 1] * prior[k]);
-        }
-        const auto fit = solve_small<K + 1>(normal);
+        const auto fit = strength_plane<K>(history, m, at, coulomb_prior<K>(phi, n_phi, ucs, s1, s3, sigma_star));
         if (!fit) return at;
         predicted[m] = (*fit)[0];
         for (int k = 0; k < K; ++k) slope[m][k] = (*fit)[k + 1];
@@ -406,11 +455,11 @@ double stiffness_ratio_step(double ratio, double nu, double prev_ratio, double p
     return std::clamp((target_nu - nu) / slope, -limit, limit);
 }
 
-std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
-                                            const std::function<void(const CalibrationIteration&)>& report) {
-    std::vector<CalibrationIteration> out;
-    JointPropertySpec j = calibration_start(t, o);
-    double prev_phi2 = -1.0, prev_misfit = 0.0; // φ2 and its misfit at the previous iteration
+namespace {
+
+/// The confined friction's cap where calibrate() fits it (the curvature or the
+/// confined friction), and its start unless given.
+void start_confined_friction(JointPropertySpec& j, const CalibrationTargets& t, const CalibrationOptions& o) {
     if (o.fit_curvature) {
         if (t.envelope.size() < 2) throw std::invalid_argument("a curvature calibration needs two confined targets");
         if (o.fit_confined_friction) throw std::invalid_argument("fit_curvature fits the confined friction itself");
@@ -424,30 +473,45 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         if (j.confined_friction < 0.0) j.confined_friction = std::max(55.0, j.friction);
         if (!(j.confined_friction_from > 0.0)) j.confined_friction_from = t.ucs;
     }
-    const bool with_phi = !t.envelope.empty();
+}
+
+/// calibrate()'s steps from one iteration to the next, each unknown corrected by
+/// the measure it mainly controls, and what they remember of the iterations before.
+struct CalibrationSteps {
+    const CalibrationTargets& t;
+    const CalibrationOptions& o;
     std::vector<double> sigma3, sigma1_target;
-    for (const auto& [s3, s1] : t.envelope) sigma3.push_back(s3), sigma1_target.push_back(s1);
     // The strengths the cohesion and friction steer by, targets and history.
-    std::vector<double> log_strength_target{std::log(t.ucs)};
-    for (double s1 : sigma1_target) log_strength_target.push_back(std::log(s1));
+    std::vector<double> log_strength_target;
     std::vector<StrengthSample> strength_history;
+    bool with_phi = false;
     // σci/UCS by the strength heterogeneity h = 1/m.
-    const bool with_ci = o.fit_ci && t.ci_ratio > 0;
+    bool with_ci = false;
+    double prev_phi2 = -1.0, prev_misfit = 0.0; // φ2 and its misfit at the previous iteration
     double prev_h = -1.0, prev_ci = 0.0;
     double prev_ratio = -1.0, prev_nu = 0.0; // ks/kn and ν of the previous iteration
-    for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
-        CalibrationIteration it = measure_macro_properties(j, o, o.base.rock.pattern.seed, sigma3);
-        it.misfit = calibration_misfit(it, t, with_ci);
-        it.converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
-                       std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&
-                       std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile;
+
+    CalibrationSteps(const CalibrationTargets& targets, const CalibrationOptions& options) : t(targets), o(options) {
+        with_phi = !t.envelope.empty();
+        for (const auto& [s3, s1] : t.envelope) sigma3.push_back(s3), sigma1_target.push_back(s1);
+        log_strength_target.push_back(std::log(t.ucs));
+        for (double s1 : sigma1_target) log_strength_target.push_back(std::log(s1));
+        with_ci = o.fit_ci && t.ci_ratio > 0;
+    }
+
+    /// Every measure within its tolerance.
+    bool converged(const CalibrationIteration& it) const {
+        bool converged = std::abs(it.E / t.E - 1) <= o.tolerance_E && std::abs(it.nu / t.nu - 1) <= o.tolerance_nu &&
+                         std::abs(it.ucs / t.ucs - 1) <= o.tolerance_ucs &&
+                         std::abs(it.tensile / t.tensile - 1) <= o.tolerance_tensile;
         for (std::size_t c = 0; c < sigma3.size(); ++c)
-            it.converged = it.converged && std::abs(it.confined[c] / sigma1_target[c] - 1) <= o.tolerance_envelope;
-        if (with_ci) it.converged = it.converged && std::abs(it.ci_ratio - t.ci_ratio) <= o.tolerance_ci;
-        out.push_back(it);
-        if (report) report(it);
-        if (it.converged) break;
-        // Each unknown corrected by the measure it mainly controls.
+            converged = converged && std::abs(it.confined[c] / sigma1_target[c] - 1) <= o.tolerance_envelope;
+        if (with_ci) converged = converged && std::abs(it.ci_ratio - t.ci_ratio) <= o.tolerance_ci;
+        return converged;
+    }
+
+    /// kn and ks for E and ν, the tensile strength for the tension test's.
+    void step_stiffness_and_tensile(JointPropertySpec& j, const CalibrationIteration& it) {
         const double r = j.ks / j.kn;
         const double r_new = std::clamp(r + stiffness_ratio_step(r, it.nu, prev_ratio, prev_nu, t.nu), 0.02, 1.5);
         prev_ratio = r, prev_nu = it.nu;
@@ -456,6 +520,11 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         j.kn *= (t.E / it.E) * ((1.0 + r) / (3.0 + r)) / ((1.0 + r_new) / (3.0 + r_new));
         j.ks = r_new * j.kn;
         j.tensile *= t.tensile / it.tensile;
+    }
+
+    /// The cohesion for the UCS; with confined targets, the friction (and the
+    /// cap's φ2) for the confined strengths too.
+    void step_shear_strength(JointPropertySpec& j, const CalibrationIteration& it) {
         if (o.fit_confined_friction) {
             // φ and σ* held: the cohesion for the UCS, φ2 for the confined strengths.
             j.cohesion *= t.ucs / it.ucs;
@@ -484,14 +553,38 @@ std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const C
         } else {
             j.cohesion *= t.ucs / it.ucs;
         }
-        if (with_ci && std::abs(it.ci_ratio - t.ci_ratio) > 0.25 * o.tolerance_ci) {
-            const double h = heterogeneity_of(j);
-            const double h_new = next_heterogeneity(prev_h, prev_ci, h, it.ci_ratio, t.ci_ratio);
-            prev_h = h, prev_ci = it.ci_ratio;
-            j.cohesion *= ucs_loss(h) / ucs_loss(h_new);
-            j.tensile *= tension_loss(h) / tension_loss(h_new);
-            j.weibull_modulus = h_new > 1e-6 ? 1.0 / h_new : 0.0;
-        }
+    }
+
+    /// The heterogeneity for σci/UCS, the strengths kept for its loss.
+    void step_heterogeneity(JointPropertySpec& j, const CalibrationIteration& it) {
+        if (!(with_ci && std::abs(it.ci_ratio - t.ci_ratio) > 0.25 * o.tolerance_ci)) return;
+        const double h = heterogeneity_of(j);
+        const double h_new = next_heterogeneity(prev_h, prev_ci, h, it.ci_ratio, t.ci_ratio);
+        prev_h = h, prev_ci = it.ci_ratio;
+        j.cohesion *= ucs_loss(h) / ucs_loss(h_new);
+        j.tensile *= tension_loss(h) / tension_loss(h_new);
+        j.weibull_modulus = h_new > 1e-6 ? 1.0 / h_new : 0.0;
+    }
+};
+
+} // namespace
+
+std::vector<CalibrationIteration> calibrate(const CalibrationTargets& t, const CalibrationOptions& o,
+                                            const std::function<void(const CalibrationIteration&)>& report) {
+    std::vector<CalibrationIteration> out;
+    JointPropertySpec j = calibration_start(t, o);
+    start_confined_friction(j, t, o);
+    CalibrationSteps steps(t, o);
+    for (int iteration = 0; iteration < o.max_iterations; ++iteration) {
+        CalibrationIteration it = measure_macro_properties(j, o, o.base.rock.pattern.seed, steps.sigma3);
+        it.misfit = calibration_misfit(it, t, steps.with_ci);
+        it.converged = steps.converged(it);
+        out.push_back(it);
+        if (report) report(it);
+        if (it.converged) break;
+        steps.step_stiffness_and_tensile(j, it);
+        steps.step_shear_strength(j, it);
+        steps.step_heterogeneity(j, it);
     }
     return out;
 }

@@ -299,6 +299,54 @@ nlohmann::json calibration_record(const CalibrateValues& values, const Calibrati
             {"joint_property_toml", toml}};
 }
 
+/// The broken joints' friction first, on the rubble's: the bonds' confined
+/// strengths depend on it, it hardly on them (residual_friction.hpp). Sets the
+/// bonds' residual friction in `o`; the steps taken (none without a target).
+std::vector<ResidualFrictionStep> calibrate_residual_first(const JointPropertySpec& start,
+                                                          const ResidualFrictionTarget& residual, CalibrationOptions& o,
+                                                          bool quiet) {
+    std::vector<ResidualFrictionStep> residual_steps;
+    if (!(residual.friction > 0.0)) return residual_steps;
+    if (!quiet)
+        std::fprintf(stderr, "the broken joints' friction first: the rubble's friction %.3g deg (within %.2g) on "
+                             "biaxial tests at sigma3 %.4g MPa to %.2g%% strain, with the start's bonds\n",
+                     residual.friction, residual.tolerance, residual.confinement / 1e6, 100 * residual.max_strain);
+    int r = 0;
+    residual_steps = calibrate_residual_friction(start, residual, o, [&](const ResidualFrictionStep& step) {
+        if (!quiet) print_residual_step(++r, step);
+    });
+    o.base.rock.bonds.residual_friction = best_residual_step(residual_steps, residual.friction).residual_friction;
+    if (!quiet)
+        std::fprintf(stderr, "broken joints' friction %.4g deg; now the bonds\n", o.base.rock.bonds.residual_friction);
+    return residual_steps;
+}
+
+/// The calibrated set's rubble on the fresh seeds: the friction it will slide at,
+/// recorded in `calibration`; whether it is within the target's tolerance.
+bool check_fresh_rubble(const CalibrationIteration& last, const ResidualFrictionTarget& residual,
+                        const std::vector<ResidualFrictionStep>& residual_steps, const CalibrationOptions& o, bool quiet,
+                        nlohmann::json& calibration) {
+    const auto fresh_rubble = measure_rubble_friction(last.joint, residual, o, o.base.rock.pattern.seed + 1000);
+    const bool residual_converged = std::abs(fresh_rubble.rubble_friction - residual.friction) <= residual.tolerance &&
+                                    fresh_rubble.unmeasured < o.realizations;
+    if (!quiet) {
+        std::fprintf(stderr, "fresh seeds, the rubble: ");
+        print_residual_step(0, fresh_rubble);
+    }
+    calibration["residual_friction"] = residual_record(residual, residual_steps, fresh_rubble, residual_converged);
+    return residual_converged;
+}
+
+/// joint_property.toml and calibration.json in the output directory.
+void write_calibration_files(const fs::path& out, const std::string& toml, const nlohmann::json& calibration,
+                             bool converged, bool quiet) {
+    io::write_text_atomically(out / "joint_property.toml", toml);
+    io::write_text_atomically(out / "calibration.json", calibration.dump(2) + "\n");
+    if (!quiet)
+        std::fprintf(stderr, "wrote %s/joint_property.toml and calibration.json%s\n", out.string().c_str(),
+                     converged ? "" : " (not converged within the iteration limit)");
+}
+
 } // namespace
 
 /// `bbm calibrate`: iterates the micro-properties and writes the joint property
@@ -316,23 +364,8 @@ int run_calibrate(CalibrateValues& values, bool quiet, bool check_only, std::str
     std::vector<double> sigma3;
     for (const auto& p : targets.envelope) sigma3.push_back(p.first);
     if (!quiet) print_calibration_header(values, o, first, start);
-    // The broken joints' friction first, on the rubble's: the bonds' confined
-    // strengths depend on it, it hardly on them (residual_friction.hpp).
     const ResidualFrictionTarget residual{values.residual_target, values.residual_confinement};
-    std::vector<ResidualFrictionStep> residual_steps;
-    if (residual.friction > 0.0) {
-        if (!quiet)
-            std::fprintf(stderr, "the broken joints' friction first: the rubble's friction %.3g deg (within %.2g) on "
-                                 "biaxial tests at sigma3 %.4g MPa to %.2g%% strain, with the start's bonds\n",
-                         residual.friction, residual.tolerance, residual.confinement / 1e6, 100 * residual.max_strain);
-        int r = 0;
-        residual_steps = calibrate_residual_friction(start, residual, o, [&](const ResidualFrictionStep& step) {
-            if (!quiet) print_residual_step(++r, step);
-        });
-        o.base.rock.bonds.residual_friction = best_residual_step(residual_steps, residual.friction).residual_friction;
-        if (!quiet)
-            std::fprintf(stderr, "broken joints' friction %.4g deg; now the bonds\n", o.base.rock.bonds.residual_friction);
-    }
+    const std::vector<ResidualFrictionStep> residual_steps = calibrate_residual_first(start, residual, o, quiet);
     if (!quiet) print_iteration_columns();
     nlohmann::json table = nlohmann::json::array();
     int k = 0;
@@ -350,27 +383,11 @@ int run_calibrate(CalibrateValues& values, bool quiet, bool check_only, std::str
     const std::string toml = calibrated_set_toml(values, o, last, last_number);
     nlohmann::json calibration =
         calibration_record(values, o, first, start, last, last_number, fresh, std::move(table), toml);
-    bool residual_converged = true;
-    if (!residual_steps.empty()) {
-        // The calibrated set's rubble on the fresh seeds: the friction it will slide at.
-        const auto fresh_rubble = measure_rubble_friction(last.joint, residual, o, o.base.rock.pattern.seed + 1000);
-        residual_converged = std::abs(fresh_rubble.rubble_friction - residual.friction) <= residual.tolerance &&
-                             fresh_rubble.unmeasured < o.realizations;
-        if (!quiet) {
-            std::fprintf(stderr, "fresh seeds, the rubble: ");
-            print_residual_step(0, fresh_rubble);
-        }
-        calibration["residual_friction"] = residual_record(residual, residual_steps, fresh_rubble, residual_converged);
-    }
+    const bool residual_converged =
+        residual_steps.empty() || check_fresh_rubble(last, residual, residual_steps, o, quiet, calibration);
     const bool converged = last.converged && residual_converged;
     if (calibration_json) *calibration_json = calibration.dump();
-    if (values.lab.write_files && Ranks::root()) {
-        io::write_text_atomically(out / "joint_property.toml", toml);
-        io::write_text_atomically(out / "calibration.json", calibration.dump(2) + "\n");
-        if (!quiet)
-            std::fprintf(stderr, "wrote %s/joint_property.toml and calibration.json%s\n", out.string().c_str(),
-                         converged ? "" : " (not converged within the iteration limit)");
-    }
+    if (values.lab.write_files && Ranks::root()) write_calibration_files(out, toml, calibration, converged, quiet);
     return converged ? 0 : 4;
 }
 

@@ -54,6 +54,68 @@ double HoekBrownFit::sigma1(double s3) const {
 
 double HoekBrownFit::tensile_strength() const { return 0.5 * sigma_ci * (std::sqrt(mi * mi + 4.0) - mi); }
 
+namespace {
+
+/// A start of the Hoek-Brown fit (A, B) when the linearised one fails: an
+/// envelope that rises faster than the criterion's square root at low
+/// confinement (a lattice that interlocks) puts the linearised intercept below
+/// zero: start instead from the points at the lowest σ3 and the chord to the
+/// highest (y = (σ1 − σ3)²). False when that fails too.
+bool chord_start(const std::vector<double>& s3, const std::vector<double>& y, std::size_t n, double& A, double& B) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::size_t i = 0; i < n; ++i) lo = std::min(lo, s3[i]), hi = std::max(hi, s3[i]);
+    double y_lo = 0.0, y_hi = 0.0;
+    int n_lo = 0, n_hi = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (s3[i] == lo) y_lo += y[i], ++n_lo;
+        if (s3[i] == hi) y_hi += y[i], ++n_hi;
+    }
+    y_lo /= n_lo, y_hi /= n_hi;
+    B = std::max((y_hi - y_lo) / (hi - lo), 1e-12 * y_lo / std::max(hi, 1.0));
+    A = std::max(y_lo - B * lo, 1e-6 * y_lo);
+    return A > 0.0;
+}
+
+/// The sum of squared σ1 residuals of σ1 = σ3 + √(a + b σ3) (inf where the root is not real).
+double hoek_brown_cost(const std::vector<double>& s3, const std::vector<double>& s1, std::size_t n, double a, double b) {
+    double ss = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double q = a + b * s3[i];
+        if (!(q > 0.0)) return double(INFINITY);
+        ss += std::pow(s3[i] + std::sqrt(q) - s1[i], 2);
+    }
+    return ss;
+}
+
+/// Gauss–Newton on the σ1 residuals from (A, B), each step halved until it lowers
+/// the cost; the cost at the end.
+double gauss_newton_hoek_brown(const std::vector<double>& s3, const std::vector<double>& s1, std::size_t n, double& A,
+                               double& B) {
+    double current = hoek_brown_cost(s3, s1, n, A, B);
+    for (int iteration = 0; iteration < 100 && std::isfinite(current); ++iteration) {
+        // Normal equations of the 2 × 2 Gauss–Newton step.
+        double jaa = 0.0, jab = 0.0, jbb = 0.0, ga = 0.0, gb = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double root = std::sqrt(A + B * s3[i]);
+            const double r = s3[i] + root - s1[i], da = 0.5 / root, db = 0.5 * s3[i] / root;
+            jaa += da * da, jab += da * db, jbb += db * db, ga += da * r, gb += db * r;
+        }
+        const double det = jaa * jbb - jab * jab;
+        if (!(std::abs(det) > 0.0)) break;
+        const double stepA = -(jbb * ga - jab * gb) / det, stepB = -(jaa * gb - jab * ga) / det;
+        double t = 1.0, next = hoek_brown_cost(s3, s1, n, A + stepA, B + stepB);
+        while (!(next <= current) && t > 1e-6) t *= 0.5, next = hoek_brown_cost(s3, s1, n, A + t * stepA, B + t * stepB);
+        if (!(next <= current)) break;
+        A += t * stepA, B += t * stepB;
+        const bool done = current - next <= 1e-15 * current;
+        current = next;
+        if (done) break;
+    }
+    return current;
+}
+
+} // namespace
+
 HoekBrownFit fit_hoek_brown(const std::vector<double>& s3, const std::vector<double>& s1) {
     // In A = σci², B = mi σci the criterion is σ1 = σ3 + √(A + B σ3): Hoek's
     // linearisation (σ1 − σ3)² = A + B σ3 starts, Gauss–Newton on the σ1
@@ -66,53 +128,9 @@ HoekBrownFit fit_hoek_brown(const std::vector<double>& s3, const std::vector<dou
     const LineFit start = fit_line(s3, y);
     if (!start.valid) return f; // fewer than two confinements
     double A = start.intercept, B = start.slope;
-    if (!(A > 0.0) || !(B > 0.0)) {
-        // An envelope that rises faster than the criterion's square root at low
-        // confinement (a lattice that interlocks) puts the linearised intercept
-        // below zero: start instead from the points at the lowest σ3 and the
-        // chord to the highest.
-        double lo = INFINITY, hi = -INFINITY;
-        for (std::size_t i = 0; i < n; ++i) lo = std::min(lo, s3[i]), hi = std::max(hi, s3[i]);
-        double y_lo = 0.0, y_hi = 0.0;
-        int n_lo = 0, n_hi = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (s3[i] == lo) y_lo += y[i], ++n_lo;
-            if (s3[i] == hi) y_hi += y[i], ++n_hi;
-        }
-        y_lo /= n_lo, y_hi /= n_hi;
-        B = std::max((y_hi - y_lo) / (hi - lo), 1e-12 * y_lo / std::max(hi, 1.0));
-        A = std::max(y_lo - B * lo, 1e-6 * y_lo);
-        if (!(A > 0.0)) return f;
-    }
-    auto cost = [&](double a, double b) {
-        double ss = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const double q = a + b * s3[i];
-            if (!(q > 0.0)) return double(INFINITY);
-            ss += std::pow(s3[i] + std::sqrt(q) - s1[i], 2);
-        }
-        return ss;
-    };
-    double current = cost(A, B);
-    for (int iteration = 0; iteration < 100 && std::isfinite(current); ++iteration) {
-        // Normal equations of the 2 × 2 Gauss–Newton step.
-        double jaa = 0.0, jab = 0.0, jbb = 0.0, ga = 0.0, gb = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const double root = std::sqrt(A + B * s3[i]);
-            const double r = s3[i] + root - s1[i], da = 0.5 / root, db = 0.5 * s3[i] / root;
-            jaa += da * da, jab += da * db, jbb += db * db, ga += da * r, gb += db * r;
-        }
-        const double det = jaa * jbb - jab * jab;
-        if (!(std::abs(det) > 0.0)) break;
-        const double stepA = -(jbb * ga - jab * gb) / det, stepB = -(jaa * gb - jab * ga) / det;
-        double t = 1.0, next = cost(A + stepA, B + stepB);
-        while (!(next <= current) && t > 1e-6) t *= 0.5, next = cost(A + t * stepA, B + t * stepB);
-        if (!(next <= current)) break;
-        A += t * stepA, B += t * stepB;
-        const bool done = current - next <= 1e-15 * current;
-        current = next;
-        if (done) break;
-    }
+    if (!(A > 0.0) || !(B > 0.0))
+        if (!chord_start(s3, y, n, A, B)) return f;
+    const double current = gauss_newton_hoek_brown(s3, s1, n, A, B);
     f.sigma_ci = std::sqrt(A);
     f.mi = B / f.sigma_ci;
     f.rms = std::sqrt(current / double(n));
@@ -230,7 +248,8 @@ void print_fits(const nlohmann::json& e) {
 /// envelope.png from envelope.json's content: σ1 against σ3 (MPa) — σci and σcd
 /// of every compression test, every realization's peak drawn over them (the
 /// tension tests at σ3 = −T, σ1 = 0), the fitted curves and the target record.
-void draw_envelope(const nlohmann::json& e, const fs::path& file) {
+/// Every run's points: the peaks (tension at −T), σci and σcd; in that order.
+std::vector<io::Series> measured_points(const nlohmann::json& e) {
     using Style = io::Series::Style;
     io::Series peaks{"peaks (each realization)", {}, {}, Style::points};
     io::Series cis{"sigma_ci", {}, {}, Style::points}, cds{"sigma_cd", {}, {}, Style::points};
@@ -247,33 +266,41 @@ void draw_envelope(const nlohmann::json& e, const fs::path& file) {
             peaks.x.push_back(-t / 1e6), peaks.y.push_back(0.0);
         }
     }
-    std::vector<io::Series> series{cis, cds, peaks};
+    return {cis, cds, peaks};
+}
+
+/// A criterion σ1(σ3) drawn from σ3 = 0 to `top`.
+template <class Sigma1>
+io::Series criterion_curve(const std::string& label, double top, Sigma1 sigma1) {
+    io::Series c{label, {}, {}};
+    for (int k = 0; k <= 60; ++k) {
+        const double x = top * k / 60.0;
+        c.x.push_back(x / 1e6), c.y.push_back(sigma1(x) / 1e6);
+    }
+    return c;
+}
+
+/// The fitted criteria up to the highest confinement (tested, or of the
+/// laboratory record), the record's points and the target criterion.
+void add_criteria(std::vector<io::Series>& series, const nlohmann::json& e) {
     double top = 0.0;
     for (double s3 : e["confinements"]) top = std::max(top, s3);
     if (e.contains("target_record"))
         for (const auto& pair : e["target_record"]["pairs"]) top = std::max(top, pair[0].get<double>());
-    auto curve = [&](const std::string& label, auto sigma1) {
-        io::Series c{label, {}, {}};
-        for (int k = 0; k <= 60; ++k) {
-            const double x = top * k / 60.0;
-            c.x.push_back(x / 1e6), c.y.push_back(sigma1(x) / 1e6);
-        }
-        return c;
-    };
     char label[256];
     if (e["hoek_brown"]["valid"].get<bool>()) {
         const HoekBrownFit hb{e["hoek_brown"]["sigma_ci"], e["hoek_brown"]["mi"], 0.0, true};
         std::snprintf(label, sizeof label, "Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", hb.sigma_ci / 1e6, hb.mi);
-        series.push_back(curve(label, [&](double x) { return hb.sigma1(x); }));
+        series.push_back(criterion_curve(label, top, [&](double x) { return hb.sigma1(x); }));
     }
     if (e["mohr_coulomb"]["valid"].get<bool>()) {
         const double sc = e["mohr_coulomb"]["sigma_c"], k = e["mohr_coulomb"]["slope"];
         std::snprintf(label, sizeof label, "Mohr-Coulomb: c %.2f MPa, phi %.1f deg",
                       e["mohr_coulomb"]["cohesion"].get<double>() / 1e6, e["mohr_coulomb"]["friction_deg"].get<double>());
-        series.push_back(curve(label, [&](double x) { return sc + k * x; }));
+        series.push_back(criterion_curve(label, top, [&](double x) { return sc + k * x; }));
     }
     if (e.contains("target_record")) {
-        io::Series r{"laboratory record", {}, {}, Style::points};
+        io::Series r{"laboratory record", {}, {}, io::Series::Style::points};
         for (const auto& pair : e["target_record"]["pairs"])
             r.x.push_back(pair[0].get<double>() / 1e6), r.y.push_back(pair[1].get<double>() / 1e6);
         series.push_back(r);
@@ -281,20 +308,31 @@ void draw_envelope(const nlohmann::json& e, const fs::path& file) {
     if (e.contains("target_hoek_brown")) {
         const HoekBrownFit target{e["target_hoek_brown"]["sigma_ci"], e["target_hoek_brown"]["mi"], 0.0, true};
         std::snprintf(label, sizeof label, "target Hoek-Brown: sigma_ci %.1f MPa, mi %.1f", target.sigma_ci / 1e6, target.mi);
-        series.push_back(curve(label, [&](double x) { return target.sigma1(x); }));
+        series.push_back(criterion_curve(label, top, [&](double x) { return target.sigma1(x); }));
     }
+}
+
+/// The picture's title: the rock drawn.
+std::string envelope_title(const nlohmann::json& e) {
     const auto& sp = e["specimen"];
     // Heterogeneous bonds are part of the rock drawn (older envelope.json files have no modulus).
     const double weibull = sp.value("weibull_modulus", 0.0);
     char bonds[48] = "";
     if (weibull > 0) std::snprintf(bonds, sizeof bonds, ", bond strengths Weibull m = %.3g", weibull);
+    char label[256];
     std::snprintf(label, sizeof label, "strength envelope, %s blocks of %.2g m%s%s, %d realization%s",
                   sp["pattern"].get<std::string>().c_str(), sp["size"].get<double>(),
                   sp["deformable_fraction"].get<double>() > 0
                       ? (", deformable f = " + std::to_string(sp["deformable_fraction"].get<double>()).substr(0, 4)).c_str()
                       : "",
                   bonds, sp["realizations"].get<int>(), sp["realizations"].get<int>() > 1 ? "s" : "");
-    io::draw_curves(series, "sigma3 (MPa; tension at -T)", "sigma1 (MPa)", file, label, false, true);
+    return label;
+}
+
+void draw_envelope(const nlohmann::json& e, const fs::path& file) {
+    std::vector<io::Series> series = measured_points(e);
+    add_criteria(series, e);
+    io::draw_curves(series, "sigma3 (MPa; tension at -T)", "sigma1 (MPa)", file, envelope_title(e), false, true);
 }
 
 } // namespace
@@ -557,12 +595,10 @@ nlohmann::json envelope_summary(const EnvelopeOptions& e, const std::vector<Enve
     return summary;
 }
 
-} // namespace
-
-int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
-    quiet = quiet || !Ranks::root();
+/// The envelope's inputs checked and read: the confinements, the model's rock
+/// (--model), the laboratory record and the target criterion; the record's pairs.
+std::vector<std::pair<double, double>> read_envelope_inputs(EnvelopeOptions& e) {
     LabTestValues& c = e.lab;
-    if (e.replot) return replot_envelope(e, quiet, check_only);
     for (double s3 : e.confinements)
         if (!(s3 > 0.0) || !std::isfinite(s3))
             throw InputError("--confinements", 0, "", "each confinement must be a positive stress in Pa");
@@ -572,16 +608,49 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     if ((e.target_sigma_ci > 0.0) != (e.target_mi > 0.0))
         throw InputError(e.target_mi > 0.0 ? "--target-sigma-ci" : "--target-mi", 0, "",
                          "--target-sigma-ci and --target-mi go together (the Hoek-Brown record to draw)");
-    // The tests' options: compression as given; tension loaded like `bbm tension`
-    // (ten times slower: it peaks at a tenth of the strain), Brazilian like `bbm brazilian`.
+    return record;
+}
+
+/// The tests' options: compression as given; tension loaded like `bbm tension`
+/// (ten times slower: it peaks at a tenth of the strain), Brazilian like `bbm brazilian`.
+struct EnvelopeTests {
+    LabTestValues compression, tension;
+    LabTestOptions::Kind tension_kind;
+};
+
+EnvelopeTests envelope_tests(const EnvelopeOptions& e) {
+    const LabTestValues& c = e.lab;
     const bool brazilian = e.tension_test == "brazilian";
-    LabTestValues compression = c, tension = c;
-    prepare_labtest(compression, LabTestOptions::Kind::ucs);
-    const auto tension_kind = brazilian ? LabTestOptions::Kind::brazilian : LabTestOptions::Kind::tension;
-    if (brazilian) tension.o.width = e.brazilian_diameter;
-    tension.o.strain_per_step = c.o.strain_per_step * (brazilian ? 0.2 : 0.1);
-    tension.o.platen_friction = -1.0;
-    prepare_labtest(tension, tension_kind);
+    EnvelopeTests t{c, c, brazilian ? LabTestOptions::Kind::brazilian : LabTestOptions::Kind::tension};
+    prepare_labtest(t.compression, LabTestOptions::Kind::ucs);
+    if (brazilian) t.tension.o.width = e.brazilian_diameter;
+    t.tension.o.strain_per_step = c.o.strain_per_step * (brazilian ? 0.2 : 0.1);
+    t.tension.o.platen_friction = -1.0;
+    prepare_labtest(t.tension, t.tension_kind);
+    return t;
+}
+
+/// The envelope on the console: the UCS and tension, the fits, what to know of the runs.
+void print_envelope_result(const nlohmann::json& summary, const std::vector<EnvelopeRun>& runs, const EnvelopeOptions& e) {
+    const LabTestValues& c = e.lab;
+    const auto& ucs = summary["ucs"];
+    const auto& t = summary["tension"];
+    std::fprintf(stderr, "UCS %.2f +- %.2f MPa; %s tension %.2f MPa (T/UCS %.3f)\n", ucs["mean"].get<double>() / 1e6,
+                 ucs["std"].get<double>() / 1e6, e.tension_test == "brazilian" ? "Brazilian" : "direct",
+                 t["strength"]["mean"].get<double>() / 1e6, t["over_ucs"].get<double>());
+    print_fits(summary);
+    warn_about_envelope_runs(runs, c);
+    if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", fs::path(c.out).string().c_str());
+}
+
+} // namespace
+
+int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy* study) {
+    quiet = quiet || !Ranks::root();
+    LabTestValues& c = e.lab;
+    if (e.replot) return replot_envelope(e, quiet, check_only);
+    const std::vector<std::pair<double, double>> record = read_envelope_inputs(e);
+    const EnvelopeTests tests = envelope_tests(e);
     if (check_only) return 0;
     const fs::path out = c.out;
     if (c.write_files && Ranks::root()) io::make_output_directory(out);
@@ -591,12 +660,12 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
     // Deformable specimens one at a time, with the threads in their loop (as `bbm ucs`).
     const bool one_at_a_time = c.o.rock.material.deformable_fraction > 0.0;
     std::vector<EnvelopeRun> runs;
-    EnvelopeRunner run_jobs{c, compression, tension, tension_kind, available, one_at_a_time, quiet, runs};
+    EnvelopeRunner run_jobs{c, tests.compression, tests.tension, tests.tension_kind, available, one_at_a_time, quiet, runs};
     if (!quiet)
         std::fprintf(stderr, "bbm envelope: %s blocks of %.3g m, %g m x %g m, %d realization%s of each test on %d thread%s\n",
                      meshing::to_string(c.o.rock.pattern.kind), c.o.rock.pattern.size, c.o.width, c.o.height, n, n > 1 ? "s" : "", available,
                      available > 1 ? "s" : "");
-    const std::vector<double> confinements = run_envelope_tests(e, run_jobs, tension_kind);
+    const std::vector<double> confinements = run_envelope_tests(e, run_jobs, tests.tension_kind);
     const auto [per_run, csv] = envelope_runs_table(runs);
     const nlohmann::json summary = envelope_summary(e, runs, per_run, confinements, record);
 
@@ -605,16 +674,7 @@ int run_envelope(EnvelopeOptions& e, bool quiet, bool check_only, EnvelopeStudy*
         io::write_text_atomically(out / "envelope.csv", csv);
         draw_envelope(summary, out / "envelope.png");
     }
-    if (!quiet) {
-        const auto& ucs = summary["ucs"];
-        const auto& t = summary["tension"];
-        std::fprintf(stderr, "UCS %.2f +- %.2f MPa; %s tension %.2f MPa (T/UCS %.3f)\n", ucs["mean"].get<double>() / 1e6,
-                     ucs["std"].get<double>() / 1e6, brazilian ? "Brazilian" : "direct",
-                     t["strength"]["mean"].get<double>() / 1e6, t["over_ucs"].get<double>());
-        print_fits(summary);
-        warn_about_envelope_runs(runs, c);
-        if (c.write_files) std::fprintf(stderr, "wrote %s/{envelope.json, envelope.csv, envelope.png}\n", out.string().c_str());
-    }
+    if (!quiet) print_envelope_result(summary, runs, e);
     if (study) {
         study->runs = std::move(runs);
         study->summary_json = summary.dump();

@@ -137,11 +137,9 @@ void add_labtest_materials(AnalysisSpec& an, const LabTestOptions& o) {
     an.solver.new_contact_property = unbonded.name;
 }
 
-} // namespace
-
-AnalysisSpec labtest_analysis(const LabTestOptions& o) {
-    AnalysisSpec an;
-    add_labtest_materials(an, o);
+/// The platens: bottom held, top moving at the strain rate (apart in tension),
+/// as platen blocks, rough faces or smooth ones (these with an anchor).
+void add_platen_boundaries(AnalysisSpec& an, const LabTestOptions& o) {
     const bool platen_blocks = uses_platen_blocks(o);
     const double h = specimen_height(o), band = 0.5 * o.rock.pattern.size, v = o.strain_per_step * h;
     const double big = 10.0 * (o.width + h);
@@ -186,65 +184,84 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
         anchor.vx = 0.0;
         an.boundaries = {bottom, top, anchor};
     }
-    if (o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0) {
-        BoundarySpec left;
-        left.name = "left";
-        left.kind = BoundarySpec::Kind::stress;
-        left.select.box = Box2{{-big, band}, {1e-6 * o.width, h - band}};
-        left.stress.sxx = -o.confinement;
-        BoundarySpec right = left;
-        right.name = "right";
-        right.select.box = Box2{{o.width * (1 - 1e-6), band}, {big, h - band}};
-        an.boundaries.push_back(left);
-        an.boundaries.push_back(right);
-    }
+}
+
+/// A biaxial test's confinement: the lateral stress on the left and right faces.
+void add_confining_boundaries(AnalysisSpec& an, const LabTestOptions& o) {
+    if (!(o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0)) return;
+    const double h = specimen_height(o), band = 0.5 * o.rock.pattern.size;
+    const double big = 10.0 * (o.width + h);
+    BoundarySpec left;
+    left.name = "left";
+    left.kind = BoundarySpec::Kind::stress;
+    left.select.box = Box2{{-big, band}, {1e-6 * o.width, h - band}};
+    left.stress.sxx = -o.confinement;
+    BoundarySpec right = left;
+    right.name = "right";
+    right.select.box = Box2{{o.width * (1 - 1e-6), band}, {big, h - band}};
+    an.boundaries.push_back(left);
+    an.boundaries.push_back(right);
+}
+
+} // namespace
+
+AnalysisSpec labtest_analysis(const LabTestOptions& o) {
+    AnalysisSpec an;
+    add_labtest_materials(an, o);
+    add_platen_boundaries(an, o);
+    add_confining_boundaries(an, o);
     an.solver.mode = SolverSpec::Mode::quasi_static;
     an.solver.damping = 0.8;
     an.solver.threads = o.threads;
     return an;
 }
 
+namespace {
 
-void measure_rock_mechanics(LabTestResult& r, std::size_t preload_points, bool tension, long peak_step) {
+/// The linear part: the implicit preload's line (exact), else the pre-peak
+/// points (to `last`) from 10% of the peak to the first broken bond or 50% of
+/// the peak, whichever comes first — never past crack initiation.
+void measure_linear_part(LabTestResult& r, std::size_t preload_points, double nu_sign, std::size_t last) {
     const auto& c = r.curve;
-    if (c.size() < 2 || r.peak_stress <= 0.0) return;
-    const double peak = r.peak_stress, nu_sign = tension ? -1.0 : 1.0;
-    std::size_t last = 0; // the last pre-peak point
-    while (last + 1 < c.size() && c[last + 1].step <= peak_step) ++last;
-    // The linear part: the implicit preload's line (exact), else the pre-peak
-    // points from 10% of the peak to the first broken bond or 50% of the peak,
-    // whichever comes first — never past crack initiation.
-    std::vector<double> eps, sig, lat;
+    const double peak = r.peak_stress;
     if (preload_points >= 2) {
         const auto &a = c.front(), &b = c[preload_points - 1];
         r.E = (b.axial_stress - a.axial_stress) / (b.axial_strain - a.axial_strain);
         r.nu = nu_sign * (b.lateral_strain - a.lateral_strain) / (b.axial_strain - a.axial_strain);
         r.linear_limit_stress = b.axial_stress;
-    } else {
-        const int cracks0 = c.front().cracks_tensile + c.front().cracks_shear;
-        for (std::size_t k = 0; k <= last; ++k) {
-            const auto& p = c[k];
-            if (p.cracks_tensile + p.cracks_shear > cracks0 || p.axial_stress > 0.5 * peak) break;
-            if (p.axial_stress >= 0.1 * peak)
-                eps.push_back(p.axial_strain), sig.push_back(p.axial_stress), lat.push_back(p.lateral_strain);
-        }
-        r.E = fit_slope(eps, sig);
-        r.nu = nu_sign * fit_slope(eps, lat);
-        r.linear_limit_stress = sig.empty() ? 0.0 : sig.back();
+        return;
     }
-    // ISRM tangent modulus at 50% of the peak: pre-peak points within ±5% of it.
-    eps.clear(), sig.clear();
+    std::vector<double> eps, sig, lat;
+    const int cracks0 = c.front().cracks_tensile + c.front().cracks_shear;
+    for (std::size_t k = 0; k <= last; ++k) {
+        const auto& p = c[k];
+        if (p.cracks_tensile + p.cracks_shear > cracks0 || p.axial_stress > 0.5 * peak) break;
+        if (p.axial_stress >= 0.1 * peak)
+            eps.push_back(p.axial_strain), sig.push_back(p.axial_stress), lat.push_back(p.lateral_strain);
+    }
+    r.E = fit_slope(eps, sig);
+    r.nu = nu_sign * fit_slope(eps, lat);
+    r.linear_limit_stress = sig.empty() ? 0.0 : sig.back();
+}
+
+/// ISRM tangent modulus at 50% of the peak: pre-peak points within ±5% of it.
+double tangent_modulus_at_half_peak(const std::vector<StressStrainPoint>& c, std::size_t last, double peak) {
+    std::vector<double> eps, sig;
     for (std::size_t k = 0; k <= last; ++k)
         if (std::abs(c[k].axial_stress - 0.5 * peak) <= 0.05 * peak)
             eps.push_back(c[k].axial_strain), sig.push_back(c[k].axial_stress);
-    r.E50 = eps.size() >= 2 ? fit_slope(eps, sig) : 0.0;
-    if (tension || !(r.E > 0.0)) return;
-    // Crack initiation and damage (Martin & Chandler 1994), from the loading's start:
-    // volumetric strain εv = εa + εl (plane strain, εl = −lateral expansion), its
-    // elastic part (1 − ν) Δσ / E, the crack volumetric strain εcv = εv − that.
-    // σci: where εcv leaves zero for good — the last pre-peak point (5-point mean)
-    // with |εcv| within 0.5% of the elastic volumetric strain at the peak; σcd:
-    // where εv reverses (its largest pre-peak value; the peak if it never does).
+    return eps.size() >= 2 ? fit_slope(eps, sig) : 0.0;
+}
+
+/// Crack initiation and damage (Martin & Chandler 1994), from the loading's start:
+/// volumetric strain εv = εa + εl (plane strain, εl = −lateral expansion), its
+/// elastic part (1 − ν) Δσ / E, the crack volumetric strain εcv = εv − that.
+/// σci: where εcv leaves zero for good — the last pre-peak point (5-point mean)
+/// with |εcv| within 0.5% of the elastic volumetric strain at the peak; σcd:
+/// where εv reverses (its largest pre-peak value; the peak if it never does).
+void measure_crack_thresholds(LabTestResult& r, std::size_t last) {
+    const auto& c = r.curve;
+    const double peak = r.peak_stress;
     const auto& o = c.front();
     auto volumetric = [&](std::size_t k) {
         return (c[k].axial_strain - o.axial_strain) - (c[k].lateral_strain - o.lateral_strain);
@@ -270,6 +287,20 @@ void measure_rock_mechanics(LabTestResult& r, std::size_t preload_points, bool t
         if (const double v = mean5(volumetric, k); v > best) best = v, damage = k;
     r.crack_initiation_stress = c[initiation].axial_stress;
     r.crack_damage_stress = c[damage].axial_stress;
+}
+
+} // namespace
+
+void measure_rock_mechanics(LabTestResult& r, std::size_t preload_points, bool tension, long peak_step) {
+    const auto& c = r.curve;
+    if (c.size() < 2 || r.peak_stress <= 0.0) return;
+    const double peak = r.peak_stress, nu_sign = tension ? -1.0 : 1.0;
+    std::size_t last = 0; // the last pre-peak point
+    while (last + 1 < c.size() && c[last + 1].step <= peak_step) ++last;
+    measure_linear_part(r, preload_points, nu_sign, last);
+    r.E50 = tangent_modulus_at_half_peak(c, last, peak);
+    if (tension || !(r.E > 0.0)) return;
+    measure_crack_thresholds(r, last);
 }
 
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y) {

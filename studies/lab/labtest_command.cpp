@@ -322,37 +322,24 @@ nlohmann::json realizations_summary(const char* name, const std::vector<LabTestR
                           {"per_realization", per}};
 }
 
-} // namespace
-
-int run_labtest_command(LabTestValues& c, LabTestOptions::Kind kind, bool quiet, bool check_only, LabTestStudy* study) {
-    const char* name = labtest_name(kind);
-    auto& o = c.o;
-    prepare_labtest(c, kind);
-    if (check_only) return 0;
-    const fs::path out = c.out;
-    const bool write = c.write_files;
-    if (write) io::make_output_directory(out);
-    const int n = c.realizations;
-    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    // Deformable specimens: realizations one at a time, each with the threads in its
-    // contact loop. Side by side in one process a 4 x 8 m f = 0.95 specimen gave,
-    // rarely (2 runs of about 40), another answer than alone — a thread-safety
-    // fault around meshing not found yet (docs/notes/2026-11-28-calibration-history.md,
-    // What the programs do).
-    const bool one_at_a_time = o.rock.material.deformable_fraction > 0.0;
-    const int threads = one_at_a_time ? 1 : std::max(1, std::min(n, available));
-    const int threads_for_loop = available;
-    const int shown_threads = n > 1 && !one_at_a_time ? threads : threads_for_loop;
+/// A lab test's realizations (seeds from the pattern's on): each one's test, its
+/// files, its lines on the console.
+struct Realizations {
+    const LabTestValues& c;
+    const char* name;
+    fs::path out;
+    bool write = false, quiet = false, one_at_a_time = false;
+    int n = 1, threads_for_loop = 1;
     std::mutex print;
-    // Progress from rank 0 only; the others run quietly.
-    quiet = quiet || !Ranks::root();
-    if (!quiet)
-        std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s%s\n", name,
-                     meshing::to_string(o.rock.pattern.kind), o.rock.pattern.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
-                     n > 1 ? "s" : "", shown_threads, shown_threads > 1 ? "s" : "",
-                     Ranks::size() > 1 ? (" per rank, " + std::to_string(Ranks::size()) + " ranks").c_str() : "");
     Progress lines; // progress of a single realization; every realization's result
-    auto realization = [&](int k) -> std::string {
+
+    Realizations(const LabTestValues& values, const char* test, bool no_lines, bool deformable, int threads)
+        : c(values), name(test), out(values.out), write(values.write_files), quiet(no_lines), one_at_a_time(deformable),
+          n(values.realizations), threads_for_loop(threads) {}
+
+    /// Realization k, its result as the record that travels between ranks.
+    std::string run(int k) {
+        const LabTestOptions& o = c.o;
         try {
             LabTestOptions ok = o;
             ok.rock.pattern.seed = o.rock.pattern.seed + k;
@@ -389,21 +376,59 @@ int run_labtest_command(LabTestValues& c, LabTestOptions::Kind kind, bool quiet,
         } catch (const GeometryError& e) {
             throw InputError(labtest_flag(e.key()), 0, "", e.what());
         }
-    };
+    }
+};
+
+/// The summary of several realizations, written to summary.json and its means said.
+nlohmann::json summarise_realizations(const char* name, const std::vector<LabTestResult>& results, const fs::path& out,
+                                      bool write, bool quiet) {
+    const int n = int(results.size());
+    nlohmann::json summary = realizations_summary(name, results);
+    if (write && Ranks::root()) io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
+    if (!quiet)
+        std::fprintf(stderr, "mean of %d: E %.2f GPa, nu %.3f, peak %.2f MPa%s%s\n", n,
+                     summary["E"]["mean"].get<double>() / 1e9, summary["nu"]["mean"].get<double>(),
+                     summary["peak_stress"]["mean"].get<double>() / 1e6, write ? "; wrote " : "",
+                     write ? (out / "summary.json").string().c_str() : "");
+    return summary;
+}
+
+} // namespace
+
+int run_labtest_command(LabTestValues& c, LabTestOptions::Kind kind, bool quiet, bool check_only, LabTestStudy* study) {
+    const char* name = labtest_name(kind);
+    auto& o = c.o;
+    prepare_labtest(c, kind);
+    if (check_only) return 0;
+    const fs::path out = c.out;
+    const bool write = c.write_files;
+    if (write) io::make_output_directory(out);
+    const int n = c.realizations;
+    const int available = c.threads > 0 ? c.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    // Deformable specimens: realizations one at a time, each with the threads in its
+    // contact loop. Side by side in one process a 4 x 8 m f = 0.95 specimen gave,
+    // rarely (2 runs of about 40), another answer than alone — a thread-safety
+    // fault around meshing not found yet (docs/notes/2026-11-28-calibration-history.md,
+    // What the programs do).
+    const bool one_at_a_time = o.rock.material.deformable_fraction > 0.0;
+    const int threads = one_at_a_time ? 1 : std::max(1, std::min(n, available));
+    const int threads_for_loop = available;
+    const int shown_threads = n > 1 && !one_at_a_time ? threads : threads_for_loop;
+    // Progress from rank 0 only; the others run quietly.
+    quiet = quiet || !Ranks::root();
+    if (!quiet)
+        std::fprintf(stderr, "bbm %s: %s blocks of %.3g m, %g m x %g m, %d realization%s on %d thread%s%s\n", name,
+                     meshing::to_string(o.rock.pattern.kind), o.rock.pattern.size, o.width, kind == LabTestOptions::Kind::brazilian ? o.width : o.height, n,
+                     n > 1 ? "s" : "", shown_threads, shown_threads > 1 ? "s" : "",
+                     Ranks::size() > 1 ? (" per rank, " + std::to_string(Ranks::size()) + " ranks").c_str() : "");
+    Realizations realizations(c, name, quiet, one_at_a_time, threads_for_loop);
     // Realizations over ranks (k mod ranks) and threads; every rank gets them all.
     std::vector<LabTestResult> results;
-    for (const auto& text : run_spread(n, n > 1 ? threads : 1, realization))
+    for (const auto& text : run_spread(n, n > 1 ? threads : 1, [&](int k) { return realizations.run(k); }))
         results.push_back(labtest_from_record(nlohmann::json::parse(text)));
-    nlohmann::json summary = n == 1 ? labtest_json(results[0]) : nlohmann::json();
-    if (n > 1) {
-        summary = realizations_summary(name, results);
-        if (write && Ranks::root()) io::write_text_atomically(out / "summary.json", summary.dump(2) + "\n");
-        if (!quiet)
-            std::fprintf(stderr, "mean of %d: E %.2f GPa, nu %.3f, peak %.2f MPa%s%s\n", n,
-                         summary["E"]["mean"].get<double>() / 1e9, summary["nu"]["mean"].get<double>(),
-                         summary["peak_stress"]["mean"].get<double>() / 1e6, write ? "; wrote " : "",
-                         write ? (out / "summary.json").string().c_str() : "");
-    }
+    const nlohmann::json summary = n == 1  ? labtest_json(results[0])
+                                   : n > 1 ? summarise_realizations(name, results, out, write, quiet)
+                                           : nlohmann::json();
     if (study) {
         study->results = std::move(results);
         study->summary_json = summary.dump();

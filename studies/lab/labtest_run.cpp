@@ -187,6 +187,59 @@ private:
     int property_ = -1;
 };
 
+/// The implicit solve of the trial displacement; false (the preload skipped) when
+/// it cannot be solved. A specimen the confinement cracked can hold a block by one
+/// point or a loose group (a trigon triangle at 71 MPa on Lac du Bonnet's bonds):
+/// the implicit matrix is singular there. The preload is a shortcut, not the
+/// test: the explicit loading then starts from the trial displacement.
+bool solve_trial(Solver& s, LabTestResult& r) {
+    try {
+        solve_elastic(s.world());
+    } catch (const SingularSystemError&) {
+        r.preload_skipped = true;
+        return false;
+    }
+    return true;
+}
+
+/// Every body on by (reach − 1) times its trial displacement (from `bodies0`,
+/// `position0`): each joint takes the same multiple of its trial increment (no
+/// row of joints next to the platen takes the whole of it), then one more solve
+/// for the geometric nonlinearity.
+void scale_trial(Solver& s, const std::vector<contact::BodyState>& bodies0, const std::vector<Vec2>& position0,
+                 double reach) {
+    const auto& nd = s.world().nodes;
+    const auto& bodies = s.world().bodies.state;
+    std::vector<Vec2> du(bodies.size()), dn(nd.count());
+    std::vector<double> dtheta(bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+        du[i] = (reach - 1.0) * (bodies[i].centroid - bodies0[i].centroid),
+        dtheta[i] = (reach - 1.0) * (bodies[i].theta - bodies0[i].theta);
+    for (int k = 0; k < nd.count(); ++k) dn[k] = (reach - 1.0) * (nd.position[k] - position0[k]);
+    move_bodies(s.world(), du, dtheta, dn);
+    try {
+        solve_elastic(s.world()); // the geometric correction: without it the linear state stands
+    } catch (const SingularSystemError&) {
+    }
+}
+
+/// The straight line between the preload's two states, exact for the linear
+/// response (none when the specimen could not be solved: E then comes from the
+/// explicit curve), after the origin.
+void add_preload_line(LabTestResult& r, const StressStrainPoint& origin, const StressStrainPoint& end, bool solvable,
+                      const std::function<void(const StressStrainPoint&)>& progress) {
+    for (int k = 1; k <= (solvable ? 20 : 0); ++k) {
+        const double f = k / 20.0;
+        StressStrainPoint p = end;
+        p.axial_strain = origin.axial_strain + f * (end.axial_strain - origin.axial_strain);
+        p.axial_stress = origin.axial_stress + f * (end.axial_stress - origin.axial_stress);
+        p.lateral_strain = origin.lateral_strain + f * (end.lateral_strain - origin.lateral_strain);
+        r.curve.push_back(p);
+        if (progress) progress(p);
+    }
+    r.curve.insert(r.curve.begin(), origin);
+}
+
 /// Elastic preload: until the first joint yields the specimen is linear, and its
 /// quasi-static response is one implicit solve — not thousands of damped steps
 /// whose start-up transient would bias E. A trial platen displacement gives the
@@ -198,67 +251,29 @@ std::size_t elastic_preload(Solver& s, MovingPlaten& platen, const LabTestOption
                             LabTestResult& r, double& strain,
                             const std::function<void(const StressStrainPoint&)>& progress) {
     const auto& c = contacts(s.world());
-    const auto& nd = s.world().nodes;
     const std::vector<contact::JointHistory> before = c.history;
     const std::vector<contact::BodyState> bodies0 = s.world().bodies.state;
-    const auto position0 = nd.position;
+    const auto position0 = s.world().nodes.position;
     const StressStrainPoint origin = gauges.measure(0.0, 0.0);
     const double trial = 1e-6;
     platen.set_speed(trial * specimen_height(o));
     move_supports(s.world(), s.world().clock.dt);
     strain = trial;
-    // A specimen the confinement cracked can hold a block by one point or a
-    // loose group (a trigon triangle at 71 MPa on Lac du Bonnet's bonds): the
-    // implicit matrix is singular there. The preload is a shortcut, not the
-    // test: the explicit loading then starts from the trial displacement.
-    bool solvable = true;
-    try {
-        solve_elastic(s.world());
-    } catch (const SingularSystemError&) {
-        solvable = false;
-        r.preload_skipped = true;
-    }
+    const bool solvable = solve_trial(s, r);
     double lambda = solvable ? 1e6 : 0.0;
     for (int i = 0; i < c.size(); ++i)
         lambda = std::min(lambda, contact::elastic_limit(s.world().properties.laws[c.property[i]], before[i], c.history[i], 1e6));
     const double reach = o.preload_fraction * lambda;
     if (solvable && reach > 1.0 && lambda < 1e6) {
-        // Every body on by (reach − 1) times its trial displacement: each joint
-        // takes the same multiple of its trial increment (no row of joints next
-        // to the platen takes the whole of it), then one more solve for the
-        // geometric nonlinearity.
-        const auto& bodies = s.world().bodies.state;
-        std::vector<Vec2> du(bodies.size()), dn(nd.count());
-        std::vector<double> dtheta(bodies.size());
-        for (std::size_t i = 0; i < bodies.size(); ++i)
-            du[i] = (reach - 1.0) * (bodies[i].centroid - bodies0[i].centroid),
-            dtheta[i] = (reach - 1.0) * (bodies[i].theta - bodies0[i].theta);
-        for (int k = 0; k < nd.count(); ++k) dn[k] = (reach - 1.0) * (nd.position[k] - position0[k]);
-        move_bodies(s.world(), du, dtheta, dn);
+        scale_trial(s, bodies0, position0, reach);
         strain = reach * trial;
-        try {
-            solve_elastic(s.world()); // the geometric correction: without it the linear state stands
-        } catch (const SingularSystemError&) {
-        }
     }
-    // The straight line between them, exact for the linear response (none when
-    // the specimen could not be solved: E then comes from the explicit curve).
-    const StressStrainPoint end = gauges.measure(strain, 0.0);
-    for (int k = 1; k <= (solvable ? 20 : 0); ++k) {
-        const double f = k / 20.0;
-        StressStrainPoint p = end;
-        p.axial_strain = origin.axial_strain + f * (end.axial_strain - origin.axial_strain);
-        p.axial_stress = origin.axial_stress + f * (end.axial_stress - origin.axial_stress);
-        p.lateral_strain = origin.lateral_strain + f * (end.lateral_strain - origin.lateral_strain);
-        r.curve.push_back(p);
-        if (progress) progress(p);
-    }
-    r.curve.insert(r.curve.begin(), origin);
+    add_preload_line(r, origin, gauges.measure(strain, 0.0), solvable, progress);
     return solvable ? r.curve.size() : 0;
 }
 
 /// The loading rate: fixed, or (servo) adapted at every record to the cracking —
-/// servo_cracks new cracks a record per 5,000 contacts — and, once cracking has
+/// servo.cracks new cracks a record per 5,000 contacts — and, once cracking has
 /// started, to the platens' balance. The platens start from rest: slowly, then the
 /// servo speeds up.
 class Servo {
@@ -416,38 +431,34 @@ private:
     std::size_t stall_from_ = 0; ///< first record within 2e-4 of strain of the last
 };
 
-} // namespace
+/// Smooth platens hold the specimen horizontally by the bottom face's middle
+/// blocks: there must be one.
+void check_smooth_platens_hold(const Solver& s, const LabTestOptions& o) {
+    if (o.rough_platens || uses_platen_blocks(o)) return;
+    const auto& fixed = s.world().loads.block_fixed;
+    if (std::none_of(fixed.begin(), fixed.end(), [](auto f) { return (f & 1) != 0; }))
+        throw std::runtime_error("smooth platens: no block on the bottom face's middle to hold the specimen "
+                                 "horizontally; use --platens rough or a larger specimen");
+}
 
-LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(const StressStrainPoint&)>& progress,
-                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish,
-                          const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto blocks = meshing::generate_blocks(labtest_geometry(o));
-    Solver s(blocks, labtest_analysis(o));
-    if (!o.rough_platens && !uses_platen_blocks(o)) {
-        const auto& fixed = s.world().loads.block_fixed;
-        if (std::none_of(fixed.begin(), fixed.end(), [](auto f) { return (f & 1) != 0; }))
-            throw std::runtime_error("smooth platens: no block on the bottom face's middle to hold the specimen "
-                                     "horizontally; use --platens rough or a larger specimen");
-    }
-    LabTestResult r;
-    r.blocks = blocks.block_count();
-    r.contacts = contacts(s.world()).size();
+/// The specimen in the machine: its gauges, the joint set's gauge and the platen.
+struct LabRig {
+    Solver& s;
+    const LabTestOptions& o;
+    const Gauges gauges;
+    const JointSetGauge joint_set;
+    MovingPlaten platen;
+};
+
+/// The explicit loading from `strain`, a point of the curve every record_every
+/// steps after `start`, until a stop rule or max_steps ends it.
+void load_until_stopped(LabRig& rig, long start, double strain, Servo& servo, StopRules& rules, LabTestResult& r,
+                        const std::function<void(const StressStrainPoint&)>& progress,
+                        const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame) {
+    Solver& s = rig.s;
+    const LabTestOptions& o = rig.o;
     const double h = specimen_height(o);
-    const bool brazilian = o.kind == LabTestOptions::Kind::brazilian;
-    const Gauges gauges(s, o);
-    const JointSetGauge joint_set(s, o);
-    // Biaxial: the confinement first, ramped with the platens held, then settled
-    // (applied at once it is a shock that cracks the specimen before any axial load).
-    MovingPlaten platen(s);
-    const long start = o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0 ? confine(s, platen) : 0;
-    const int cracks_at_start = cracks(s.world(), contact::JointState::broken_tension) + cracks(s.world(), contact::JointState::broken_shear);
-    double strain = 0.0;
-    const std::size_t preload_points =
-        o.elastic_preload && !uses_platen_blocks(o) ? elastic_preload(s, platen, o, gauges, r, strain, progress) : 0;
-    Servo servo(o, r.contacts, cracks_at_start);
-    StopRules rules(o, cracks_at_start);
-    platen.set_speed(servo.rate() * h);
+    rig.platen.set_speed(servo.rate() * h);
     double ratio_max = 0.0;
     while (s.world().clock.steps - start < o.stop.max_steps) {
         s.step();
@@ -455,13 +466,13 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         ratio_max = std::max(ratio_max, s.world().clock.ratio);
         if ((s.world().clock.steps - start) % o.record_every != 0) continue;
         record_new_cracks(s, r);
-        StressStrainPoint p = gauges.measure(strain, servo.rate());
+        StressStrainPoint p = rig.gauges.measure(strain, servo.rate());
         p.unbalanced_ratio = ratio_max;
         r.curve.push_back(p);
-        joint_set.record(s, p, r);
+        rig.joint_set.record(s, p, r);
         if (o.servo.on) {
             servo.adapt(s, p, rules.failed());
-            platen.set_speed(servo.rate() * h);
+            rig.platen.set_speed(servo.rate() * h);
         }
         ratio_max = 0.0;
         if (progress) progress(p);
@@ -471,6 +482,14 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
         if (on_frame && o.frame_every > 0 && (s.world().clock.steps - start) % o.frame_every == 0) on_frame(s, p);
         if (rules.stop_after(s, p, r)) break;
     }
+}
+
+/// The result's figures once loading has stopped: the peak (a lower bound if
+/// loading was going on), the moduli and crack thresholds, the residual
+/// strength, the cracks.
+void finish_labtest_result(Solver& s, const LabTestOptions& o, const StopRules& rules, long start,
+                           std::size_t preload_points, LabTestResult& r) {
+    const bool brazilian = o.kind == LabTestOptions::Kind::brazilian;
     // Out of steps while loading on: the peak is a lower bound too.
     if (s.world().clock.steps - start >= o.stop.max_steps && r.loaded_past_max_strain && !rules.failed() && !r.curve.empty())
         r.still_loading = rules.still_at_peak(r.curve.back());
@@ -483,6 +502,32 @@ LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(cons
     record_new_cracks(s, r);
     r.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
     r.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
+}
+
+} // namespace
+
+LabTestResult run_labtest(const LabTestOptions& o, const std::function<void(const StressStrainPoint&)>& progress,
+                          const std::function<void(const Solver&, const LabTestResult&)>& on_finish,
+                          const std::function<void(const Solver&, const StressStrainPoint&)>& on_frame) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto blocks = meshing::generate_blocks(labtest_geometry(o));
+    Solver s(blocks, labtest_analysis(o));
+    check_smooth_platens_hold(s, o);
+    LabTestResult r;
+    r.blocks = blocks.block_count();
+    r.contacts = contacts(s.world()).size();
+    LabRig rig{s, o, Gauges(s, o), JointSetGauge(s, o), MovingPlaten(s)};
+    // Biaxial: the confinement first, ramped with the platens held, then settled
+    // (applied at once it is a shock that cracks the specimen before any axial load).
+    const long start = o.kind == LabTestOptions::Kind::biaxial && o.confinement > 0 ? confine(s, rig.platen) : 0;
+    const int cracks_at_start = cracks(s.world(), contact::JointState::broken_tension) + cracks(s.world(), contact::JointState::broken_shear);
+    double strain = 0.0;
+    const std::size_t preload_points =
+        o.elastic_preload && !uses_platen_blocks(o) ? elastic_preload(s, rig.platen, o, rig.gauges, r, strain, progress) : 0;
+    Servo servo(o, r.contacts, cracks_at_start);
+    StopRules rules(o, cracks_at_start);
+    load_until_stopped(rig, start, strain, servo, rules, r, progress, on_frame);
+    finish_labtest_result(s, o, rules, start, preload_points, r);
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (on_finish) on_finish(s, r);
     return r;

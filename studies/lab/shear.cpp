@@ -172,6 +172,112 @@ void shear_figures(ShearTestResult& r, const ShearPoint& peak) {
 
 } // namespace
 
+namespace {
+
+/// The test's machine on a built specimen: the two boxes, the servo on the upper
+/// box that holds the normal load (CNL) or follows the normal stiffness (CNS),
+/// and what a record measures.
+class ShearMachine {
+public:
+    ShearMachine(Solver& s, const ShearTestOptions& o) : s_(s), o_(o), lower_(s, "lower_"), upper_(s, "upper_") {
+        if (lower_.blocks.empty() || upper_.blocks.empty())
+            throw std::runtime_error("direct shear: no block on the specimen's faces to hold it");
+        const double w = o.width;
+        // The servo's stiffness: the rows of bonds of the two halves and the plane in
+        // series (per unit area), times the width. The plane is joint over k of its
+        // length and bonded rock over the rest.
+        const double rows = o.rock.pattern.kind == meshing::PatternSpec::Kind::single ? 0.0 : o.height / o.rock.pattern.size;
+        const double plane_kn = o.persistence * o.plane.kn + (1.0 - o.persistence) * o.rock.bonds.kn;
+        stiffness_ = w / (rows / o.rock.bonds.kn + 1.0 / plane_kn);
+        // Largest box speed, m per step: a thousandth of σn's elastic displacement, or
+        // the shear rate itself (a joint dilating at up to 45°, Barton-Bandis's rough
+        // joints at low σn, lifts the box about that fast: a slower box let σn run away).
+        servo_cap_ = std::max(1e-3 * o.normal_stress * w / stiffness_, o.shear_rate);
+    }
+
+    /// The normal stress first: ramped, then settled, the box held horizontally.
+    /// Where the box then is, is the origin of the displacement and the dilation.
+    void apply_normal_stress() {
+        constexpr long ramp = 2000, settle_max = 40000;
+        for (long k = 1; k <= ramp; ++k) {
+            servo(0.0, target(0.0) * double(k) / double(ramp));
+            s_.step();
+        }
+        for (long k = 0; k < settle_max; ++k) {
+            servo(0.0, target(0.0));
+            s_.step();
+            if (k > 200 && std::abs(upper_.force(s_).y - target(0.0)) < 1e-4 * target(0.0) && s_.world().clock.ratio < 1e-5)
+                break;
+        }
+        start_ = s_.world().clock.steps;
+        origin_ = upper_.displacement(s_);
+        dilation_origin_ = origin_.y;
+    }
+
+    /// Shears to the largest displacement, a point of the curve every
+    /// record_every steps; the peak.
+    ShearPoint shear(ShearTestResult& r, const std::function<void(const ShearPoint&)>& progress,
+                     const std::function<void(const Solver&, const ShearPoint&)>& on_frame) {
+        const double w = o_.width;
+        r.curve.push_back(measure());
+        // The peak at the step: a brittle bond lets go between two records.
+        ShearPoint peak = r.curve.front();
+        double u = 0.0;
+        while (u < o_.max_displacement) {
+            const double dilation = upper_.displacement(s_).y - dilation_origin_;
+            servo(o_.shear_rate, target(dilation));
+            s_.step();
+            u = upper_.displacement(s_).x - origin_.x;
+            if (0.5 * (lower_.force(s_).x - upper_.force(s_).x) / w > peak.shear_stress) peak = measure();
+            if ((s_.world().clock.steps - start_) % o_.record_every != 0) continue;
+            const ShearPoint p = measure();
+            r.curve.push_back(p);
+            const double t = target(p.dilation) / w;
+            if (t > 0) r.normal_stress_error = std::max(r.normal_stress_error, std::abs(p.normal_stress - t) / t);
+            if (progress) progress(p);
+            if (studies::stop_signal_received()) throw Interrupted("interrupted during a shear test"); // as a lab test's
+            if (on_frame && o_.frame_every > 0 && (s_.world().clock.steps - start_) % o_.frame_every == 0) on_frame(s_, p);
+        }
+        return peak;
+    }
+
+private:
+    /// The normal force wanted at a dilation (constant with no normal stiffness).
+    double target(double dilation) const {
+        return o_.width * std::max(0.0, o_.normal_stress + o_.normal_stiffness * dilation);
+    }
+
+    void servo(double horizontal, double target_force) {
+        const double n = upper_.force(s_).y;
+        const double vy = std::clamp(o_.servo_gain * (n - target_force) / stiffness_, -servo_cap_, servo_cap_);
+        upper_.set_velocity(s_, {horizontal, vy});
+    }
+
+    ShearPoint measure() const {
+        const double w = o_.width;
+        ShearPoint p;
+        p.step = s_.world().clock.steps;
+        const Vec2 d = upper_.displacement(s_);
+        p.displacement = d.x - origin_.x;
+        p.dilation = d.y - dilation_origin_;
+        p.shear_stress = 0.5 * (lower_.force(s_).x - upper_.force(s_).x) / w;
+        p.normal_stress = upper_.force(s_).y / w;
+        p.cracks_tensile = cracks(s_.world(), contact::JointState::broken_tension);
+        p.cracks_shear = cracks(s_.world(), contact::JointState::broken_shear);
+        return p;
+    }
+
+    Solver& s_;
+    const ShearTestOptions& o_;
+    const ShearBox lower_, upper_;
+    double stiffness_ = 0.0, servo_cap_ = 0.0;
+    long start_ = 0;
+    Vec2 origin_{};
+    double dilation_origin_ = 0.0;
+};
+
+} // namespace
+
 ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<void(const ShearPoint&)>& progress,
                                const std::function<void(const Solver&, const ShearTestResult&)>& on_finish,
                                const std::function<void(const Solver&, const ShearPoint&)>& on_frame) {
@@ -184,74 +290,9 @@ ShearTestResult run_shear_test(const ShearTestOptions& o, const std::function<vo
     r.blocks = assembly.block_count();
     r.contacts = contacts(s.world()).size();
     for (const auto& j : assembly.joints) r.plane_joints += j.tag == meshing::JointTag::real_joint;
-    const ShearBox lower(s, "lower_"), upper(s, "upper_");
-    if (lower.blocks.empty() || upper.blocks.empty())
-        throw std::runtime_error("direct shear: no block on the specimen's faces to hold it");
-    const double w = o.width;
-    // The servo's stiffness: the rows of bonds of the two halves and the plane in
-    // series (per unit area), times the width. The plane is joint over k of its
-    // length and bonded rock over the rest.
-    const double rows = o.rock.pattern.kind == meshing::PatternSpec::Kind::single ? 0.0 : o.height / o.rock.pattern.size;
-    const double plane_kn = o.persistence * o.plane.kn + (1.0 - o.persistence) * o.rock.bonds.kn;
-    const double stiffness = w / (rows / o.rock.bonds.kn + 1.0 / plane_kn);
-    // Largest box speed, m per step: a thousandth of σn's elastic displacement, or
-    // the shear rate itself (a joint dilating at up to 45°, Barton-Bandis's rough
-    // joints at low σn, lifts the box about that fast: a slower box let σn run away).
-    const double servo_cap = std::max(1e-3 * o.normal_stress * w / stiffness, o.shear_rate);
-    double dilation_origin = 0.0;
-    auto target = [&](double dilation) {
-        return w * std::max(0.0, o.normal_stress + o.normal_stiffness * dilation);
-    };
-    auto servo = [&](double horizontal, double target_force) {
-        const double n = upper.force(s).y;
-        const double vy = std::clamp(o.servo_gain * (n - target_force) / stiffness, -servo_cap, servo_cap);
-        upper.set_velocity(s, {horizontal, vy});
-    };
-    // The normal stress first: ramped, then settled, the box held horizontally.
-    constexpr long ramp = 2000, settle_max = 40000;
-    for (long k = 1; k <= ramp; ++k) {
-        servo(0.0, target(0.0) * double(k) / double(ramp));
-        s.step();
-    }
-    for (long k = 0; k < settle_max; ++k) {
-        servo(0.0, target(0.0));
-        s.step();
-        if (k > 200 && std::abs(upper.force(s).y - target(0.0)) < 1e-4 * target(0.0) && s.world().clock.ratio < 1e-5) break;
-    }
-    const long start = s.world().clock.steps;
-    const Vec2 origin = upper.displacement(s);
-    dilation_origin = origin.y;
-    auto measure = [&] {
-        ShearPoint p;
-        p.step = s.world().clock.steps;
-        const Vec2 d = upper.displacement(s);
-        p.displacement = d.x - origin.x;
-        p.dilation = d.y - dilation_origin;
-        p.shear_stress = 0.5 * (lower.force(s).x - upper.force(s).x) / w;
-        p.normal_stress = upper.force(s).y / w;
-        p.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
-        p.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
-        return p;
-    };
-    r.curve.push_back(measure());
-    // The peak at the step: a brittle bond lets go between two records.
-    ShearPoint peak = r.curve.front();
-    double u = 0.0;
-    while (u < o.max_displacement) {
-        const double dilation = upper.displacement(s).y - dilation_origin;
-        servo(o.shear_rate, target(dilation));
-        s.step();
-        u = upper.displacement(s).x - origin.x;
-        if (0.5 * (lower.force(s).x - upper.force(s).x) / w > peak.shear_stress) peak = measure();
-        if ((s.world().clock.steps - start) % o.record_every != 0) continue;
-        const ShearPoint p = measure();
-        r.curve.push_back(p);
-        const double t = target(p.dilation) / w;
-        if (t > 0) r.normal_stress_error = std::max(r.normal_stress_error, std::abs(p.normal_stress - t) / t);
-        if (progress) progress(p);
-        if (studies::stop_signal_received()) throw Interrupted("interrupted during a shear test"); // as a lab test's
-        if (on_frame && o.frame_every > 0 && (s.world().clock.steps - start) % o.frame_every == 0) on_frame(s, p);
-    }
+    ShearMachine machine(s, o);
+    machine.apply_normal_stress();
+    const ShearPoint peak = machine.shear(r, progress, on_frame);
     shear_figures(r, peak);
     r.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
     r.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
@@ -462,27 +503,33 @@ void print_shear_summary(const nlohmann::json& summary) {
                      summary["residual_coulomb"]["friction_deg"].get<double>());
 }
 
-} // namespace
+/// The series on the console: the specimen, the normal stresses and realizations, the mode.
+void print_shear_series(const ShearValues& v) {
+    const int per = v.lab.realizations;
+    std::fprintf(stderr, "bbm shear: %s blocks of %.3g m, %g m x %g m, persistence %g, %zu normal stress%s x %d "
+                         "realization%s, %s\n",
+                 meshing::to_string(v.o.rock.pattern.kind), v.o.rock.pattern.size, v.o.width, v.o.height, v.o.persistence, v.normal_stresses.size(),
+                 v.normal_stresses.size() > 1 ? "es" : "", per, per > 1 ? "s" : "",
+                 v.o.normal_stiffness > 0 ? "constant normal stiffness" : "constant normal load");
+}
 
-int run_shear(ShearValues& v, bool quiet, bool check_only, ShearStudy* study) {
-    check_shear_options(v);
-    if (check_only) return 0;
-    const std::filesystem::path out = v.lab.out;
-    const bool write = v.lab.write_files;
-    if (write) io::make_output_directory(out);
-    const int per = v.lab.realizations, n = per * int(v.normal_stresses.size());
-    const int available = v.lab.threads > 0 ? v.lab.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    const int side_by_side = std::max(1, std::min(n, available));
-    quiet = quiet || !Ranks::root();
-    if (!quiet)
-        std::fprintf(stderr, "bbm shear: %s blocks of %.3g m, %g m x %g m, persistence %g, %zu normal stress%s x %d "
-                             "realization%s, %s\n",
-                     meshing::to_string(v.o.rock.pattern.kind), v.o.rock.pattern.size, v.o.width, v.o.height, v.o.persistence, v.normal_stresses.size(),
-                     v.normal_stresses.size() > 1 ? "es" : "", per, per > 1 ? "s" : "",
-                     v.o.normal_stiffness > 0 ? "constant normal stiffness" : "constant normal load");
+/// The runs of a series, per normal stress and seed (run k: normal stress k / per,
+/// seed k % per): each run's test, its files, its lines on the console.
+struct ShearSeries {
+    const ShearValues& v;
+    std::filesystem::path out;
+    bool write = false, quiet = false;
+    int per = 1, n = 1, available = 1;
     std::mutex print;
     Progress lines; // progress of a single run; every run's result
-    auto run = [&](int k) -> std::string {
+
+    ShearSeries(const ShearValues& values, std::filesystem::path dir, bool write_files, bool no_lines, int runs_per_stress,
+                int runs, int threads)
+        : v(values), out(std::move(dir)), write(write_files), quiet(no_lines), per(runs_per_stress), n(runs),
+          available(threads) {}
+
+    /// Run k, its result as the record that travels between ranks.
+    std::string run(int k) {
         ShearTestOptions o = v.o;
         o.normal_stress = v.normal_stresses[k / per];
         o.rock.pattern.seed = v.o.rock.pattern.seed + std::uint64_t(k % per);
@@ -516,14 +563,11 @@ int run_shear(ShearValues& v, bool quiet, bool check_only, ShearStudy* study) {
                          r.peak_dilation_angle, r.cracks_tensile + r.cracks_shear, r.steps, r.wall_seconds);
         }
         return shear_record(r).dump();
-    };
-    std::vector<ShearTestResult> results;
-    try {
-        for (const auto& text : run_spread(n, n > 1 ? side_by_side : 1, run))
-            results.push_back(shear_from_record(nlohmann::json::parse(text)));
-    } catch (const GeometryError& e) {
-        throw InputError("--size", 0, "", e.what());
     }
+};
+
+/// A run whose servo missed the normal stress by more than 5%, said on the console.
+void warn_servo_misses(const std::vector<ShearTestResult>& results) {
     for (const auto& r : results)
         if (r.normal_stress_error > 0.05 && Ranks::root())
             std::fprintf(stderr,
@@ -531,6 +575,30 @@ int run_shear(ShearValues& v, bool quiet, bool check_only, ShearStudy* study) {
                          "(normal_stress_error in summary.json): the peak is at another normal stress than asked; "
                          "lower --shear-rate or raise --servo-gain\n",
                          r.normal_stress / 1e6, 100.0 * r.normal_stress_error);
+}
+
+} // namespace
+
+int run_shear(ShearValues& v, bool quiet, bool check_only, ShearStudy* study) {
+    check_shear_options(v);
+    if (check_only) return 0;
+    const std::filesystem::path out = v.lab.out;
+    const bool write = v.lab.write_files;
+    if (write) io::make_output_directory(out);
+    const int per = v.lab.realizations, n = per * int(v.normal_stresses.size());
+    const int available = v.lab.threads > 0 ? v.lab.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int side_by_side = std::max(1, std::min(n, available));
+    quiet = quiet || !Ranks::root();
+    if (!quiet) print_shear_series(v);
+    ShearSeries series(v, out, write, quiet, per, n, available);
+    std::vector<ShearTestResult> results;
+    try {
+        for (const auto& text : run_spread(n, n > 1 ? side_by_side : 1, [&](int k) { return series.run(k); }))
+            results.push_back(shear_from_record(nlohmann::json::parse(text)));
+    } catch (const GeometryError& e) {
+        throw InputError("--size", 0, "", e.what());
+    }
+    warn_servo_misses(results);
     const nlohmann::json summary = shear_summary(v, results);
     if (write && Ranks::root()) {
         write_shear_curves(results, out);

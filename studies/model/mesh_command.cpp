@@ -21,21 +21,30 @@ namespace fs = std::filesystem;
 
 namespace {
 
-nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::GenerationStats& st,
-                            double seconds) {
-    using nlohmann::json;
+/// The blocks' areas, and those of the block patterns (not single blocks): how
+/// many, their area, their shortest edge.
+struct BlockSizes {
     double total_area = 0.0, inner_area = 0.0;
     int inner_blocks = 0;
     double min_edge = INFINITY;
+};
+
+BlockSizes block_sizes(const meshing::BlockAssembly& a) {
+    BlockSizes s;
     for (int b = 0; b < a.block_count(); ++b) {
-        total_area += a.area[b];
+        s.total_area += a.area[b];
         if (a.pattern[b] == meshing::PatternSpec::Kind::single) continue;
-        inner_area += a.area[b];
-        ++inner_blocks;
+        s.inner_area += a.area[b];
+        ++s.inner_blocks;
         const auto p = a.block(b);
-        for (std::size_t i = 0; i < p.size(); ++i) min_edge = std::min(min_edge, norm(p[(i + 1) % p.size()] - p[i]));
+        for (std::size_t i = 0; i < p.size(); ++i) s.min_edge = std::min(s.min_edge, norm(p[(i + 1) % p.size()] - p[i]));
     }
-    json regions = json::array();
+    return s;
+}
+
+/// Per region: its pattern, blocks, area and block sizes.
+nlohmann::json regions_json(const meshing::BlockAssembly& a) {
+    nlohmann::json regions = nlohmann::json::array();
     for (int r = 0; r < int(a.region_names.size()); ++r) {
         int n = 0;
         double area = 0.0;
@@ -50,10 +59,12 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
                            {"mean_feret_diameter", meshing::mean_feret_diameter(a, r)},
                            {"equal_area_diameter", meshing::mean_block_size(a, r)}});
     }
-    std::map<std::string, int> tags;
-    for (const auto& j : a.joints) ++tags[meshing::to_string(j.tag)];
-    // The fracture network as built against what was asked (meshing/dfn.hpp).
-    json fracture_sets = json::array();
+    return regions;
+}
+
+/// The fracture network as built against what was asked (meshing/dfn.hpp).
+nlohmann::json fracture_sets_json(const meshing::BlockAssembly& a) {
+    nlohmann::json fracture_sets = nlohmann::json::array();
     for (std::size_t k = 0; k < a.fracture_stats.size(); ++k) {
         const auto& f = a.fracture_stats[k];
         fracture_sets.push_back({{"name", f.name},
@@ -73,14 +84,22 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
                                  {"mean_length_target", f.mean_length_target},
                                  {"mean_trace_length", f.mean_trace}});
     }
+    return fracture_sets;
+}
+
+nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::GenerationStats& st,
+                            double seconds) {
+    const BlockSizes s = block_sizes(a);
+    std::map<std::string, int> tags;
+    for (const auto& j : a.joints) ++tags[meshing::to_string(j.tag)];
     return {{"blocks", a.block_count()},
             {"joints", a.joints.size()},
             {"joints_by_tag", tags},
-            {"total_area", total_area},
-            {"inner_blocks", inner_blocks},
+            {"total_area", s.total_area},
+            {"inner_blocks", s.inner_blocks},
             {"equal_area_diameter",
-             inner_blocks ? std::sqrt(4.0 * inner_area / inner_blocks / 3.141592653589793) : 0.0},
-            {"min_edge_length", inner_blocks ? min_edge : 0.0},
+             s.inner_blocks ? std::sqrt(4.0 * s.inner_area / s.inner_blocks / 3.141592653589793) : 0.0},
+            {"min_edge_length", s.inner_blocks ? s.min_edge : 0.0},
             {"collapsed_edges", st.collapsed_edges},
             {"short_edges_left", st.short_edges_left},
             {"merged_slivers", st.merged_slivers},
@@ -88,8 +107,8 @@ nlohmann::json mesh_summary(const meshing::BlockAssembly& a, const meshing::Gene
             {"merged_trace_length", st.merged_trace_length},
             {"rock_bridges", st.rock_bridges},
             {"hole_cuts", st.hole_cuts},
-            {"regions", regions},
-            {"fracture_sets", fracture_sets},
+            {"regions", regions_json(a)},
+            {"fracture_sets", fracture_sets_json(a)},
             {"seconds", {{"regions", st.seconds_regions},
                          {"patterns", st.seconds_patterns},
                          {"topology", st.seconds_topology},

@@ -105,6 +105,67 @@ nlohmann::json verdict_json(const Verdict& v) {
 
 namespace {
 
+/// The failed zone (studies/model/opening.hpp): per sector its depth, its
+/// extent toward the springline and the crown, its lobes, and where it meets the
+/// edge of the opening's region.
+nlohmann::json failed_zone_json(const FailedZone& zone) {
+    nlohmann::json out = {{"cell_m", zone.cell},
+                          {"threshold_broken_fraction", zone.threshold},
+                          {"sector_deg", 360.0 / double(zone.depth.size())},
+                          {"depth_by_sector_m", zone.depth},
+                          {"depth_by_sector_cells_m", zone.depth_cells},
+                          {"resolution_m", zone.resolution},
+                          {"depth_springline", zone.depth_springline},
+                          {"depth_crown", zone.depth_crown},
+                          {"extent_springline_deg", zone.extent_springline_deg},
+                          {"extent_crown_deg", zone.extent_crown_deg},
+                          {"area_m2", zone.area},
+                          {"reaches_region_edge", zone.reaches_region_edge},
+                          {"region_edge_cells", zone.edge_cells},
+                          {"region_edge_cells_damaged", zone.edge_cells_damaged}};
+    nlohmann::json lobes = nlohmann::json::array();
+    for (const auto& l : zone.lobes())
+        lobes.push_back({{"centre_deg", l.centre_deg}, {"depth_m", l.depth}, {"width_deg", l.width_deg}, {"area_m2", l.area}});
+    out["lobes"] = lobes;
+    if (zone.reaches_region_edge) out["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
+    return out;
+}
+
+/// Hoop stress profiles from the wall outwards (compression positive, MPa),
+/// toward the springline and the crown.
+void add_hoop_stress_profiles(nlohmann::json& opening, const World& w, const ReportSpec& rep) {
+    const auto stress = block_stresses(w);
+    const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
+    nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
+    for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
+        const double hs = hoop_stress_at(w, stress, rep.center, rep.springline, f * a_s, 0.3);
+        const double hc = hoop_stress_at(w, stress, rep.center, rep.crown, f * a_c, 0.3);
+        spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
+        crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
+    }
+    opening["hoop_stress_springline"] = spring;
+    opening["hoop_stress_crown"] = crown;
+}
+
+/// The damaged zone as a path for water along the tunnel, rings of a tenth of the radius.
+nlohmann::json axial_permeability_json(const World& w, const ReportSpec& rep) {
+    const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
+    const auto k = measure_axial_permeability(w, rep.center, rep.springline, rep.crown, 0.1 * std::min(a_s, a_c));
+    return {{"intact_m2", k.intact},
+            {"ring_m", k.ring},
+            {"crown_m2", k.crown},
+            {"springline_m2", k.springline},
+            {"all_round_m2", k.all_round},
+            {"edz_joints", k.edz_joints},
+            {"edz_area_m2", k.edz_area},
+            {"edz_depth_m", k.edz_depth},
+            {"edz_transmissivity_m4", k.edz_transmissivity},
+            {"edz_permeability_m2", k.edz_permeability},
+            {"core_area_m2", k.core_area},
+            {"core_joints", k.core_joints},
+            {"parted_joints", k.parted_joints}};
+}
+
 /// summary.json's "opening": the wall's displacements and convergences, the
 /// cracked depth, the failed zone with its lobes, and hoop stress profiles.
 nlohmann::json opening_summary(const World& w, const ReportSpec& rep) {
@@ -120,56 +181,9 @@ nlohmann::json opening_summary(const World& w, const ReportSpec& rep) {
         {"cracks_crown_sector", m.cracks_crown_sector},
         {"springline_sector_tensile", m.tensile_springline_sector},
         {"springline_sector_shear", m.shear_springline_sector}};
-    const auto zone = measure_failed_zone(w, rep.center, rep.springline, rep.crown);
-    opening["failed_zone"] = {{"cell_m", zone.cell},
-                              {"threshold_broken_fraction", zone.threshold},
-                              {"sector_deg", 360.0 / double(zone.depth.size())},
-                              {"depth_by_sector_m", zone.depth},
-                              {"depth_by_sector_cells_m", zone.depth_cells},
-                              {"resolution_m", zone.resolution},
-                              {"depth_springline", zone.depth_springline},
-                              {"depth_crown", zone.depth_crown},
-                              {"extent_springline_deg", zone.extent_springline_deg},
-                              {"extent_crown_deg", zone.extent_crown_deg},
-                              {"area_m2", zone.area},
-                              {"reaches_region_edge", zone.reaches_region_edge},
-                              {"region_edge_cells", zone.edge_cells},
-                              {"region_edge_cells_damaged", zone.edge_cells_damaged}};
-    nlohmann::json lobes = nlohmann::json::array();
-    for (const auto& l : zone.lobes())
-        lobes.push_back({{"centre_deg", l.centre_deg}, {"depth_m", l.depth}, {"width_deg", l.width_deg}, {"area_m2", l.area}});
-    opening["failed_zone"]["lobes"] = lobes;
-    if (zone.reaches_region_edge)
-        opening["failed_zone"]["region_edge_point"] = {zone.region_edge_point.x, zone.region_edge_point.y};
-    // Hoop stress profiles from the wall outwards (compression positive, MPa).
-    const auto stress = block_stresses(w);
-    const double a_s = norm(rep.springline - rep.center), a_c = norm(rep.crown - rep.center);
-    nlohmann::json spring = nlohmann::json::array(), crown = nlohmann::json::array();
-    for (double f : {1.05, 1.125, 1.25, 1.5, 2.0}) {
-        const double hs = hoop_stress_at(w, stress, rep.center, rep.springline, f * a_s, 0.3);
-        const double hc = hoop_stress_at(w, stress, rep.center, rep.crown, f * a_c, 0.3);
-        spring.push_back({{"r", f * a_s}, {"hoop_MPa", std::isfinite(hs) ? -hs / 1e6 : 0.0}});
-        crown.push_back({{"r", f * a_c}, {"hoop_MPa", std::isfinite(hc) ? -hc / 1e6 : 0.0}});
-    }
-    opening["hoop_stress_springline"] = spring;
-    opening["hoop_stress_crown"] = crown;
-    if (w.flow) {
-        // The damaged zone as a path for water along the tunnel, rings of a tenth of the radius.
-        const auto k = measure_axial_permeability(w, rep.center, rep.springline, rep.crown, 0.1 * std::min(a_s, a_c));
-        opening["axial_permeability"] = {{"intact_m2", k.intact},
-                                         {"ring_m", k.ring},
-                                         {"crown_m2", k.crown},
-                                         {"springline_m2", k.springline},
-                                         {"all_round_m2", k.all_round},
-                                         {"edz_joints", k.edz_joints},
-                                         {"edz_area_m2", k.edz_area},
-                                         {"edz_depth_m", k.edz_depth},
-                                         {"edz_transmissivity_m4", k.edz_transmissivity},
-                                         {"edz_permeability_m2", k.edz_permeability},
-                                         {"core_area_m2", k.core_area},
-                                         {"core_joints", k.core_joints},
-                                         {"parted_joints", k.parted_joints}};
-    }
+    opening["failed_zone"] = failed_zone_json(measure_failed_zone(w, rep.center, rep.springline, rep.crown));
+    add_hoop_stress_profiles(opening, w, rep);
+    if (w.flow) opening["axial_permeability"] = axial_permeability_json(w, rep);
     return opening;
 }
 
@@ -191,6 +205,43 @@ void add_support_summaries(nlohmann::json& summary, const World& w) {
     }
 }
 
+/// Per stage run: its kind, steps, ratio, time, method and verdict.
+nlohmann::json stages_json(const std::vector<StageReport>& reports) {
+    nlohmann::json stages = nlohmann::json::array();
+    for (const auto& r : reports) {
+        nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
+                         {"seconds", r.seconds}, {"converged", r.converged}};
+        if (!r.method.empty()) j["method"] = r.method;
+        if (r.verdict.kind != Verdict::Kind::none) j["verdict"] = verdict_json(r.verdict);
+        stages.push_back(j);
+    }
+    return stages;
+}
+
+/// The water in the joints: the network, its conducting pipes, the inflow, the highest pressure.
+nlohmann::json flow_summary(const JointFlow& flow) {
+    const auto& st = flow.state;
+    int conducting = 0;
+    for (int k = 0; k < flow.net.pipes(); ++k) conducting += flow::conductance(flow.net, flow.fluid, st, k) > 0.0;
+    return {{"mode", flow.spec.mode == FlowSpec::Mode::steady ? "steady" : "transient"},
+            {"domains", flow.net.domains()},
+            {"pipes", flow.net.pipes()},
+            {"conducting_pipes", conducting},
+            {"inflow", inflow(flow)},
+            {"max_pressure", *std::max_element(st.pressure.begin(), st.pressure.end())},
+            {"steady_solves", flow.solves}};
+}
+
+/// The run's verdict: that of its last judged (solve or cycle) stage.
+void add_run_verdict(nlohmann::json& summary, const std::vector<StageReport>& reports) {
+    for (auto r = reports.rbegin(); r != reports.rend(); ++r)
+        if (r->verdict.kind != Verdict::Kind::none) {
+            summary["verdict"] = verdict_json(r->verdict);
+            summary["verdict"]["stage"] = r->name;
+            break;
+        }
+}
+
 } // namespace
 
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
@@ -200,14 +251,6 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
     const World& w = solver.world();
     int rigid = 0;
     for (int i = 0; i < blocks.block_count(); ++i) rigid += !w.blocks.deformable[i];
-    nlohmann::json stages = nlohmann::json::array();
-    for (const auto& r : reports) {
-        nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
-                         {"seconds", r.seconds}, {"converged", r.converged}};
-        if (!r.method.empty()) j["method"] = r.method;
-        if (r.verdict.kind != Verdict::Kind::none) j["verdict"] = verdict_json(r.verdict);
-        stages.push_back(j);
-    }
     nlohmann::json summary{
         {"bbm_version", version_text()},
         {"model", model_name},
@@ -231,27 +274,9 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         // false: stopped by a health check or interrupted; the fields describe the
         // last good state, not the end of the model's stages.
         {"complete", complete},
-        {"stages", stages}};
-    if (w.flow) {
-        const JointFlow& flow = *w.flow;
-        const auto& st = flow.state;
-        int conducting = 0;
-        for (int k = 0; k < flow.net.pipes(); ++k) conducting += flow::conductance(flow.net, flow.fluid, st, k) > 0.0;
-        summary["flow"] = {{"mode", flow.spec.mode == FlowSpec::Mode::steady ? "steady" : "transient"},
-                           {"domains", flow.net.domains()},
-                           {"pipes", flow.net.pipes()},
-                           {"conducting_pipes", conducting},
-                           {"inflow", inflow(flow)},
-                           {"max_pressure", *std::max_element(st.pressure.begin(), st.pressure.end())},
-                           {"steady_solves", flow.solves}};
-    }
-    // The run's verdict: that of its last judged (solve or cycle) stage.
-    for (auto r = reports.rbegin(); r != reports.rend(); ++r)
-        if (r->verdict.kind != Verdict::Kind::none) {
-            summary["verdict"] = verdict_json(r->verdict);
-            summary["verdict"]["stage"] = r->name;
-            break;
-        }
+        {"stages", stages_json(reports)}};
+    if (w.flow) summary["flow"] = flow_summary(*w.flow);
+    add_run_verdict(summary, reports);
     add_support_summaries(summary, w);
     const auto& rep = file.analysis.report;
     if (rep.opening) summary["opening"] = opening_summary(w, rep);

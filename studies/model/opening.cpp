@@ -11,41 +11,43 @@
 
 namespace bbm {
 
-OpeningMeasures measure_opening(const World& w, Vec2 center, Vec2 springline, Vec2 crown) {
-    OpeningMeasures m;
+namespace {
+
+/// The displacement of the material point (rigid vertex or node, of a block still
+/// there) that started nearest p.
+Vec2 displacement_nearest(const World& w, Vec2 p) {
     const auto& b = w.blocks;
     const auto& n = w.nodes;
     const auto& x = w.vertices;
     const auto& removed = w.bodies.removed;
-    // The material point (rigid vertex or node, of a block still there) that started nearest p.
-    auto displacement_at = [&](Vec2 p) {
-        double best = INFINITY;
-        Vec2 u{};
-        for (int i = 0; i < b.count(); ++i) {
-            if (removed[i] || b.deformable[i]) continue;
-            const auto& body = w.bodies.state[i];
-            const Rotation rot = rotation(body.theta);
-            for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
-                const Vec2 x0 = b.centroid0[i] + x.local[v];
-                if (norm(x0 - p) >= best) continue;
-                best = norm(x0 - p);
-                u = body.centroid + rot(x.local[v]) - x0;
-            }
+    double best = INFINITY;
+    Vec2 u{};
+    for (int i = 0; i < b.count(); ++i) {
+        if (removed[i] || b.deformable[i]) continue;
+        const auto& body = w.bodies.state[i];
+        const Rotation rot = rotation(body.theta);
+        for (std::uint32_t v = b.first[i]; v < b.first[i + 1]; ++v) {
+            const Vec2 x0 = b.centroid0[i] + x.local[v];
+            if (norm(x0 - p) >= best) continue;
+            best = norm(x0 - p);
+            u = body.centroid + rot(x.local[v]) - x0;
         }
-        for (int k = 0; k < n.count(); ++k)
-            if (!removed[n.block[k]] && norm(n.position0[k] - p) < best)
-                best = norm(n.position0[k] - p), u = n.position[k] - n.position0[k];
-        return u;
-    };
-    m.springline_displacement = displacement_at(springline);
-    m.crown_displacement = displacement_at(crown);
+    }
+    for (int k = 0; k < n.count(); ++k)
+        if (!removed[n.block[k]] && norm(n.position0[k] - p) < best)
+            best = norm(n.position0[k] - p), u = n.position[k] - n.position0[k];
+    return u;
+}
+
+/// The cracks in the ±30° sectors toward the springline and the crown (into `m`),
+/// and the distances beyond the wall of those within ±15° of each.
+void count_sector_cracks(const World& w, Vec2 center, Vec2 springline, Vec2 crown, OpeningMeasures& m,
+                         std::vector<double>& depth_s, std::vector<double>& depth_c) {
+    const auto& x = w.vertices;
     const Vec2 ds = (springline - center) / norm(springline - center), dc = (crown - center) / norm(crown - center);
-    m.springline_convergence = -dot(m.springline_displacement, ds);
-    m.crown_convergence = -dot(m.crown_displacement, dc);
     const double rs = norm(springline - center), rc = norm(crown - center);
     const double cos30 = std::cos(30.0 * 3.141592653589793 / 180.0), cos15 = std::cos(15.0 * 3.141592653589793 / 180.0);
     const auto& c = contacts(w);
-    std::vector<double> depth_s, depth_c;
     for (int i = 0; i < c.size(); ++i) {
         const auto mode = c.history[i].broken;
         if (mode != contact::JointState::broken_tension && mode != contact::JointState::broken_shear) continue;
@@ -61,15 +63,29 @@ OpeningMeasures measure_opening(const World& w, Vec2 center, Vec2 springline, Ve
         if (cs >= cos15) depth_s.push_back(d - rs);
         if (cc >= cos15) depth_c.push_back(d - rc);
     }
-    // Depth of the failed zone: within it lie 90% of the sector's cracks (a lone
-    // crack far from the wall is not a failed zone); fewer than 3 cracks: none.
-    auto depth = [](std::vector<double>& v) {
-        if (v.size() < 3) return 0.0;
-        std::sort(v.begin(), v.end());
-        return std::max(0.0, v[std::size_t(std::ceil(0.9 * double(v.size()))) - 1]);
-    };
-    m.failed_depth_springline = depth(depth_s);
-    m.failed_depth_crown = depth(depth_c);
+}
+
+/// Depth of the failed zone: within it lie 90% of the sector's cracks (a lone
+/// crack far from the wall is not a failed zone); fewer than 3 cracks: none.
+double sector_crack_depth(std::vector<double>& v) {
+    if (v.size() < 3) return 0.0;
+    std::sort(v.begin(), v.end());
+    return std::max(0.0, v[std::size_t(std::ceil(0.9 * double(v.size()))) - 1]);
+}
+
+} // namespace
+
+OpeningMeasures measure_opening(const World& w, Vec2 center, Vec2 springline, Vec2 crown) {
+    OpeningMeasures m;
+    m.springline_displacement = displacement_nearest(w, springline);
+    m.crown_displacement = displacement_nearest(w, crown);
+    const Vec2 ds = (springline - center) / norm(springline - center), dc = (crown - center) / norm(crown - center);
+    m.springline_convergence = -dot(m.springline_displacement, ds);
+    m.crown_convergence = -dot(m.crown_displacement, dc);
+    std::vector<double> depth_s, depth_c;
+    count_sector_cracks(w, center, springline, crown, m, depth_s, depth_c);
+    m.failed_depth_springline = sector_crack_depth(depth_s);
+    m.failed_depth_crown = sector_crack_depth(depth_c);
     return m;
 }
 
@@ -235,64 +251,72 @@ std::vector<double> outermost_broken(const GridZone& z) {
     return out;
 }
 
-} // namespace
+/// The band along the region's edge: its cells and their neighbours, inside it.
+bool near_region_edge(const GridZone& g, int k) {
+    const int sectors = g.grid.sectors, rings = g.grid.rings;
+    const int ring = k / sectors, sector = k % sectors;
+    for (int dr = -1; dr <= 1; ++dr)
+        for (int ds = -1; ds <= 1; ++ds) {
+            const int rr = ring + dr, ss = (sector + ds + sectors) % sectors;
+            if (rr >= 0 && rr < rings && g.joints.edge[std::size_t(rr * sectors + ss)]) return true;
+        }
+    return false;
+}
 
-FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec2 crown, double cell,
-                               double threshold, int sectors) {
-    FailedZone z;
-    z.cell = cell, z.threshold = threshold, z.center = center;
-    z.radius = std::min(norm(springline - center), norm(crown - center));
-    z.depth.assign(std::size_t(sectors), 0.0), z.depth_cells.assign(std::size_t(sectors), 0.0);
-    const GridZone g0 = zone_on_grid(w, PolarCells{center, z.radius, cell, sectors}, threshold);
-    const CellJoints& j = g0.joints;
-    const std::vector<int>& wall = g0.wall;
-    const std::vector<std::uint8_t>& in_zone = g0.in_zone;
-    const int rings = g0.grid.rings;
-    // The band along the region's edge: its cells and their neighbours, inside it.
-    auto near_edge = [&](int k) {
-        const int ring = k / sectors, sector = k % sectors;
-        for (int dr = -1; dr <= 1; ++dr)
-            for (int ds = -1; ds <= 1; ++ds) {
-                const int rr = ring + dr, ss = (sector + ds + sectors) % sectors;
-                if (rr >= 0 && rr < rings && j.edge[std::size_t(rr * sectors + ss)]) return true;
-            }
-        return false;
-    };
-    for (int k = 0; k < g0.grid.size(); ++k)
-        if (j.all[std::size_t(k)] > 0 && near_edge(k)) ++z.edge_cells, z.edge_cells_damaged += g0.damaged(k, threshold);
-    for (std::size_t k = 0; k < in_zone.size(); ++k) {
-        if (!in_zone[k]) continue;
+/// The cells of rock in the band along the region's edge, and the damaged ones.
+void count_edge_cells(FailedZone& z, const GridZone& g, double threshold) {
+    for (int k = 0; k < g.grid.size(); ++k)
+        if (g.joints.all[std::size_t(k)] > 0 && near_region_edge(g, k))
+            ++z.edge_cells, z.edge_cells_damaged += g.damaged(k, threshold);
+}
+
+/// The zone's cells on the first grid: its area, its depth per sector in whole
+/// cells, and whether (and nearest the centre, where) it reaches the region's edge.
+void add_zone_cells(FailedZone& z, const GridZone& g) {
+    const int sectors = g.grid.sectors;
+    const double cell = z.cell;
+    const Vec2 center = z.center;
+    for (std::size_t k = 0; k < g.in_zone.size(); ++k) {
+        if (!g.in_zone[k]) continue;
         const int ring = int(k) / sectors, sector = int(k) % sectors;
-        if (near_edge(int(k)) && (!z.reaches_region_edge || norm(z.region_edge_point - center) < z.radius + (ring + 0.5) * cell)) {
+        if (near_region_edge(g, int(k)) &&
+            (!z.reaches_region_edge || norm(z.region_edge_point - center) < z.radius + (ring + 0.5) * cell)) {
             const double mid = (sector + 0.5) * 2 * pi / sectors;
             z.reaches_region_edge = true;
             z.region_edge_point = center + (z.radius + (ring + 0.5) * cell) * Vec2{std::cos(mid), std::sin(mid)};
         }
         z.depth_cells[std::size_t(sector)] =
-            std::max(z.depth_cells[std::size_t(sector)], (ring + 1 - wall[std::size_t(sector)]) * cell);
+            std::max(z.depth_cells[std::size_t(sector)], (ring + 1 - g.wall[std::size_t(sector)]) * cell);
         const double r0 = z.radius + ring * cell, r1 = r0 + cell;
         z.area += pi * (r1 * r1 - r0 * r0) / sectors;
     }
-    // The wall in each sector at the contacts' resolution: its innermost contact point of the rock.
+}
+
+/// The wall in each sector at the contacts' resolution: its innermost contact
+/// point of the rock (inf: none).
+std::vector<double> wall_distances(const CellJoints& j, int sectors) {
     std::vector<double> wall_distance(std::size_t(sectors), INFINITY);
     for (std::size_t i = 0; i < j.cell.size(); ++i)
         if (j.cell[i] >= 0) {
             const auto sector = std::size_t(j.cell[i] % sectors);
             wall_distance[sector] = std::min(wall_distance[sector], j.distance[i]);
         }
-    z.wall_offset.assign(std::size_t(sectors), 0.0);
-    for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector)
-        if (std::isfinite(wall_distance[sector])) z.wall_offset[sector] = std::max(0.0, wall_distance[sector] - z.radius);
-    // The depth: the zone's outermost broken contact point, on grids whose rings
-    // start `grid_shifts` fractions of a cell apart, the median over them. On one
-    // grid the outermost broken contact of a dense zone sits at the outer edge of
-    // its deepest cell (the next cell out is under the threshold), so one grid would
-    // still step a cell; the shifted grids' edges are a cell / grid_shifts apart.
+    return wall_distance;
+}
+
+/// The depth: the zone's outermost broken contact point, on grids whose rings
+/// start `grid_shifts` fractions of a cell apart, the median over them. On one
+/// grid the outermost broken contact of a dense zone sits at the outer edge of
+/// its deepest cell (the next cell out is under the threshold), so one grid would
+/// still step a cell; the shifted grids' edges are a cell / grid_shifts apart.
+void set_median_depths(FailedZone& z, const World& w, const GridZone& g0, const std::vector<double>& wall_distance) {
+    const int sectors = g0.grid.sectors;
+    const double cell = z.cell;
     std::vector<std::vector<double>> depths(z.depth.size());
     for (int shift = 0; shift < grid_shifts; ++shift) {
         const GridZone g = shift == 0 ? g0
-                                      : zone_on_grid(w, PolarCells{center, z.radius - shift * cell / grid_shifts, cell, sectors},
-                                                     threshold);
+                                      : zone_on_grid(w, PolarCells{z.center, z.radius - shift * cell / grid_shifts, cell, sectors},
+                                                     z.threshold);
         const auto outermost = outermost_broken(g);
         for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector)
             depths[sector].push_back(std::isfinite(outermost[sector]) ? outermost[sector] - wall_distance[sector] : 0.0);
@@ -302,11 +326,14 @@ FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec
         std::sort(d.begin(), d.end());
         z.depth[sector] = 0.5 * (d[(d.size() - 1) / 2] + d[d.size() / 2]);
     }
-    // The resolution: the larger of the grids' step and the mean radial step
-    // between the distinct contact points a depth can end at, within four cells of
-    // the wall, the median over sectors (a sector along a symmetry plane holds only
-    // that plane's points).
-    std::vector<std::vector<double>> band(z.depth.size());
+}
+
+/// The resolution: the larger of the grids' step and the mean radial step
+/// between the distinct contact points a depth can end at, within four cells of
+/// the wall, the median over sectors (a sector along a symmetry plane holds only
+/// that plane's points).
+double depth_resolution(const CellJoints& j, const std::vector<double>& wall_distance, double cell, int sectors) {
+    std::vector<std::vector<double>> band(wall_distance.size());
     for (std::size_t i = 0; i < j.cell.size(); ++i)
         if (j.cell[i] >= 0) {
             const auto sector = std::size_t(j.cell[i] % sectors);
@@ -319,11 +346,31 @@ FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec
         d.erase(std::unique(d.begin(), d.end(), [](double x, double y) { return y - x < 1e-9; }), d.end());
         if (d.size() >= 2) step.push_back((d.back() - d.front()) / double(d.size() - 1));
     }
+    double resolution = 0.0;
     if (!step.empty()) {
         std::nth_element(step.begin(), step.begin() + std::ptrdiff_t(step.size() / 2), step.end());
-        z.resolution = step[step.size() / 2];
+        resolution = step[step.size() / 2];
     }
-    z.resolution = std::max(z.resolution, cell / grid_shifts);
+    return std::max(resolution, cell / grid_shifts);
+}
+
+} // namespace
+
+FailedZone measure_failed_zone(const World& w, Vec2 center, Vec2 springline, Vec2 crown, double cell,
+                               double threshold, int sectors) {
+    FailedZone z;
+    z.cell = cell, z.threshold = threshold, z.center = center;
+    z.radius = std::min(norm(springline - center), norm(crown - center));
+    z.depth.assign(std::size_t(sectors), 0.0), z.depth_cells.assign(std::size_t(sectors), 0.0);
+    const GridZone g0 = zone_on_grid(w, PolarCells{center, z.radius, cell, sectors}, threshold);
+    count_edge_cells(z, g0, threshold);
+    add_zone_cells(z, g0);
+    const std::vector<double> wall_distance = wall_distances(g0.joints, sectors);
+    z.wall_offset.assign(std::size_t(sectors), 0.0);
+    for (std::size_t sector = 0; sector < std::size_t(sectors); ++sector)
+        if (std::isfinite(wall_distance[sector])) z.wall_offset[sector] = std::max(0.0, wall_distance[sector] - z.radius);
+    set_median_depths(z, w, g0, wall_distance);
+    z.resolution = depth_resolution(g0.joints, wall_distance, cell, sectors);
     zone_toward(z, sectors, springline, z.depth_springline, z.extent_springline_deg);
     zone_toward(z, sectors, crown, z.depth_crown, z.extent_crown_deg);
     return z;

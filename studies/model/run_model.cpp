@@ -574,6 +574,83 @@ void report_stop(int stop_signal, long step, const fs::path& out) {
                  step, (out / "checkpoint.bin").string().c_str(), out.string().c_str());
 }
 
+/// What was built, on stderr: rigid and deformable blocks, zones, contacts, the time step.
+void print_model_built(const std::string& model_path, const BuiltModel& built) {
+    const meshing::BlockAssembly& blocks = built.blocks;
+    const Solver& solver = *built.solver;
+    int rigid = 0;
+    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver.world().blocks.deformable[i];
+    std::fprintf(stderr, "%s: %d rigid blocks, %d deformable blocks with %d zones, %d contacts; time step %.3g s (%s)\n",
+                 model_path.c_str(), rigid, blocks.block_count() - rigid, solver.world().zones.size(),
+                 contacts(solver.world()).size(), solver.world().clock.dt,
+                 built.model.analysis.solver.mode == SolverSpec::Mode::quasi_static ? "quasi-static" : "dynamic");
+}
+
+/// --resume: the output's records and the world's state from the checkpoint;
+/// where in the stages the run goes on.
+StageCursor resume_from_checkpoint(RunOutput& output, Solver& solver, std::ifstream& checkpoint,
+                                   const CheckpointHeader& header, const RunOptions& opt, const std::string& model_path) {
+    const fs::path file = opt.out / "checkpoint.bin";
+    try {
+        output.restore(checkpoint, header);
+        load_state(solver.world(), checkpoint);
+    } catch (const std::runtime_error& e) {
+        // A checkpoint that does not fit this model or this bbm is bad input, not a crash.
+        throw InputError(file.string(), 0, "", e.what());
+    }
+    const StageCursor start = output.cursor();
+    if (!opt.quiet)
+        std::fprintf(stderr,
+                     "resuming %s at step %ld (stage %d '%s', step %ld in it; checkpoint format %u, written by bbm %s "
+                     "on %d thread%s)\n",
+                     model_path.c_str(), solver.world().clock.steps, start.stage + 1, header.stage.c_str(), start.step,
+                     header.format, header.bbm_version.c_str(), header.threads, header.threads == 1 ? "" : "s");
+    return start;
+}
+
+/// The stages run from `start`: the reports of this part of the run, and the
+/// message of the health check that stopped it (empty if none did).
+struct StagesRun {
+    std::vector<StageReport> this_part;
+    std::string health;
+};
+
+StagesRun run_model_stages(Solver& solver, const io::ModelFile& model, RunOutput& output, StageCursor start,
+                           const std::string& model_path) {
+    StagesRun run;
+    try {
+        run.this_part = run_stages(solver, model.analysis.stages, output, start);
+    } catch (const NumericalError& e) {
+        run.health = e.what();
+    } catch (const InputError& e) {
+        // Found by a stage (a support installed where there is no rock): the model's line.
+        if (!e.file().empty()) throw;
+        throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
+    }
+    return run;
+}
+
+/// summary.json, and the pictures of the state — or, when a health check stopped
+/// the run, its history so far instead; the summary.
+nlohmann::json write_run_output(const BuiltModel& built, RunOutput& output, const RunOptions& opt,
+                                const std::string& model_path, const std::vector<StageReport>& reports,
+                                const std::string& health, int stop_signal, double seconds) {
+    const Solver& solver = *built.solver;
+    nlohmann::json summary = run_summary(model_path, built.model, built.blocks, built.gen, solver, reports, seconds,
+                                         stop_signal != 0, health.empty() && stop_signal == 0);
+    if (opt.profile) summary["profile"] = report_profile(solver.profile(), contacts(solver.world()).size());
+    FailurePlotOptions fo = failure_plot_options(built.model, built.blocks, solver, model_path);
+    fo.shade_pressure = opt.shade_pressure;
+    if (!health.empty()) {
+        summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
+        output.flush_history();    // its rows so far: how the stage went wrong
+    } else {
+        draw_pictures(solver, output, opt, fo);
+    }
+    write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");
+    return summary;
+}
+
 } // namespace
 
 int run_model(const RunOptions& opt) {
@@ -594,78 +671,33 @@ int run_model(const RunOptions& opt) {
     if (!to_run) return 0;
     const std::string& model_path = *to_run;
     BuiltModel built = build_model_to_run(model_path, opt);
-    io::ModelFile& model = built.model;
-    const meshing::BlockAssembly& blocks = built.blocks;
-    const meshing::GenerationStats& gen = built.gen;
-    std::unique_ptr<Solver>& solver = built.solver;
+    Solver& solver = *built.solver;
     if (opt.check_only) return 0;
-    solver->profile().enabled = opt.profile;
-    int rigid = 0;
-    for (int i = 0; i < blocks.block_count(); ++i) rigid += !solver->world().blocks.deformable[i];
-    if (!opt.quiet)
-        std::fprintf(stderr, "%s: %d rigid blocks, %d deformable blocks with %d zones, %d contacts; time step %.3g s (%s)\n",
-                     model_path.c_str(), rigid, blocks.block_count() - rigid, solver->world().zones.size(),
-                     contacts(solver->world()).size(), solver->world().clock.dt,
-                     model.analysis.solver.mode == SolverSpec::Mode::quasi_static ? "quasi-static" : "dynamic");
-    RunOutput output(opt.out, model.analysis, *solver, opt, fs::absolute(model_path).lexically_normal().string(),
+    solver.profile().enabled = opt.profile;
+    if (!opt.quiet) print_model_built(model_path, built);
+    RunOutput output(opt.out, built.model.analysis, solver, opt, fs::absolute(model_path).lexically_normal().string(),
                      text_hash(read_file_text(model_path)));
     StageCursor start;
-    if (opt.resume) {
-        const fs::path file = opt.out / "checkpoint.bin";
-        try {
-            output.restore(checkpoint, header);
-            load_state(solver->world(), checkpoint);
-        } catch (const std::runtime_error& e) {
-            // A checkpoint that does not fit this model or this bbm is bad input, not a crash.
-            throw InputError(file.string(), 0, "", e.what());
-        }
-        start = output.cursor();
-        if (!opt.quiet)
-            std::fprintf(stderr,
-                         "resuming %s at step %ld (stage %d '%s', step %ld in it; checkpoint format %u, written by bbm %s "
-                         "on %d thread%s)\n",
-                         model_path.c_str(), solver->world().clock.steps, start.stage + 1, header.stage.c_str(), start.step,
-                         header.format, header.bbm_version.c_str(), header.threads, header.threads == 1 ? "" : "s");
-    }
-    std::string health;
-    std::vector<StageReport> this_part;
-    try {
-        this_part = run_stages(*solver, model.analysis.stages, output, start);
-    } catch (const NumericalError& e) {
-        health = e.what();
-    } catch (const InputError& e) {
-        // Found by a stage (a support installed where there is no rock): the model's line.
-        if (!e.file().empty()) throw;
-        throw InputError(model_path, model.source.line_of(e.key()), e.key(), e.message());
-    }
+    if (opt.resume) start = resume_from_checkpoint(output, solver, checkpoint, header, opt, model_path);
+    const StagesRun run = run_model_stages(solver, built.model, output, start, model_path);
     const int stop_signal = interrupted.load();
     if (stop_signal != 0) {
-        output.write_checkpoint(*solver);
-        if (!opt.quiet) report_stop(stop_signal, solver->world().clock.steps, opt.out);
+        output.write_checkpoint(solver);
+        if (!opt.quiet) report_stop(stop_signal, solver.world().clock.steps, opt.out);
     }
     // The stages finished (before a resume too) and, if the run stopped inside one, that stage so far.
     std::vector<StageReport> reports = output.reports();
-    if (stop_signal != 0 && !this_part.empty() && int(reports.size()) == output.cursor().stage)
-        reports.push_back(this_part.back());
+    if (stop_signal != 0 && !run.this_part.empty() && int(reports.size()) == output.cursor().stage)
+        reports.push_back(run.this_part.back());
     const double seconds = output.wall_seconds();
-    nlohmann::json summary = run_summary(model_path, model, blocks, gen, *solver, reports, seconds, stop_signal != 0,
-                                         health.empty() && stop_signal == 0);
-    if (opt.profile) summary["profile"] = report_profile(solver->profile(), contacts(solver->world()).size());
-    FailurePlotOptions fo = failure_plot_options(model, blocks, *solver, model_path);
-    fo.shade_pressure = opt.shade_pressure;
-    if (!health.empty()) {
-        summary["error"] = health; // pictures of a broken state would mislead: the last good VTK stays
-        output.flush_history();    // its rows so far: how the stage went wrong
-    } else {
-        draw_pictures(*solver, output, opt, fo);
-    }
-    write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");
-    if (!health.empty()) {
-        std::fprintf(stderr, "\nbbm: stopped: %s\nThe output of the last good step is kept in %s.\n", health.c_str(),
-                     opt.out.string().c_str());
+    const nlohmann::json summary =
+        write_run_output(built, output, opt, model_path, reports, run.health, stop_signal, seconds);
+    if (!run.health.empty()) {
+        std::fprintf(stderr, "\nbbm: stopped: %s\nThe output of the last good step is kept in %s.\n",
+                     run.health.c_str(), opt.out.string().c_str());
         return 3;
     }
-    if (!opt.quiet) print_run_report(*solver, summary, model, opt, seconds);
+    if (!opt.quiet) print_run_report(solver, summary, built.model, opt, seconds);
     return stop_signal != 0 ? 130 : 0;
 }
 

@@ -195,76 +195,99 @@ struct SweepTable {
     std::map<std::string, std::map<double, std::pair<double, int>>> mean; // others -> x -> (sum, count)
 };
 
-void tabulate_sweep(const SweepOptions& o, const std::vector<SweepRun>& plan, const std::vector<std::string>& summaries,
-                    const std::vector<std::string>& errors, SweepTable& out) {
-    auto& csv = out.csv;
-    auto& table = out.table;
-    auto& failed = out.failed;
-    auto& by_seed = out.by_seed;
-    auto& mean = out.mean;
-    const std::size_t runs = plan.size();
+/// Run k's row of sweep.json (its keys' values, status, error and summary), its
+/// summary (null when the run failed) and the plot's value of it.
+struct SweepRow {
+    nlohmann::json row, summary;
+    std::string status; ///< done, failed or incomplete
+    double y = NAN;
+};
+
+SweepRow sweep_row(const SweepOptions& o, std::size_t k, const SweepRun& r, const std::string& summary,
+                   const std::string& error) {
+    SweepRow out;
+    nlohmann::json& row = out.row;
+    nlohmann::json& s = out.summary;
+    row = {{"run", k + 1}, {"folder", r.dir}, {"seed_offset", r.seed_offset}};
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& [key, value] : r.set) values[key] = value;
+    row["set"] = values;
+    out.status = "done";
+    if (!error.empty()) {
+        out.status = "failed", row["error"] = error;
+    } else {
+        s = nlohmann::json::parse(summary);
+        if (!s.value("complete", false)) out.status = "incomplete";
+        if (s.contains("error")) row["error"] = s["error"];
+        if (s.value("resumed", false)) row["resumed"] = true;
+        row["summary"] = s;
+    }
+    row["status"] = out.status;
+    out.y = s.is_null() ? NAN : summary_value(s, o.plot);
+    row["plot_value"] = std::isfinite(out.y) ? nlohmann::json(out.y) : nlohmann::json();
+    return out;
+}
+
+/// A summary's value for sweep.csv ("" when the run has none).
+std::string csv_number(const nlohmann::json& s, const std::string& key) {
+    if (s.is_null()) return "";
+    const double v = summary_value(s, key);
+    if (!std::isfinite(v)) return "";
+    char t[40];
+    std::snprintf(t, sizeof t, "%.10g", v);
+    return t;
+}
+
+void add_csv_header(const SweepOptions& o, std::ostringstream& csv) {
     csv << "run";
     for (const auto& s : o.set) csv << ',' << csv_field(s.first);
     csv << ",seed_offset,status,error,steps,cracks_tensile,cracks_shear,wall_seconds,state_hash," << csv_field(o.plot)
         << ",folder\n";
-    for (std::size_t k = 0; k < runs; ++k) {
+}
+
+void add_csv_row(const SweepOptions& o, std::size_t k, const SweepRun& r, const SweepRow& w, std::ostringstream& csv) {
+    const nlohmann::json& s = w.summary;
+    csv << k + 1;
+    for (const auto& [key, value] : r.set) csv << ',' << csv_field(value);
+    csv << ',' << r.seed_offset << ',' << w.status << ',' << csv_field(w.row.value("error", std::string{})) << ','
+        << csv_number(s, "steps") << ',' << csv_number(s, "cracks.tensile") << ',' << csv_number(s, "cracks.shear") << ','
+        << csv_number(s, "wall_seconds") << ',' << (s.is_null() ? "" : s.value("state_hash", std::string{})) << ','
+        << (std::isfinite(w.y) ? csv_number(s, o.plot) : "") << ',' << r.dir << '\n';
+}
+
+/// The plot: the value y against the first swept key, if it is a number.
+void add_plot_point(const SweepOptions& o, const SweepRun& r, double y, SweepTable& out) {
+    char* end = nullptr;
+    const double x = std::strtod(r.set.front().second.c_str(), &end);
+    if (!(end && *end == '\0')) return;
+    std::string others;
+    for (std::size_t q = 1; q < r.set.size(); ++q)
+        others += (others.empty() ? "" : ", ") + r.set[q].first + " = " + r.set[q].second;
+    // Several seeds: each run a point (one series per value of the other
+    // keys) beside the mean's line; one seed: a line per value.
+    auto& ser = out.by_seed[{others, o.seeds > 1 ? 0L : r.seed_offset}];
+    if (o.seeds > 1) {
+        ser.label = others.empty() ? "each seed" : others + ", each seed";
+        ser.style = io::Series::Style::points;
+    } else {
+        ser.label = others.empty() ? "seed offset " + std::to_string(r.seed_offset) : others;
+    }
+    ser.x.push_back(x), ser.y.push_back(y);
+    auto& m = out.mean[others][x];
+    m.first += y, ++m.second;
+}
+
+void tabulate_sweep(const SweepOptions& o, const std::vector<SweepRun>& plan, const std::vector<std::string>& summaries,
+                    const std::vector<std::string>& errors, SweepTable& out) {
+    add_csv_header(o, out.csv);
+    for (std::size_t k = 0; k < plan.size(); ++k) {
         const auto& r = plan[k];
-        nlohmann::json row{{"run", k + 1}, {"folder", r.dir}, {"seed_offset", r.seed_offset}};
-        nlohmann::json values = nlohmann::json::object();
-        for (const auto& [key, value] : r.set) values[key] = value;
-        row["set"] = values;
-        std::string status = "done";
-        nlohmann::json s;
-        if (!errors[k].empty()) {
-            status = "failed", row["error"] = errors[k], ++failed;
-        } else {
-            s = nlohmann::json::parse(summaries[k]);
-            if (!s.value("complete", false)) status = "incomplete", ++failed;
-            if (s.contains("error")) row["error"] = s["error"];
-            if (s.value("resumed", false)) row["resumed"] = true;
-            row["summary"] = s;
-        }
-        row["status"] = status;
-        const double y = s.is_null() ? NAN : summary_value(s, o.plot);
-        row["plot_value"] = std::isfinite(y) ? nlohmann::json(y) : nlohmann::json();
-        table.push_back(row);
-        csv << k + 1;
-        for (const auto& [key, value] : r.set) csv << ',' << csv_field(value);
-        auto num = [&](const char* a, const char* b = nullptr) -> std::string {
-            if (s.is_null()) return "";
-            const double v = summary_value(s, b ? std::string(a) + "." + b : std::string(a));
-            if (!std::isfinite(v)) return "";
-            char t[40];
-            std::snprintf(t, sizeof t, "%.10g", v);
-            return t;
-        };
-        csv << ',' << r.seed_offset << ',' << status << ',' << csv_field(row.value("error", std::string{})) << ','
-            << num("steps") << ',' << num("cracks", "tensile") << ',' << num("cracks", "shear") << ','
-            << num("wall_seconds") << ',' << (s.is_null() ? "" : s.value("state_hash", std::string{})) << ','
-            << (std::isfinite(y) ? num(o.plot.c_str()) : "") << ',' << r.dir << '\n';
-        // The plot: the value against the first swept key, if it is a number, of
-        // finished runs only (a run stopped early has no answer to average).
-        if (!o.set.empty() && std::isfinite(y) && status == "done") {
-            char* end = nullptr;
-            const double x = std::strtod(r.set.front().second.c_str(), &end);
-            if (end && *end == '\0') {
-                std::string others;
-                for (std::size_t q = 1; q < r.set.size(); ++q)
-                    others += (others.empty() ? "" : ", ") + r.set[q].first + " = " + r.set[q].second;
-                // Several seeds: each run a point (one series per value of the other
-                // keys) beside the mean's line; one seed: a line per value.
-                auto& ser = by_seed[{others, o.seeds > 1 ? 0L : r.seed_offset}];
-                if (o.seeds > 1) {
-                    ser.label = others.empty() ? "each seed" : others + ", each seed";
-                    ser.style = io::Series::Style::points;
-                } else {
-                    ser.label = others.empty() ? "seed offset " + std::to_string(r.seed_offset) : others;
-                }
-                ser.x.push_back(x), ser.y.push_back(y);
-                auto& m = mean[others][x];
-                m.first += y, ++m.second;
-            }
-        }
+        SweepRow w = sweep_row(o, k, r, summaries[k], errors[k]);
+        if (w.status != "done") ++out.failed;
+        out.table.push_back(w.row);
+        add_csv_row(o, k, r, w, out.csv);
+        // The plot of finished runs only (a run stopped early has no answer to average).
+        if (!o.set.empty() && std::isfinite(w.y) && w.status == "done") add_plot_point(o, r, w.y, out);
     }
 }
 
