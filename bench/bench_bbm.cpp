@@ -93,12 +93,23 @@ struct Timed {
 int main(int argc, char** argv) {
     std::string out = "bench_bbm.json";
     bool quick = false, answers_only = false; // --answers-only: the second table alone
+    bool scaling_only = false;                // --scaling-only: the first table alone
+    std::vector<int> sizes{2500, 10000, 40000, 160000}; // --sizes 10000,40000: the scaling's scenes
     for (int k = 1; k < argc; ++k) {
         if (!std::strcmp(argv[k], "--out") && k + 1 < argc) out = argv[++k];
         else if (!std::strcmp(argv[k], "--quick")) quick = true;
         else if (!std::strcmp(argv[k], "--answers-only")) answers_only = true;
-        else {
-            std::fprintf(stderr, "usage: bench_bbm [--out results.json] [--quick | --answers-only]\n");
+        else if (!std::strcmp(argv[k], "--scaling-only")) scaling_only = true;
+        else if (!std::strcmp(argv[k], "--sizes") && k + 1 < argc) {
+            sizes.clear();
+            for (const char* p = argv[++k]; *p;) {
+                char* end = nullptr;
+                sizes.push_back(int(std::strtol(p, &end, 10)));
+                p = *end == ',' ? end + 1 : end;
+            }
+        } else {
+            std::fprintf(stderr, "usage: bench_bbm [--out results.json] [--quick | --answers-only | --scaling-only] "
+                                 "[--sizes 10000,40000]\n");
             return 2;
         }
     }
@@ -111,7 +122,7 @@ int main(int argc, char** argv) {
     // 160,000-block scenes the same jobs took 1.6–1.9 times as long in this process
     // (2026-11-26: the trigon tunnel 11.5 s against 6.1 s, the UCS 4.9 s against
     // 3.1 s), a state of the process, not of the jobs.
-    if (!quick) {
+    if (!quick && !scaling_only) {
         nlohmann::json answers = nlohmann::json::array();
         const fs::path tmp = fs::temp_directory_path() / "bbm_bench_answers";
         auto labtest = [](meshing::PatternSpec::Kind pattern, double kn, double ks) {
@@ -197,7 +208,6 @@ int main(int argc, char** argv) {
         fs::remove_all(tmp);
     }
     // 1. Scaling.
-    std::vector<int> sizes{2500, 10000, 40000, 160000};
     if (quick) sizes.pop_back();
     if (answers_only) sizes.clear();
     nlohmann::json scaling = nlohmann::json::array();
