@@ -16,7 +16,10 @@ using BoundaryKey = Key<BoundarySpec>;
 using AssignmentKey = Key<JointAssignmentSpec>;
 
 /// A boundary's types, in the order of BoundarySpec::Kind.
-inline constexpr std::string_view boundary_type_words = "velocity, stress";
+inline constexpr std::string_view boundary_type_words = "velocity, stress, viscous";
+/// An incident wave's pulses and kinds, in the order of IncidentWaveSpec's enums.
+inline constexpr std::string_view pulse_words = "none, ricker, half_sine, harmonic";
+inline constexpr std::string_view wave_words = "p, s";
 /// The joint tags, in the order of meshing::JointTag.
 inline constexpr std::string_view joint_tag_words = "inner, radial, peripheral, real_joint, interface, fracture";
 
@@ -29,7 +32,10 @@ inline constexpr BoundaryKey boundary_keys[] = {
     {.key = "name", .kind = KeyKind::text, .required = true, .meaning = "Non-empty, unique; named by histories"},
     {.key = "type", .kind = KeyKind::choice, .required = true,
      .meaning = "velocity: prescribed velocities of blocks (and nodes); stress: a traction σ·n on the exposed "
-                "block edges selected (n their outward normal; on a deformable block it goes to the nodes)",
+                "block edges selected (n their outward normal; on a deformable block it goes to the nodes); "
+                "viscous: dashpots ρ c_p (normal) and ρ c_s (shear) per unit length on the exposed edges of "
+                "deformable blocks selected, which absorb the waves that reach them (Lysmer & Kuhlemeyer 1969) "
+                "and send in an incident wave (needs [solver] mode = \"dynamic\")",
      .words = boundary_type_words},
     {.key = "regions", .kind = KeyKind::names, .meaning = "Select in these regions only; not empty, no repeats",
      .absent = "any region"},
@@ -56,6 +62,25 @@ inline constexpr BoundaryKey boundary_keys[] = {
     {.key = "dsxx_dy", .bounds = unbounded(" Pa/m"), .only = "stress", .meaning = "dσxx/dy", .absent = "0"},
     {.key = "dsyy_dy", .bounds = unbounded(" Pa/m"), .only = "stress", .meaning = "dσyy/dy", .absent = "0"},
     {.key = "dsxy_dy", .bounds = unbounded(" Pa/m"), .only = "stress", .meaning = "dσxy/dy", .absent = "0"},
+    {.key = "pulse", .kind = KeyKind::choice, .only = "viscous",
+     .meaning = "The incident wave's particle velocity at the boundary, v(t) from `start`: ricker (peak frequency "
+                "f, its peak 1.2/f after start), half_sine (one half period of sin 2πft), harmonic (sin 2πft "
+                "over `cycles` periods); sent in as the traction 2 ρ c v(t) (the dashpot takes half)",
+     .absent = "none: the boundary only absorbs", .words = pulse_words},
+    {.key = "wave", .kind = KeyKind::choice, .only = "viscous",
+     .meaning = "p: the particle velocity along the inward normal (c = c_p); s: along the edge, counter-clockwise "
+                "about the model (c = c_s)",
+     .absent = "p", .words = wave_words},
+    {.key = "velocity", .bounds = unbounded(" m/s"), .only = "viscous",
+     .meaning = "The incident wave's peak particle velocity", .absent = "0",
+     .set = [](BoundarySpec& s, double v) { s.incident.velocity = v; }},
+    {.key = "frequency", .bounds = above(0, " Hz"), .only = "viscous", .meaning = "Of the pulse",
+     .absent = "required with a pulse", .set = [](BoundarySpec& s, double v) { s.incident.frequency = v; }},
+    {.key = "cycles", .bounds = above(0, ""), .only = "viscous", .meaning = "harmonic: the train's length in periods",
+     .absent = "1", .set = [](BoundarySpec& s, double v) { s.incident.cycles = v; }},
+    {.key = "start", .bounds = at_least(0, " s"), .only = "viscous",
+     .meaning = "When the pulse starts, in the model's time", .absent = "0",
+     .set = [](BoundarySpec& s, double v) { s.incident.start = v; }},
 };
 
 /// Every key of [[joint_assignment]]: the rules are applied in file order, a later

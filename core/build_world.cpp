@@ -453,13 +453,14 @@ void load_exposed_stretch(World& w, const BoundarySpec& bc, int i, int v0, int v
     }
 }
 
-/// A stress boundary: its traction σ·n on the exposed (unjointed) block edges selected.
-void apply_stress_boundary(World& w, const BoundarySpec& bc, const meshing::BlockAssembly& a,
-                           const std::vector<std::vector<std::pair<double, double>>>& covered, std::vector<int>& blocks,
-                           std::vector<int>& nodes) {
+/// Calls f(i, v0, v1, x0, x1, w0, w1, n) for every exposed (unjointed) stretch
+/// [x0, x1] of an edge v0 → v1 of block i (outward normal n, parameters w0 to w1
+/// along the edge) that a boundary selects: in its regions, its midpoint in its box.
+template <class F>
+void for_each_exposed_stretch(const World& w, const BoundarySpec& bc, const meshing::BlockAssembly& a,
+                              const std::vector<std::vector<std::pair<double, double>>>& covered, F&& f) {
     for (int i = 0; i < a.block_count(); ++i) {
         if (!selected(bc.select.regions, w.region_names[a.region[i]])) continue;
-        bool any = false;
         for (std::uint32_t v0 = a.first[i]; v0 < a.first[i + 1]; ++v0) {
             const int v1 = contact::next_vertex(a.first.data(), i, int(v0));
             const Vec2 p = a.points[v0], d = a.points[v1] - p;
@@ -472,16 +473,57 @@ void apply_stress_boundary(World& w, const BoundarySpec& bc, const meshing::Bloc
                 if (c0 > s + 1e-12) {
                     // Exposed [s, c0].
                     const Vec2 x0 = p + s * d, x1 = p + std::min(c0, 1.0) * d;
-                    if (in_box(bc.select.box, 0.5 * (x0 + x1))) {
-                        load_exposed_stretch(w, bc, i, int(v0), v1, x0, x1, s, std::min(c0, 1.0), n, nodes);
-                        any = true;
-                    }
+                    if (in_box(bc.select.box, 0.5 * (x0 + x1))) f(i, int(v0), v1, x0, x1, s, std::min(c0, 1.0), n);
                 }
                 s = std::max(s, c1);
             }
         }
-        if (any && !w.blocks.deformable[i]) blocks.push_back(i);
     }
+}
+
+/// A stress boundary: its traction σ·n on the exposed (unjointed) block edges selected.
+void apply_stress_boundary(World& w, const BoundarySpec& bc, const meshing::BlockAssembly& a,
+                           const std::vector<std::vector<std::pair<double, double>>>& covered, std::vector<int>& blocks,
+                           std::vector<int>& nodes) {
+    for_each_exposed_stretch(w, bc, a, covered, [&](int i, int v0, int v1, Vec2 x0, Vec2 x1, double w0, double w1, Vec2 n) {
+        load_exposed_stretch(w, bc, i, v0, v1, x0, x1, w0, w1, n, nodes);
+        if (!w.blocks.deformable[i] && (blocks.empty() || blocks.back() != i)) blocks.push_back(i);
+    });
+}
+
+/// A viscous boundary (core/viscous.hpp): dashpots on the exposed edges of the
+/// deformable blocks selected, of their material, each stretch's to its two
+/// nodes by position. A rigid block's face is refused (not yet taken).
+void apply_viscous_boundary(World& w, const BoundarySpec& bc, int index, const meshing::BlockAssembly& a,
+                            const std::vector<std::vector<std::pair<double, double>>>& covered, std::vector<int>& nodes) {
+    const std::string key = "boundary[" + std::to_string(index) + "]";
+    if (w.settings.mode != SolverSpec::Mode::dynamic)
+        throw InputError("", 0, key + ".type",
+                         "a viscous boundary absorbs waves, which a quasi-static run has none of: set [solver] mode = "
+                         "\"dynamic\"");
+    auto& vb = w.viscous;
+    const int k = int(vb.names.size());
+    vb.names.push_back(bc.name), vb.waves.push_back(bc.incident), vb.absorbed.push_back(0.0), vb.supplied.push_back(0.0);
+    std::vector<int> zone_of_block(std::size_t(a.block_count()), -1);
+    for (int z = w.zones.size() - 1; z >= 0; --z) zone_of_block[std::size_t(w.zones.block[z])] = z;
+    for_each_exposed_stretch(w, bc, a, covered, [&](int i, int v0, int v1, Vec2 x0, Vec2 x1, double w0, double w1, Vec2 n) {
+        if (!w.blocks.deformable[i])
+            throw InputError("", 0, key + ".box",
+                             "viscous boundary '" + bc.name + "' selects an exposed face of rigid block " +
+                                 std::to_string(i) + " near (" + std::to_string(x0.x) + ", " + std::to_string(x0.y) +
+                                 "): viscous boundaries take the edges of deformable blocks only (mesh the region "
+                                 "at the model's edge, as its far field)");
+        const int z = zone_of_block[std::size_t(i)];
+        const double rho = w.zones.density[z], pm = w.zones.elasticity[z].p_modulus(), g = w.zones.elasticity[z].shear;
+        const double length = norm(x1 - x0), along = 0.5 * (w0 + w1);
+        const int n0 = w.vertices.node[v0], n1 = w.vertices.node[v1];
+        add_dashpot(vb, k, n0, (1.0 - along) * length, n, rho, pm, g);
+        add_dashpot(vb, k, n1, along * length, n, rho, pm, g);
+        for (int m : {n0, n1})
+            if (std::find(nodes.begin(), nodes.end(), m) == nodes.end()) nodes.push_back(m);
+    });
+    if (nodes.empty())
+        throw InputError("", 0, key + ".box", "viscous boundary '" + bc.name + "' selects no exposed edge");
 }
 
 /// The model's boundaries: prescribed velocities and stress tractions.
@@ -495,7 +537,8 @@ void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAsse
     for (const auto& bc : an.boundaries) {
         std::vector<int> blocks, nodes;
         if (bc.kind == BoundarySpec::Kind::velocity) apply_velocity_boundary(w, bc, blocks, nodes);
-        else apply_stress_boundary(w, bc, a, covered, blocks, nodes);
+        else if (bc.kind == BoundarySpec::Kind::stress) apply_stress_boundary(w, bc, a, covered, blocks, nodes);
+        else apply_viscous_boundary(w, bc, int(&bc - an.boundaries.data()), a, covered, nodes);
         auto& b = w.boundaries;
         b.names.push_back(bc.name);
         b.block_list.insert(b.block_list.end(), blocks.begin(), blocks.end());
@@ -504,6 +547,7 @@ void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAsse
         b.node_first.push_back(int(b.node_list.size()));
     }
     w.boundaries.force.assign(w.boundaries.names.size(), {});
+    sort_dashpots(w.viscous);
 }
 
 } // namespace

@@ -61,8 +61,21 @@ struct StressFieldSpec {
     double dsxx_dy = 0, dsyy_dy = 0, dsxy_dy = 0;
 };
 
+/// A plane wave sent in through a viscous boundary: its particle velocity v(t) at
+/// the boundary, of a named pulse (core/viscous.hpp has their formulas).
+struct IncidentWaveSpec {
+    enum class Pulse { none, ricker, half_sine, harmonic };
+    enum class Wave { p, s }; ///< p: particle motion along the inward normal; s: along the edge
+    Pulse pulse = Pulse::none;
+    Wave wave = Wave::p;
+    double velocity = 0.0;  ///< peak particle velocity of the incoming wave, m/s
+    double frequency = 0.0; ///< Hz (Ricker: its peak frequency)
+    double cycles = 1.0;    ///< harmonic: the train's length in periods
+    double start = 0.0;     ///< s: when the pulse starts at the boundary
+};
+
 struct BoundarySpec {
-    enum class Kind { velocity, stress };
+    enum class Kind { velocity, stress, viscous };
     std::string name;
     Kind kind = Kind::velocity;
     SelectionSpec select;
@@ -70,6 +83,9 @@ struct BoundarySpec {
     std::optional<double> vx, vy, omega;
     /// stress: traction σ·n on the exposed (unjointed) block edges selected.
     StressFieldSpec stress;
+    /// viscous: dashpots ρ c_p and ρ c_s per unit length on the exposed edges
+    /// selected, and the wave sent in through them (none: they only absorb).
+    IncidentWaveSpec incident;
 };
 
 struct SolverSpec {

@@ -22,9 +22,10 @@ namespace {
 // state-field list); 8 a third support type's fields; 9 the
 // opening's pressure scale (a pressurise stage); A an excavation's support path;
 // B the same fields, with a fingerprint of every parameter of every property
-// and support set (A's hashed only the stiffnesses).
+// and support set (A's hashed only the stiffnesses); C the yielding bolts' and the
+// viscous boundaries' fields.
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = 'B';
+constexpr std::uint64_t format = 'C';
 constexpr std::uint64_t magic = magic_base | format;
 
 /// FNV-1a, 64 bits.

@@ -281,6 +281,52 @@ void gather_node_stage(World& w, const StepContext&, Range r) {
 }
 Range node_share(const World& w, const StepContext& ctx) { return equal_share(w.nodes.count(), ctx); }
 
+/// The viscous boundaries' dashpots and incident waves (core/viscous.hpp): each
+/// node's force gains F_in − C v̄, v̄ the mean of its velocity before and after
+/// this step's central difference, solved for with the gathered force; the
+/// energy each boundary absorbs and supplies is added in entry order.
+void viscous_stage(World& w, const StepContext&, Range) {
+    auto& b = w.viscous;
+    const double dt = w.clock.dt, time = w.clock.time;
+    for (int e = 0; e < b.count();) {
+        const int n = b.node[e];
+        int end = e;
+        std::array<double, 3> c{};
+        Vec2 input{};
+        for (; end < b.count() && b.node[end] == n; ++end) {
+            for (int k = 0; k < 3; ++k) c[k] += b.damping[end][k];
+            input += incident_velocity(b.waves[b.boundary[end]], time) * b.input[end];
+        }
+        if (w.bodies.removed[w.nodes.block[n]]) {
+            e = end;
+            continue;
+        }
+        // A held component takes no dashpot (its velocity is prescribed).
+        const std::uint8_t held = w.loads.node_fixed[n];
+        if (held & 1) c[0] = c[1] = input.x = 0.0;
+        if (held & 2) c[2] = c[1] = input.y = 0.0;
+        const Vec2 v = w.nodes.velocity[n], f = w.nodes.force[n] + input;
+        const double a = w.nodes.mass[n] / dt;
+        // (a + C/2) v⁺ = (a − C/2) v + f.
+        const double m00 = a + 0.5 * c[0], m01 = 0.5 * c[1], m11 = a + 0.5 * c[2];
+        const Vec2 rhs{(a - 0.5 * c[0]) * v.x - 0.5 * c[1] * v.y + f.x, -0.5 * c[1] * v.x + (a - 0.5 * c[2]) * v.y + f.y};
+        const double det = m00 * m11 - m01 * m01;
+        const Vec2 after{(m11 * rhs.x - m01 * rhs.y) / det, (m00 * rhs.y - m01 * rhs.x) / det};
+        const Vec2 mean = 0.5 * (v + after);
+        w.nodes.force[n] = f - Vec2{c[0] * mean.x + c[1] * mean.y, c[1] * mean.x + c[2] * mean.y};
+        // The energy of the free components only (a held one does no work here).
+        const Vec2 moving{held & 1 ? 0.0 : mean.x, held & 2 ? 0.0 : mean.y};
+        for (; e < end; ++e) {
+            const auto& d = b.damping[e];
+            const Vec2 fd{d[0] * moving.x + d[1] * moving.y, d[1] * moving.x + d[2] * moving.y};
+            const std::size_t k = std::size_t(b.boundary[e]);
+            b.absorbed[k] += dot(fd, moving) * dt;
+            b.supplied[k] += incident_velocity(b.waves[k], time) * dot(b.input[e], moving) * dt;
+        }
+    }
+}
+bool has_viscous(const World& w) { return w.viscous.count() > 0; }
+
 // --- 5. damping and integration ----------------------------------------------------------
 
 /// Local damping against the velocity, branch-free (the sign of v is as good as
@@ -471,6 +517,8 @@ const Stage stage_table[] = {
      gather_block_stage, Share::team, gather_block_share, false, true},
     {"gather nodes", "4", "each FE node's force over its zones, contacts and ties, in a fixed order",
      gather_node_stage, Share::team, node_share, true, true},
+    {"viscous boundaries", "4", "the dashpots of the absorbing edges and the incident waves, on their nodes' forces "
+     "(core/viscous.hpp)", viscous_stage, Share::one_thread, nullptr, false, false, has_viscous},
     {"integrate", "5", "damping, central differences, prescribed velocities", integrate_stage, Share::team,
      chunk_share, true},
     {"unbalanced", "6", "the unbalanced-force ratio, the convergence measure", ratio_stage, Share::one_thread},

@@ -27,6 +27,7 @@
 #include "core/model_spec.hpp"
 #include "core/supports/registry.hpp"
 #include "core/verdict.hpp"
+#include "core/viscous.hpp"
 #include "fem/cst.hpp"
 
 #include <array>
@@ -409,6 +410,7 @@ struct World {
     std::optional<JointFlow> flow; ///< water in the joints; none in a dry model
     SupportStates supports;         ///< one state per registered support type (core/supports/registry.hpp)
     Ties ties;
+    ViscousBoundaries viscous;      ///< the dynamic mode's absorbing edges and incident waves (core/viscous.hpp)
     StageMonitor monitor;           ///< what the current stage did, for its verdict
     Team team;
     /// Taken when the world is built (model_fingerprint, core/state.hpp):
@@ -442,6 +444,7 @@ void for_each_field(W& w, V&& v) {
     visit_fields(w.properties, v);
     for_each_support(w.supports, [&](auto type, auto& state) { decltype(type)::type::visit_fields(state, v); });
     visit_fields(w.ties, v);
+    visit_fields(w.viscous, v);
     visit_fields(w.team, v);
     // What the stage did so far, for its verdict (not physics: not in the state hash).
     v(FieldInfo{"monitor.samples", MemoryGroup::other, field_use::saved}, w.monitor.samples);

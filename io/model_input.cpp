@@ -478,6 +478,29 @@ JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Pa
     return a;
 }
 
+/// A viscous boundary's incident wave: its pulse, kind and the numbers of its
+/// formula (a frequency with every pulse).
+void read_incident_wave(const Ctx& c, const toml::table& t, const Path& p, BoundarySpec& b) {
+    using Wave = IncidentWaveSpec;
+    for (const BoundaryKey& k : boundary_keys)
+        if (k.set && key_applies(k, "viscous")) read_declared_key(c, t, p, k, b);
+    if (t.contains("pulse"))
+        b.incident.pulse = static_cast<Wave::Pulse>(
+            choice(c, t, p, "pulse", key_words(find_key(boundary_keys, "pulse")->words), "pulse"));
+    if (t.contains("wave"))
+        b.incident.wave =
+            static_cast<Wave::Wave>(choice(c, t, p, "wave", key_words(find_key(boundary_keys, "wave")->words), "wave"));
+    const bool pulse = b.incident.pulse != Wave::Pulse::none;
+    if (pulse && !t.contains("frequency"))
+        c.fail(t, p, c.in_owner() + "a pulse needs its frequency (Hz)");
+    if (pulse && !t.contains("velocity"))
+        c.fail(t, p, c.in_owner() + "a pulse needs its peak particle velocity (velocity, m/s)");
+    if (!pulse)
+        for (const char* key : {"velocity", "frequency", "cycles", "start", "wave"})
+            if (const toml::node* n = t.get(key))
+                c.fail(*n, p.key(key), c.in_owner() + "'" + key + "' describes the incident wave: give its pulse too");
+}
+
 BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& names,
                            const Names& regions) {
     static constexpr auto all_keys = key_names(boundary_keys);
@@ -490,6 +513,10 @@ BoundarySpec read_boundary(Ctx& c, const toml::table& t, const Path& p, Names& n
     if (const toml::node* n = find(c, t, p, "box")) b.select.box = read_box(c, *n, p.key("box"));
     if (b.kind == Kind::stress) {
         b.stress = read_stress(c, t, p);
+        return b;
+    }
+    if (b.kind == Kind::viscous) {
+        read_incident_wave(c, t, p, b);
         return b;
     }
     b.select.touching = boolean(c, t, p, "touching").value_or(false);

@@ -198,7 +198,6 @@ void print_fresh_seeds(const CalibrationIteration& fresh, const CalibrationOptio
 /// holds for, the targets and what the set measured; every number exact.
 std::string calibrated_set_toml(const CalibrateValues& values, const CalibrationOptions& o,
                                 const CalibrationIteration& last, int last_number) {
-    const LabTestValues& c = values.lab;
     const CalibrationTargets& targets = values.targets;
     const meshing::PatternSpec& pattern = o.base.rock.pattern;
     const std::string kind = meshing::to_string(pattern.kind);

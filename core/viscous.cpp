@@ -1,0 +1,53 @@
+// Viscous boundaries and incident waves (core/viscous.hpp for the method).
+#include "core/viscous.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+
+namespace bbm {
+
+double incident_velocity(const IncidentWaveSpec& wave, double t) {
+    using Pulse = IncidentWaveSpec::Pulse;
+    const double tau = t - wave.start, f = wave.frequency, pi = std::numbers::pi;
+    if (wave.pulse == Pulse::none || tau < 0.0) return 0.0;
+    switch (wave.pulse) {
+    case Pulse::ricker: {
+        // Its peak 1.2/f after the start, where the wavelet has grown from 1e-6 of it.
+        const double a = pi * f * (tau - 1.2 / f), a2 = a * a;
+        return wave.velocity * (1.0 - 2.0 * a2) * std::exp(-a2);
+    }
+    case Pulse::half_sine: return tau <= 0.5 / f ? wave.velocity * std::sin(2.0 * pi * f * tau) : 0.0;
+    case Pulse::harmonic: return tau <= wave.cycles / f ? wave.velocity * std::sin(2.0 * pi * f * tau) : 0.0;
+    case Pulse::none: break;
+    }
+    return 0.0;
+}
+
+void add_dashpot(ViscousBoundaries& b, int boundary, int node, double length, Vec2 n, double density,
+                 double p_modulus, double shear_modulus) {
+    const double cp = std::sqrt(p_modulus / density), cs = std::sqrt(shear_modulus / density);
+    const double kn = density * cp * length, ks = density * cs * length;
+    const Vec2 t{-n.y, n.x}; // counter-clockwise about the model
+    b.node.push_back(node);
+    b.boundary.push_back(boundary);
+    b.damping.push_back({kn * n.x * n.x + ks * t.x * t.x, kn * n.x * n.y + ks * t.x * t.y,
+                         kn * n.y * n.y + ks * t.y * t.y});
+    const IncidentWaveSpec& wave = b.waves[std::size_t(boundary)];
+    // The traction 2 ρ c v_in along the incident motion: a P wave's inward, an S wave's along t.
+    b.input.push_back(wave.wave == IncidentWaveSpec::Wave::p ? -2.0 * kn * n : 2.0 * ks * t);
+}
+
+void sort_dashpots(ViscousBoundaries& b) {
+    std::vector<int> order(b.node.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return b.node[x] < b.node[y]; });
+    auto permute = [&](auto& v) {
+        auto copy = v;
+        for (std::size_t k = 0; k < order.size(); ++k) v[k] = copy[std::size_t(order[k])];
+    };
+    permute(b.node), permute(b.boundary), permute(b.damping), permute(b.input);
+}
+
+} // namespace bbm
