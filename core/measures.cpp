@@ -93,6 +93,18 @@ double dissipated_energy(const World& w) {
     return e;
 }
 
+double absorbed_energy(const World& w) {
+    double e = 0.0;
+    for (double a : w.viscous.absorbed) e += a;
+    return e;
+}
+
+double wave_energy(const World& w) {
+    double e = 0.0;
+    for (double s : w.viscous.supplied) e += s;
+    return e;
+}
+
 int cracks(const World& w, contact::JointState mode) {
     // Broken contacts still present plus those detection removed since.
     using contact::JointState;

@@ -27,6 +27,10 @@ double strain_energy(const World& w);
 double zone_strain_energy(const World& w);
 /// Plastic work of the joints so far, J/m.
 double dissipated_energy(const World& w);
+/// The energy the viscous boundaries' dashpots have taken so far, J/m (core/viscous.hpp).
+double absorbed_energy(const World& w);
+/// The work their incident waves have done so far, J/m.
+double wave_energy(const World& w);
 /// Cracks (broken bonds) so far, by mode; cumulative.
 int cracks(const World& w, contact::JointState mode);
 /// Total contact force on a boundary's blocks in the last step, N/m (for a

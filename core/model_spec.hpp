@@ -117,7 +117,9 @@ struct HistorySpec {
         unbalanced_ratio, displacement_x, displacement_y, velocity_x, velocity_y, rotation,
         boundary_force_x, boundary_force_y, cracks_tensile, cracks_shear, kinetic_energy,
         strain_energy, dissipated_energy, work,
-        inflow ///< into the drained openings, m²/s per unit depth ([flow])
+        inflow, ///< into the drained openings, m²/s per unit depth ([flow])
+        absorbed_energy, ///< taken by the viscous boundaries' dashpots so far, J/m
+        wave_energy      ///< the work of their incident waves so far, J/m
     };
     std::string name;
     Quantity quantity = Quantity::unbalanced_ratio;

@@ -237,6 +237,8 @@ double quantity(const World& w, const HistorySpec& h, int i) {
     case Q::dissipated_energy: return dissipated_energy(w);
     case Q::work: return w.clock.work;
     case Q::inflow: return w.flow ? inflow(*w.flow) : 0.0;
+    case Q::absorbed_energy: return absorbed_energy(w);
+    case Q::wave_energy: return wave_energy(w);
     }
     return 0.0;
 }

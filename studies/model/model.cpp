@@ -276,6 +276,14 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         {"complete", complete},
         {"stages", stages_json(reports)}};
     if (w.flow) summary["flow"] = flow_summary(*w.flow);
+    if (w.viscous.count() > 0) {
+        // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
+        auto& e = summary["energy"];
+        e["absorbed"] = absorbed_energy(w), e["wave_input"] = wave_energy(w);
+        for (std::size_t k = 0; k < w.viscous.names.size(); ++k)
+            summary["viscous_boundaries"][w.viscous.names[k]] = {{"absorbed", w.viscous.absorbed[k]},
+                                                                  {"wave_input", w.viscous.supplied[k]}};
+    }
     add_run_verdict(summary, reports);
     add_support_summaries(summary, w);
     const auto& rep = file.analysis.report;
