@@ -20,6 +20,7 @@ void add_contact(Contacts& c, int a, int vertex, int b, int edge, int end, doubl
     c.history.push_back(h);
     c.normal.push_back({});
     if (c.flow_on) c.flow_link.push_back({-1, -1, -1}), c.fluid_pressure.push_back(0.0);
+    if (c.corroding) c.bond_section.push_back(1.0);
 }
 
 void remove_flagged_contacts(Contacts& c, const std::vector<std::uint8_t>& remove) {
@@ -36,9 +37,11 @@ void remove_flagged_contacts(Contacts& c, const std::vector<std::uint8_t>& remov
         c.history[out] = c.history[i];
         c.normal[out] = c.normal[i];
         if (c.flow_on) c.flow_link[out] = c.flow_link[i], c.fluid_pressure[out] = c.fluid_pressure[i];
+        if (c.corroding) c.bond_section[out] = c.bond_section[i];
         ++out;
     }
     if (c.flow_on) c.flow_link.resize(out), c.fluid_pressure.resize(out);
+    if (c.corroding) c.bond_section.resize(out);
     for (auto* v : {&c.vertex_block, &c.vertex_id, &c.edge_block, &c.edge_id, &c.edge_end, &c.property}) v->resize(out);
     c.length.resize(out);
     c.history.resize(out);
@@ -74,6 +77,7 @@ bool sort_contacts_by_blocks(Contacts& c) {
         rotate_cycle(c.edge_end), rotate_cycle(c.length), rotate_cycle(c.property), rotate_cycle(c.history);
         rotate_cycle(c.normal);
         if (c.flow_on) rotate_cycle(c.flow_link), rotate_cycle(c.fluid_pressure);
+        if (c.corroding) rotate_cycle(c.bond_section);
         for (int k = start; c.fill[k] >= 0;) {
             const int next = c.fill[k];
             c.fill[k] = -1 - next;

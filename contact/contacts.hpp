@@ -126,6 +126,12 @@ struct Contacts {
     std::vector<double> fluid_pressure;
     bool flow_on = false; ///< the two arrays above are kept, one entry per contact
     bool wet() const { return flow_on; }
+    /// Stress corrosion (contact/laws/stress_corrosion.hpp, core/creep.hpp): per
+    /// contact the fraction ω of its bond's section left, 1 when intact (and for a
+    /// contact made by detection), moved with its contact; its `length` is the
+    /// joint's share times ω. Empty in a model no law corrodes.
+    std::vector<double> bond_section;
+    bool corroding = false; ///< bond_section is kept, one entry per contact
 
     // Derived index, rebuilt by rebuild_contact_index() whenever contacts are added or removed.
     /// Contacts by property set and kind, flat (CSR): batch k is the contacts

@@ -27,6 +27,7 @@
 #include "contact/laws/cwfs.hpp"
 #include "contact/laws/elastic.hpp"
 #include "contact/laws/softening.hpp"
+#include "contact/laws/stress_corrosion.hpp"
 
 #include <array>
 #include <cstddef>
@@ -36,7 +37,7 @@
 namespace bbm::contact {
 
 /// Every joint law, one alternative each.
-using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw, BartonBandisLaw, CwfsLaw>;
+using JointLaw = std::variant<ElasticLaw, CoulombLaw, SofteningLaw, BartonBandisLaw, CwfsLaw, StressCorrosionLaw>;
 
 /// The laws' names, in the order of JointLaw (the model file's `law`).
 inline constexpr auto law_names = []<std::size_t... I>(std::index_sequence<I...>) {

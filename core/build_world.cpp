@@ -279,6 +279,23 @@ std::array<int, 2> add_joint_contacts(World& w, const meshing::BlockAssembly& a,
     return {first, add_end(j.p1, false)};
 }
 
+/// Real time where a law corrodes (core/creep.hpp): the bonds' sections, kept
+/// with their contacts from the first; a creep stage needs such a law.
+void start_creep(World& w, const AnalysisSpec& an) {
+    const bool corroding = std::ranges::any_of(an.joint_properties, [](const JointPropertySpec& p) {
+        return p.law == contact::StressCorrosionLaw::name;
+    });
+    if (corroding) {
+        w.contacts.corroding = true;
+        w.creep.emplace();
+    }
+    for (std::size_t k = 0; k < an.stages.size(); ++k)
+        if (an.stages[k].kind == StageSpec::Kind::creep && !corroding)
+            throw InputError("", 0, "stage[" + std::to_string(k) + "].type",
+                             "a creep stage needs bonds that corrode over time: a [[joint_property]] with law = "
+                             "\"stress_corrosion\" (docs/input.md, Stress corrosion)");
+}
+
 /// Property sets (with their derived strength classes and deformable splits),
 /// the contacts of the assembly's joints, and the water in them.
 void build_contacts(World& w, const meshing::BlockAssembly& a, const AnalysisSpec& an, const RegionMaterials& materials) {
@@ -292,6 +309,7 @@ void build_contacts(World& w, const meshing::BlockAssembly& a, const AnalysisSpe
         w.flow = make_joint_flow(a, an.flow, w.settings.gravity);
         w.contacts.flow_on = true;
     }
+    start_creep(w, an);
     for (const auto& j : a.joints) {
         int prop = table.assigned(a, j, an, w.region_names);
         prop = table.strength_class(prop, std::size_t(&j - a.joints.data()));

@@ -119,7 +119,8 @@ struct HistorySpec {
         strain_energy, dissipated_energy, work,
         inflow, ///< into the drained openings, m²/s per unit depth ([flow])
         absorbed_energy, ///< taken by the viscous boundaries' dashpots so far, J/m
-        wave_energy      ///< the work of their incident waves so far, J/m
+        wave_energy,     ///< the work of their incident waves so far, J/m
+        creep_time       ///< stress corrosion's creep time so far, s (core/creep.hpp)
     };
     std::string name;
     Quantity quantity = Quantity::unbalanced_ratio;
@@ -134,7 +135,9 @@ struct StageSpec {
     /// pressurise: the latest opening's pressure (excavated with one) ramped to
     /// `pressure` over `steps` steps (0: at once): a borehole's pressurisation
     /// cycles, as a hydraulic fracturing test runs them.
-    enum class Kind { initialize, solve, excavate, cycle, elastic, install, pressurise };
+    /// creep: real time (stress corrosion, core/creep.hpp): mechanical equilibrium
+    /// and creep steps in turn for `duration` seconds of creep time.
+    enum class Kind { initialize, solve, excavate, cycle, elastic, install, pressurise, creep };
     std::string name;
     Kind kind = Kind::solve;
     StressFieldSpec stress;            ///< initialize
@@ -163,6 +166,8 @@ struct StageSpec {
     /// (examples/field/face_path.py; docs/theory.md §6.5).
     std::vector<std::array<double, 3>> support_path;
     std::vector<std::string> supports; ///< install: names of support sets (of any registered type)
+    double duration = 0.0;             ///< creep: the creep time it runs, s
+    double loss = 0.02;                ///< creep: the largest fraction of a bond's section one creep step takes
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;

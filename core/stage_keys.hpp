@@ -15,7 +15,7 @@ namespace bbm {
 using StageKey = Key<StageSpec>;
 
 /// The stage types, in the order of StageSpec::Kind.
-inline constexpr std::string_view stage_type_words = "initialize, solve, excavate, cycle, elastic, install, pressurise";
+inline constexpr std::string_view stage_type_words = "initialize, solve, excavate, cycle, elastic, install, pressurise, creep";
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
@@ -38,10 +38,23 @@ inline constexpr StageKey stage_keys[] = {
     {.key = "dsxx_dy", .bounds = unbounded(" Pa/m"), .only = "initialize", .meaning = "dσxx/dy", .absent = "0"},
     {.key = "dsyy_dy", .bounds = unbounded(" Pa/m"), .only = "initialize", .meaning = "dσyy/dy", .absent = "0"},
     {.key = "dsxy_dy", .bounds = unbounded(" Pa/m"), .only = "initialize", .meaning = "dσxy/dy", .absent = "0"},
-    {.key = "ratio", .bounds = {.lo = 0, .hi = 1, .lo_open = true, .hi_open = true}, .only = "solve",
-     .meaning = "Run until the unbalanced-force ratio falls below it, or max_steps", .absent = "1e-5"},
-    {.key = "max_steps", .kind = KeyKind::integer, .bounds = at_least(1, " steps"), .only = "solve",
-     .meaning = "The stage's step limit", .absent = "200000"},
+    {.key = "ratio", .bounds = {.lo = 0, .hi = 1, .lo_open = true, .hi_open = true}, .only = "solve, creep",
+     .meaning = "Run until the unbalanced-force ratio falls below it, or max_steps (creep: the equilibrium each "
+                "creep step is taken at)",
+     .absent = "1e-5"},
+    {.key = "max_steps", .kind = KeyKind::integer, .bounds = at_least(1, " steps"), .only = "solve, creep",
+     .meaning = "The stage's step limit (creep: of mechanical steps, over all its creep steps)",
+     .absent = "200000 (creep: 10000000)"},
+    {.key = "duration", .bounds = {.lo = 0, .hi = 3.2e10, .lo_open = true, .unit = " s"}, .required = true,
+     .only = "creep",
+     .meaning = "The creep time the stage runs, in real seconds (3.156e7 a year; at most about 1000 years): "
+                "equilibrium and creep steps of stress corrosion in turn (theory.md §17); a bond that breaks is "
+                "equilibrated before the next creep step, and a rock that fails does not come to rest (the stage "
+                "ends at max_steps, its verdict says so)"},
+    {.key = "loss", .bounds = {.lo = 0, .hi = 0.5, .lo_open = true}, .only = "creep",
+     .meaning = "The largest fraction of a bond's intact section one creep step takes (divided by β s where "
+                "the rate is steeper): halving it checks the time steps' convergence",
+     .absent = "0.02"},
     {.key = "until", .kind = KeyKind::choice, .only = "solve",
      .meaning = "ratio: stop at the model's ratio; rest: also once the rock mass is at rest, no crack in the last "
                 "quiet_steps and the ratio of the rock mass without its detached fragments at ratio (theory.md "

@@ -16,6 +16,7 @@ const char* to_string(StageSpec::Kind k) {
     case StageSpec::Kind::elastic: return "elastic";
     case StageSpec::Kind::install: return "install";
     case StageSpec::Kind::pressurise: return "pressurise";
+    case StageSpec::Kind::creep: return "creep";
     }
     return "?";
 }
@@ -43,6 +44,15 @@ SupportPath support_path_of(const std::vector<StageSpec>& stages, int index) {
     return path;
 }
 
+/// The creep time at the end of creep stage `index`: the durations of the creep
+/// stages up to it (so a resumed stage ends where the uninterrupted one does).
+double creep_end(const std::vector<StageSpec>& stages, int index) {
+    double end = 0.0;
+    for (int k = 0; k <= index; ++k)
+        if (stages[k].kind == StageSpec::Kind::creep) end += stages[k].duration;
+    return end;
+}
+
 /// One stage of run_stages: started (unless resumed inside it), stepped to its
 /// end, judged, and reported.
 class StageRun {
@@ -54,7 +64,8 @@ public:
           // Solve and cycle stages are judged (core/verdict.hpp): the monitor samples
           // at fixed steps of the run, so a resumed stage samples where the
           // uninterrupted one does.
-          judged_(st_.kind == StageSpec::Kind::solve || st_.kind == StageSpec::Kind::cycle) {
+          judged_(st_.kind == StageSpec::Kind::solve || st_.kind == StageSpec::Kind::cycle ||
+                  st_.kind == StageSpec::Kind::creep) {
         r_.name = st_.name;
         r_.kind = to_string(st_.kind);
         r_.steps = cursor_.step;
@@ -97,6 +108,11 @@ private:
         case StageSpec::Kind::pressurise:
             if (st_.steps == 0) set_opening_pressure(w_, st_.pressure, excavation_pressure_, true);
             break;
+        case StageSpec::Kind::creep:
+            w_.creep->until = creep_end(stages_, index_);
+            w_.creep->loss = st_.loss;
+            w_.creep->since = 0;
+            break;
         case StageSpec::Kind::solve:
         case StageSpec::Kind::cycle: break;
         }
@@ -113,6 +129,14 @@ private:
         case StageSpec::Kind::excavate: run_steps(st_.steps, false); break;
         case StageSpec::Kind::cycle: run_steps(st_.steps, false); break;
         case StageSpec::Kind::pressurise: run_steps(st_.steps, false); break;
+        case StageSpec::Kind::creep: {
+            const long creep_steps = w_.creep->steps;
+            run_steps(st_.max_steps, false);
+            r_.converged = creep_finished();
+            r_.creep_time = w_.creep->time;
+            r_.creep_steps = w_.creep->steps - creep_steps;
+            break;
+        }
         case StageSpec::Kind::initialize:
         case StageSpec::Kind::install:
         case StageSpec::Kind::elastic: break;
@@ -134,14 +158,27 @@ private:
         return st_.until == U::rest && sampled && at_rest(w_.monitor, st_.ratio, st_.quiet_steps);
     }
 
+    /// A creep stage at mechanical equilibrium: a few steps since the last creep
+    /// step and the ratio reached.
+    bool creep_at_rest() const { return w_.creep->since >= 10 && w_.clock.ratio <= st_.ratio; }
+    bool creep_finished() const { return creep_at_rest() && w_.creep->time >= w_.creep->until; }
+
     /// Steps up to max_steps from the cursor, the observer told of each; stops
-    /// early when it asks, or (`solve`) once solved.
+    /// early when it asks, or (`solve`) once solved, or (`creep`) at rest at its
+    /// end. A creep stage arms a creep step (core/creep.hpp) for the step after
+    /// each equilibrium.
     void run_steps(long max_steps, bool solve) {
+        const bool creep = st_.kind == StageSpec::Kind::creep;
         for (long k = cursor_.step + 1; k <= max_steps; ++k) {
             if (st_.kind == StageSpec::Kind::pressurise)
                 set_opening_pressure(w_, pressure_before_ + (st_.pressure - pressure_before_) * double(k) / double(max_steps),
                                      excavation_pressure_, true);
+            if (creep) {
+                if (creep_finished()) return;
+                w_.creep->due = creep_at_rest() ? 1 : 0;
+            }
             s_.step();
+            if (creep) w_.creep->due = 0, ++w_.creep->since;
             ++r_.steps;
             cursor_.step = k;
             if (judged_ && w_.clock.steps % StageMonitor::sample_every == 0) sample_monitor(w_.monitor, w_);
@@ -155,7 +192,8 @@ private:
     void judge() {
         const auto& samples = w_.monitor.samples;
         if (samples.empty() || samples.back().step != w_.clock.steps) sample_monitor(w_.monitor, w_);
-        r_.verdict = verdict(w_.monitor, st_.kind == StageSpec::Kind::solve ? st_.ratio : StageSpec{}.ratio);
+        const bool own_ratio = st_.kind == StageSpec::Kind::solve || st_.kind == StageSpec::Kind::creep;
+        r_.verdict = verdict(w_.monitor, own_ratio ? st_.ratio : StageSpec{}.ratio);
     }
 
     Solver& s_;
@@ -239,6 +277,7 @@ double quantity(const World& w, const HistorySpec& h, int i) {
     case Q::inflow: return w.flow ? inflow(*w.flow) : 0.0;
     case Q::absorbed_energy: return absorbed_energy(w);
     case Q::wave_energy: return wave_energy(w);
+    case Q::creep_time: return w.creep ? w.creep->time : 0.0;
     }
     return 0.0;
 }

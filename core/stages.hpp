@@ -23,6 +23,10 @@ struct StageReport {
     /// solve, cycle: what the rock did at the end (core/verdict.hpp); the target
     /// ratio of a cycle stage is the solve stage's default.
     Verdict verdict;
+    /// creep: the creep time at its end (s), its creep steps, and the cracks
+    /// during it.
+    double creep_time = 0.0;
+    long creep_steps = 0;
 };
 
 /// Where a run stands: the stage, whether its action (initialise, excavate, the

@@ -327,6 +327,11 @@ void viscous_stage(World& w, const StepContext&, Range) {
 }
 bool has_viscous(const World& w) { return w.viscous.count() > 0; }
 
+/// A creep step of stress corrosion, armed by a creep stage at equilibrium
+/// (core/creep.hpp): the bonds' sections and lengths before the contact pass.
+void creep_stage(World& w, const StepContext&, Range) { take_creep_step(w); }
+bool creep_step_due(const World& w) { return w.creep && w.creep->due; }
+
 // --- 5. damping and integration ----------------------------------------------------------
 
 /// Local damping against the velocity, branch-free (the sign of v is as good as
@@ -507,6 +512,8 @@ const Stage stage_table[] = {
      flow_stage, Share::one_thread, nullptr, false, false, has_flow},
     {"face slip", "2", "the mean slip of rigid faces on the far field (face_shear)", face_slip_stage, Share::team,
      face_share, true, true, has_faces},
+    {"stress corrosion", "—", "a creep step: the corroding bonds' sections lost over creep time, when a creep stage "
+     "found equilibrium (core/creep.hpp)", creep_stage, Share::one_thread, nullptr, false, false, creep_step_due},
     {"supports", "4", "each support type's force pass and its ties' reactions", support_stage,
      Share::one_thread_nowait, nullptr, false, true, has_ties},
     {"contacts", "2", "the joint laws, one dispatch per batch of contacts sharing a law", contact_stage, Share::team,

@@ -23,6 +23,7 @@
 
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
+#include "core/creep.hpp"
 #include "core/joint_flow.hpp"
 #include "core/model_spec.hpp"
 #include "core/supports/registry.hpp"
@@ -408,6 +409,7 @@ struct World {
     Clock clock;
     Detection detection;
     std::optional<JointFlow> flow; ///< water in the joints; none in a dry model
+    std::optional<Creep> creep;     ///< real time: present where a law corrodes (core/creep.hpp)
     SupportStates supports;         ///< one state per registered support type (core/supports/registry.hpp)
     Ties ties;
     ViscousBoundaries viscous;      ///< the dynamic mode's absorbing edges and incident waves (core/viscous.hpp)
@@ -434,6 +436,9 @@ void for_each_field(W& w, V&& v) {
     v(FieldInfo{"contacts.flow_link", MemoryGroup::contacts, field_use::evolving}, w.contacts.flow_link);
     v(FieldInfo{"contacts.fluid_pressure", MemoryGroup::contacts, field_use::rebuilt}, w.contacts.fluid_pressure);
     if (w.flow) visit_fields(*w.flow, v);
+    // Stress corrosion (core/creep.hpp): empty where no law corrodes.
+    v(FieldInfo{"contacts.bond_section", MemoryGroup::contacts, field_use::evolving}, w.contacts.bond_section);
+    if (w.creep) visit_fields(*w.creep, v);
     visit_index_fields(w.contacts, v);
     visit_excavation_fields(w.loads, v);
     visit_fields(w.clock, v);

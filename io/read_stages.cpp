@@ -157,6 +157,12 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         s.pressure = required_number(c, t, p, "pressure", bounds("pressure"));
         s.steps = whole_number(c, t, p, "steps", bounds("steps")).value_or(0);
         break;
+    case Kind::creep:
+        s.duration = required_number(c, t, p, "duration", bounds("duration"));
+        s.loss = number(c, t, p, "loss", bounds("loss")).value_or(s.loss);
+        s.ratio = number(c, t, p, "ratio", bounds("ratio")).value_or(s.ratio);
+        s.max_steps = whole_number(c, t, p, "max_steps", bounds("max_steps")).value_or(10000000);
+        break;
     }
     return s;
 }

@@ -212,10 +212,29 @@ nlohmann::json stages_json(const std::vector<StageReport>& reports) {
         nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
                          {"seconds", r.seconds}, {"converged", r.converged}};
         if (!r.method.empty()) j["method"] = r.method;
+        if (r.kind == "creep") j["creep_time"] = r.creep_time, j["creep_steps"] = r.creep_steps;
         if (r.verdict.kind != Verdict::Kind::none) j["verdict"] = verdict_json(r.verdict);
         stages.push_back(j);
     }
     return stages;
+}
+
+/// Stress corrosion (core/creep.hpp): the creep time, its steps, and what is left
+/// of the intact bonds' sections.
+nlohmann::json creep_summary(const World& w) {
+    const auto& c = w.contacts;
+    int intact = 0;
+    double least = 1.0, mean = 0.0;
+    for (int i = 0; i < c.size(); ++i)
+        if (c.history[i].bonded) ++intact, least = std::min(least, c.bond_section[i]), mean += c.bond_section[i];
+    return {{"time", w.creep->time},
+            {"years", w.creep->time / seconds_per_year},
+            {"creep_steps", w.creep->steps},
+            {"last_creep_step", w.creep->last_step},
+            {"highest_stress_ratio", highest_stress_ratio(w)},
+            {"intact_bonds", intact},
+            {"least_section", least},
+            {"mean_section", intact > 0 ? mean / intact : 0.0}};
 }
 
 /// The water in the joints: the network, its conducting pipes, the inflow, the highest pressure.
@@ -276,6 +295,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         {"complete", complete},
         {"stages", stages_json(reports)}};
     if (w.flow) summary["flow"] = flow_summary(*w.flow);
+    if (w.creep) summary["creep"] = creep_summary(w);
     if (w.viscous.count() > 0) {
         // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
         auto& e = summary["energy"];
