@@ -49,8 +49,9 @@ inline constexpr StageKey stage_keys[] = {
      .only = "creep",
      .meaning = "The creep time the stage runs, in real seconds (3.156e7 a year; at most about 1000 years): "
                 "equilibrium and creep steps of stress corrosion in turn (theory.md §17); a bond that breaks is "
-                "equilibrated before the next creep step, and a rock that fails does not come to rest (the stage "
-                "ends at max_steps, its verdict says so)"},
+                "equilibrated before the next creep step; a rock that collapses under its held load (a body moving "
+                "a quarter of the detection tolerance in a step) ends the stage there, its creep time the time to "
+                "failure (summary.json's creep.failed_at)"},
     {.key = "loss", .bounds = {.lo = 0, .hi = 0.5, .lo_open = true}, .only = "creep",
      .meaning = "The largest fraction of a bond's intact section one creep step takes (divided by β s where "
                 "the rate is steeper): halving it checks the time steps' convergence",

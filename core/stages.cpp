@@ -162,6 +162,19 @@ private:
     /// step and the ratio reached.
     bool creep_at_rest() const { return w_.creep->since >= 10 && w_.clock.ratio <= st_.ratio; }
     bool creep_finished() const { return creep_at_rest() && w_.creep->time >= w_.creep->until; }
+    /// A rock failing under its held load: a body moving a quarter of the
+    /// detection tolerance in one step (a quasi-static model at rest moves by
+    /// elastic amounts only; the run's health check stops one at the whole
+    /// tolerance), where a creep stage ends with its time to failure.
+    bool creep_collapsing() const {
+        const double limit = 0.25 * w_.detection.tolerance / w_.clock.dt;
+        for (int i = 0; i < w_.bodies.count(); ++i)
+            if (!w_.bodies.removed[i] && !w_.blocks.deformable[i] && norm(w_.bodies.state[i].velocity) > limit)
+                return true;
+        for (int k = 0; k < w_.nodes.count(); ++k)
+            if (!w_.bodies.removed[w_.nodes.block[k]] && norm(w_.nodes.velocity[k]) > limit) return true;
+        return false;
+    }
 
     /// Steps up to max_steps from the cursor, the observer told of each; stops
     /// early when it asks, or (`solve`) once solved, or (`creep`) at rest at its
@@ -178,7 +191,14 @@ private:
                 w_.creep->due = creep_at_rest() ? 1 : 0;
             }
             s_.step();
-            if (creep) w_.creep->due = 0, ++w_.creep->since;
+            if (creep) {
+                w_.creep->due = 0, ++w_.creep->since;
+                if (creep_collapsing()) {
+                    r_.failed = true;
+                    ++r_.steps, cursor_.step = k;
+                    return;
+                }
+            }
             ++r_.steps;
             cursor_.step = k;
             if (judged_ && w_.clock.steps % StageMonitor::sample_every == 0) sample_monitor(w_.monitor, w_);

@@ -23,10 +23,12 @@ struct StageReport {
     /// solve, cycle: what the rock did at the end (core/verdict.hpp); the target
     /// ratio of a cycle stage is the solve stage's default.
     Verdict verdict;
-    /// creep: the creep time at its end (s), its creep steps, and the cracks
-    /// during it.
+    /// creep: the creep time at its end (s) and its creep steps; whether the rock
+    /// collapsed under its held load (the stage ends there: creep_time is then
+    /// its time to failure).
     double creep_time = 0.0;
     long creep_steps = 0;
+    bool failed = false;
 };
 
 /// Where a run stands: the stage, whether its action (initialise, excavate, the

@@ -36,6 +36,17 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
 
 } // namespace
 
+namespace {
+/// Under stress corrosion a runaway is how a rock failing under its held load
+/// ends (a creep stage has no other end for it): when, in creep time.
+std::string creep_failure(const World& w) {
+    if (!w.creep || w.creep->time <= 0.0) return "";
+    return fmt(" Under stress corrosion, at creep time %.6g s (%.4g days, %.4g years): a rock failing under its held "
+               "load ends so, and this is its time to failure (history.csv's creep_time).",
+               w.creep->time, w.creep->time / 86400.0, w.creep->time / seconds_per_year);
+}
+} // namespace
+
 void check_run_health(const Solver& s) {
     const World& w = s.world();
     const double tol = w.detection.tolerance, dt = w.clock.dt;
@@ -63,7 +74,7 @@ void check_run_health(const Solver& s) {
                                      "model is collapsing (a mechanism: look at the last output) or the step is "
                                      "unstable.",
                                      step, i, moved) +
-                                 advice);
+                                 creep_failure(w) + advice);
     }
     const auto& n = w.nodes;
     for (int k = 0; k < n.count(); ++k)
@@ -212,7 +223,8 @@ nlohmann::json stages_json(const std::vector<StageReport>& reports) {
         nlohmann::json j{{"name", r.name}, {"kind", r.kind}, {"steps", r.steps}, {"unbalanced_ratio", r.ratio},
                          {"seconds", r.seconds}, {"converged", r.converged}};
         if (!r.method.empty()) j["method"] = r.method;
-        if (r.kind == "creep") j["creep_time"] = r.creep_time, j["creep_steps"] = r.creep_steps;
+        if (r.kind == "creep")
+            j["creep_time"] = r.creep_time, j["creep_steps"] = r.creep_steps, j["failed"] = r.failed;
         if (r.verdict.kind != Verdict::Kind::none) j["verdict"] = verdict_json(r.verdict);
         stages.push_back(j);
     }
@@ -295,7 +307,11 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         {"complete", complete},
         {"stages", stages_json(reports)}};
     if (w.flow) summary["flow"] = flow_summary(*w.flow);
-    if (w.creep) summary["creep"] = creep_summary(w);
+    if (w.creep) {
+        summary["creep"] = creep_summary(w);
+        for (const auto& r : reports)
+            if (r.failed) summary["creep"]["failed_at"] = r.creep_time;
+    }
     if (w.viscous.count() > 0) {
         // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
         auto& e = summary["energy"];

@@ -165,12 +165,17 @@ public:
         if (options_.quiet) return;
         // A solve stage ends at its ratio, at rest (until = "rest"), at equilibrium
         // (until = "equilibrium", its ratio reached too) or at its step limit.
-        const char* end = r.converged || r.kind != "solve" ? ""
+        const char* end = r.failed                          ? "  (the rock failed under its held load)"
+                        : r.converged || r.kind != "solve" ? ""
                         : r.verdict.at_rest()               ? "  (rock at rest)"
                                                             : "  (step limit reached)";
         progress_.result("  %-12s %-10s %9ld steps  ratio %9.3e  %7.2f s%s%s", r.name.c_str(), r.kind.c_str(), r.steps,
                          r.ratio, r.seconds, end, r.method.empty() ? "" : ("  " + r.method).c_str());
         if (r.verdict.kind != Verdict::Kind::none) std::fprintf(stderr, "  %-12s %s\n", "", describe(r.verdict).c_str());
+        if (r.kind == "creep")
+            std::fprintf(stderr, "  %-12s creep time %.6g s (%.4g days, %.4g years) in %ld creep steps%s\n", "",
+                         r.creep_time, r.creep_time / 86400.0, r.creep_time / seconds_per_year, r.creep_steps,
+                         r.failed ? ": its time to failure" : "");
     }
     bool stop_requested() override { return interrupted.load() != 0; }
 
@@ -195,6 +200,8 @@ public:
         for (const auto& r : reports_) {
             put_string(o, r.name), put_string(o, r.kind), put_string(o, r.method);
             put(o, r.steps), put(o, r.ratio), put(o, r.seconds), put(o, r.converged), put(o, r.verdict);
+            // A creep stage's time (no checkpoint before creep stages had one).
+            if (r.kind == "creep") put(o, r.creep_time), put(o, r.creep_steps), put(o, r.failed);
         }
         put(o, std::uint64_t(rows_.size()));
         for (std::size_t r = 0; r < rows_.size(); ++r) {
@@ -221,6 +228,8 @@ public:
             r.steps = get<long>(i), r.ratio = get<double>(i), r.seconds = get<double>(i), r.converged = get<bool>(i);
             r.verdict = get<Verdict>(i);
             if (!r.verdict.valid()) throw std::runtime_error("checkpoint is corrupt");
+            if (r.kind == "creep")
+                r.creep_time = get<double>(i), r.creep_steps = get<long>(i), r.failed = get<bool>(i);
             reports_.push_back(r);
         }
         const auto rows = get<std::uint64_t>(i);
