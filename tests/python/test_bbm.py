@@ -415,3 +415,19 @@ def test_water_in_the_joints_arrays():
     assert c.fluid_pressure.shape == (c.count,) and c.aperture.shape == (c.count,)
     assert c.fluid_pressure.max() > 0.9e6
     assert bbm.Model(str(INSITU)).flow is None
+
+
+def test_static_fatigue_creep_time_and_bond_sections(tmp_path):
+    # The static-fatigue example held for a day of creep time (not to its failure).
+    text = (SOURCE / "examples/time/static_fatigue.toml").read_text().replace("duration = 3.156e7", "duration = 86400.0")
+    path = tmp_path / "day.toml"
+    path.write_text(text)
+    m = bbm.Model(str(path), threads=2)
+    m.run()
+    s = m.summary()
+    assert s["creep"]["time"] == 86400.0 and "failed_at" not in s["creep"]
+    assert s["stages"][-1]["kind"] == "creep" and s["stages"][-1]["converged"]
+    section = m.contacts.bond_section
+    assert section.shape == (m.contacts.count,)
+    assert 0.0 < section.min() < 1.0 and section.max() == 1.0
+    assert s["state_hash"] == cli_run(path, tmp_path / "cli")["state_hash"]
