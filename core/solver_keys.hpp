@@ -22,7 +22,9 @@ inline constexpr SolverKey solver_keys[] = {
      .meaning = "quasi_static: masses scaled so that every block converges at the same rate; dynamic: real masses "
                 "(SPEC §5)",
      .absent = "quasi_static", .words = "quasi_static, dynamic"},
-    {.key = "damping", .bounds = below(0, 1, ""), .meaning = "Local non-viscous damping coefficient", .absent = "0.8",
+    {.key = "damping", .bounds = below(0, 1, ""), .meaning = "Local non-viscous damping coefficient (Cundall's: a quasi-static device, which also takes energy "
+                "out of a wave)",
+     .absent = "0.8; in the dynamic mode 0 (waves are not damped away unless asked)",
      BBM_KEY_FIELD(SolverSpec, damping)},
     {.key = "safety", .bounds = {.lo = 0, .hi = 1, .lo_open = true}, .meaning = "Time step over the critical time step",
      .absent = "0.5", BBM_KEY_FIELD(SolverSpec, safety)},

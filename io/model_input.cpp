@@ -344,6 +344,8 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
     if (t.contains("mode"))
         s.mode = static_cast<SolverSpec::Mode>(
             choice(c, t, p, "mode", key_words(find_key(solver_keys, "mode")->words), "solver mode"));
+    // Local damping is a quasi-static device: a dynamic run has none unless asked.
+    if (s.mode == SolverSpec::Mode::dynamic && !t.contains("damping")) s.damping = 0.0;
     s.gravity = vector(c, t, p, "gravity").value_or(s.gravity);
     if (t.contains("new_contact_length"))
         s.new_contact_length = static_cast<SolverSpec::NewContactLength>(choice(

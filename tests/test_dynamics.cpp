@@ -210,3 +210,12 @@ TEST_CASE("a pulse's run resumed from a checkpoint, on 1 or 2 threads, ends in t
     CHECK(run(2, 150) == straight);
     CHECK(run(2, -1) == straight);
 }
+
+TEST_CASE("local damping is 0 by default in the dynamic mode, 0.8 in the quasi-static one") {
+    std::string text = column(true);
+    text.erase(text.find("damping = 0.0\n"), 14);
+    CHECK(test::build_model(text, "column.toml").file.analysis.solver.damping == 0.0);
+    text.replace(text.find("mode = \"dynamic\""), 16, "mode = \"quasi_static\"");
+    // (a viscous boundary then is refused when the world is built, not when read)
+    CHECK(test::build_model(text, "column.toml").file.analysis.solver.damping == 0.8);
+}

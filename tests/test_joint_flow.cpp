@@ -316,6 +316,7 @@ TEST_CASE("transient flow as a stage of a dynamic run: a pressure step diffuses 
     const Built m = build(R"(
 [solver]
 mode = "dynamic"
+damping = 0.8
 
 [[region]]
 name = "rock"
