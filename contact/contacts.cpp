@@ -119,6 +119,7 @@ void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std
     c.work_cost_before[c.work.size()] = cost;
     c.force.resize(n);
     c.partial_sum.resize(c.work.size());
+    if (c.marking) c.bond_change.assign(c.length.size(), 0), c.force_before.resize(c.length.size());
 
     // Per-block and per-node lists in contact order: count, prefix sum, fill
     // (`c.fill` is kept between calls: this runs inside steps that change contacts).
@@ -234,6 +235,8 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
     const double* __restrict inv_edge = b.inv_edge_length;
     const int* __restrict face = c.face_group.empty() ? nullptr : c.face_group.data();
     const double* __restrict face_du_s = c.face_du_s.data();
+    std::uint8_t* __restrict changed = c.marking ? c.bond_change.data() : nullptr;
+    Vec2* __restrict before = c.marking ? c.force_before.data() : nullptr;
     double sum = 0.0;
     const std::size_t count = ids.size();
     for (std::size_t k = 0; k < count; ++k) {
@@ -266,9 +269,15 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
         double du_s = dot(vr, t) * dt;
         if constexpr (Mixed)
             if (face && face[i] >= 0) du_s = face_du_s[face[i]];
+        const bool was_bonded = h.bonded, was_sound = h.damage == 0.0f;
+        const double sn_before = h.sn, tau_before = h.tau;
         law.update(h, du_n, du_s);
         const double sn = wet ? h.sn + wet[i] : h.sn; // effective stress + the fluid's
         const Vec2 f = len[i] * (sn * n - h.tau * t);
+        if (changed && was_bonded && (!h.bonded || (was_sound && h.damage > 0.0f))) {
+            changed[i] = 1;
+            before[i] = len[i] * ((wet ? sn_before + wet[i] : sn_before) * n - tau_before * t);
+        }
         double moment_b = -cross(rb, f);
         if constexpr (Mixed)
             if (b.deformable[B]) moment_b = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);

@@ -184,6 +184,15 @@ struct Contacts {
     // Per-step scratch of contact_pass (sized by rebuild_contact_index, never in a step).
     std::vector<ContactForce> force;
     std::vector<double> partial_sum; ///< per work item
+    /// Seismic events (core/events.hpp): per contact, 1 where the last contact pass
+    /// saw its bond start to soften or break (written only then: the loop's cost is
+    /// a compare), cleared by the events row of the same step. Empty, and never
+    /// written, in a model that records no events.
+    std::vector<std::uint8_t> bond_change;
+    /// And its force (on A) before that pass, written with the mark: a bond that
+    /// breaks at its peak has let go of it by the time the events row sees it.
+    std::vector<Vec2> force_before;
+    bool marking = false; ///< bond_change and force_before are kept, one entry per contact
     std::vector<int> fill;           ///< rebuild_contact_index's and the renumbering's cursor
 
     int size() const { return static_cast<int>(length.size()); }
@@ -218,6 +227,8 @@ void visit_index_fields(C& c, Visit&& v) {
     v(FieldInfo{"contacts.node_entry", G::contacts, R}, c.node_entry);
     v(FieldInfo{"contacts.fill", G::contacts, R}, c.fill);
     v(FieldInfo{"contacts.partial_sum", G::contacts, R}, c.partial_sum);
+    v(FieldInfo{"contacts.bond_change", G::contacts, R}, c.bond_change);
+    v(FieldInfo{"contacts.force_before", G::contacts, R}, c.force_before);
     v(FieldInfo{"contacts.work", G::contacts, R}, c.work);
     v(FieldInfo{"contacts.work_cost_before", G::contacts, R}, c.work_cost_before);
     v(FieldInfo{"contacts.team_split", G::other, R}, c.team_split);

@@ -579,6 +579,7 @@ World build_world(const meshing::BlockAssembly& a, const AnalysisSpec& an) {
     build_zones(w, a, materials);
     build_contacts(w, a, an, materials);
     prepare_detection(w, a);
+    start_events(w, an.events);
     prepare_team(w);
     reindex_contacts(w);
     apply_boundaries(w, an, a);

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <variant>
 
 namespace bbm {
@@ -45,7 +44,7 @@ double take_creep_step(World& w) {
     Creep& cr = *w.creep;
     auto& c = w.contacts;
     double dt = std::max(cr.until - cr.time, 0.0);
-    for_each_corroding_bond(w, [&](int i, const contact::StressCorrosionLaw& law, double s, double rate) {
+    for_each_corroding_bond(w, [&](int, const contact::StressCorrosionLaw& law, double s, double rate) {
         dt = std::min(dt, cr.loss / (rate * std::max(1.0, law.exponent * s)));
     });
     if (dt > 0.0)
@@ -58,7 +57,11 @@ double take_creep_step(World& w) {
             const double left = std::max(section - lost, 0.5 * law.section_left_at_break);
             c.length[i] *= left / section;
             section = left;
-            if (section < law.section_left_at_break) law.corrode_through(c.history[i]);
+            if (section < law.section_left_at_break) {
+                law.corrode_through(c.history[i]);
+                if (c.marking) // a source for the seismic events (core/events.hpp), its force the last pass's
+                    c.bond_change[i] = 1, c.force_before[i] = c.force[i].force;
+            }
         });
     cr.time = dt < cr.until - cr.time ? cr.time + dt : std::max(cr.time, cr.until);
     cr.last_step = dt;

@@ -178,6 +178,15 @@ struct ReportSpec {
     std::optional<Box2> window;     ///< part drawn in failure.png; empty = 2 radii around the opening
 };
 
+/// [events]: the seismic events recorded from breaking bonds (optional;
+/// core/events.hpp). Present: the catalogue is kept.
+struct EventSpec {
+    bool on = false;
+    double join_distance = 0.0; ///< m; 0: twice the mean rigid block size
+    long window = 0;            ///< steps; 0: 50
+    double thickness = 0.0;     ///< m; 0: each event's own length
+};
+
 struct AnalysisSpec {
     std::vector<MaterialSpec> materials;
     /// Material of each region by name (region name -> material name).
@@ -193,6 +202,7 @@ struct AnalysisSpec {
     SupportSpecs supports;
     FlowSpec flow; ///< [flow], [[flow_boundary]], [[flow_source]]: water in the joints
     ReportSpec report;
+    EventSpec events;
 };
 
 } // namespace bbm

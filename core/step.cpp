@@ -332,6 +332,11 @@ bool has_viscous(const World& w) { return w.viscous.count() > 0; }
 void creep_stage(World& w, const StepContext&, Range) { take_creep_step(w); }
 bool creep_step_due(const World& w) { return w.creep && w.creep->due; }
 
+/// Seismic events (core/events.hpp): the bonds the contact pass saw start to fail
+/// or break, joined into events; the open events' moment tensors.
+void events_stage(World& w, const StepContext&, Range) { record_events(w); }
+bool has_events(const World& w) { return w.events.has_value(); }
+
 // --- 5. damping and integration ----------------------------------------------------------
 
 /// Local damping against the velocity, branch-free (the sign of v is as good as
@@ -520,6 +525,8 @@ const Stage stage_table[] = {
      contact_share, false, true},
     {"zones", "3", "the constant-strain triangles' stresses and nodal forces", zone_stage, Share::team, zone_share,
      true, true},
+    {"seismic events", "—", "bonds that started to fail or broke joined into events, their moment tensors "
+     "(core/events.hpp)", events_stage, Share::one_thread, nullptr, false, false, has_events},
     {"gather blocks", "4", "each block's force and moment over its contacts, ties and loads, in a fixed order",
      gather_block_stage, Share::team, gather_block_share, false, true},
     {"gather nodes", "4", "each FE node's force over its zones, contacts and ties, in a fixed order",

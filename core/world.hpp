@@ -24,6 +24,7 @@
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
 #include "core/creep.hpp"
+#include "core/events.hpp"
 #include "core/joint_flow.hpp"
 #include "core/model_spec.hpp"
 #include "core/supports/registry.hpp"
@@ -413,6 +414,7 @@ struct World {
     SupportStates supports;         ///< one state per registered support type (core/supports/registry.hpp)
     Ties ties;
     ViscousBoundaries viscous;      ///< the dynamic mode's absorbing edges and incident waves (core/viscous.hpp)
+    std::optional<Events> events;   ///< seismic events from breaking bonds, where asked for (core/events.hpp)
     StageMonitor monitor;           ///< what the current stage did, for its verdict
     Team team;
     /// Taken when the world is built (model_fingerprint, core/state.hpp):
@@ -450,6 +452,8 @@ void for_each_field(W& w, V&& v) {
     for_each_support(w.supports, [&](auto type, auto& state) { decltype(type)::type::visit_fields(state, v); });
     visit_fields(w.ties, v);
     visit_fields(w.viscous, v);
+    // Seismic events (core/events.hpp): saved, not hashed (a record, not state).
+    if (w.events) visit_fields(*w.events, v);
     visit_fields(w.team, v);
     // What the stage did so far, for its verdict (not physics: not in the state hash).
     v(FieldInfo{"monitor.samples", MemoryGroup::other, field_use::saved}, w.monitor.samples);

@@ -12,6 +12,7 @@
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
 #include "core/boundary_keys.hpp"
+#include "core/event_keys.hpp"
 #include "core/history_keys.hpp"
 #include "core/material_keys.hpp"
 #include "core/solver_keys.hpp"
@@ -616,6 +617,29 @@ void read_report(Ctx& c, const toml::table& doc, ReportSpec& r) {
     }
 }
 
+/// The optional [events] table: the seismic events' catalogue on, and how its
+/// bonds are joined into events.
+void read_events(Ctx& c, const toml::table& doc, EventSpec& e) {
+    const toml::node* n = find(c, doc, Path{}, "events");
+    if (!n) return;
+    const Path p = Path{}.key("events");
+    const toml::table& t = to_table(c, *n, p, "an [events] table");
+    static constexpr auto keys = key_names(event_keys);
+    check_keys(c, t, p, keys);
+    for (const EventKey& k : event_keys)
+        if (k.set) read_declared_key(c, t, p, k, e);
+    e.on = true;
+    const double size = c.scale ? c.scale->size() : 0.0;
+    if (size > 0.0 && e.join_distance > 2.0 * size)
+        c.fail(*find(c, t, p, "join_distance"), p.key("join_distance"),
+               "join_distance " + shortest_text(e.join_distance) + " m is more than twice the model's size (" +
+                   shortest_text(size) + " m across): bonds are joined into an event within it (a length in mm?)");
+    if (size > 0.0 && e.thickness > 100.0 * size)
+        c.fail(*find(c, t, p, "thickness"), p.key("thickness"),
+               "thickness " + shortest_text(e.thickness) + " m is more than 100 times the model's size (" +
+                   shortest_text(size) + " m)");
+}
+
 /// How large the model is (base/table_reader.hpp): its regions' outlines and the
 /// smallest size of their block patterns, for the checks of lengths and positions.
 ModelScale model_scale(const meshing::ModelGeometrySpec& g) {
@@ -719,6 +743,7 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     check_flow_needs(c, mf);
     read_stages(c, doc, an.stages, regions, supports);
     read_report(c, doc, an.report);
+    read_events(c, doc, an.events);
     c.scale = nullptr;
 }
 
@@ -839,7 +864,7 @@ ModelFile parse_model(std::string_view text, const std::string& name) {
     const Path root{};
     // The sections, and one table per registered support type (core/supports/registry.hpp).
     std::vector<std::string_view> top_keys{"model", "region",  "material", "joint_property", "joint_assignment",
-                                           "boundary", "solver", "history", "stage", "report", "flow",
+                                           "boundary", "solver", "history", "stage", "report", "events", "flow",
                                            "flow_boundary", "flow_source"};
     for (const std::string_view t : support_tables()) top_keys.push_back(t);
     check_keys(c, doc, root, top_keys);

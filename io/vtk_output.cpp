@@ -628,6 +628,40 @@ void write_support_vtu(const SupportLines& lines, const fs::path& file) {
     write_grid(grid, file);
 }
 
+void write_events_vtu(const std::vector<SeismicEvent>& events, const fs::path& file) {
+    // One vertex cell per event at its position, its figures as cell data.
+    const auto n = static_cast<vtkIdType>(events.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(n);
+    vtkNew<vtkIdTypeArray> offsets, connectivity;
+    offsets->SetNumberOfValues(n + 1);
+    connectivity->SetNumberOfValues(n);
+    auto mw = double_array("mw", n), m0 = double_array("m0", n), r = double_array("r_value", n),
+         time = double_array("time", n), energy = double_array("kinetic_energy", n),
+         fracture = double_array("fracture_energy", n), length = double_array("length", n);
+    auto type = int_array("type", n), bonds = int_array("bonds", n), step = int_array("step", n);
+    for (vtkIdType i = 0; i < n; ++i) {
+        const SeismicEvent& e = events[std::size_t(i)];
+        points->SetPoint(i, e.position.x, e.position.y, 0.0);
+        offsets->SetValue(i, i);
+        connectivity->SetValue(i, i);
+        mw->SetValue(i, e.magnitude), m0->SetValue(i, e.moment_nm), r->SetValue(i, e.r_value);
+        time->SetValue(i, e.time), energy->SetValue(i, e.energy), fracture->SetValue(i, e.fracture_energy);
+        length->SetValue(i, e.length);
+        type->SetValue(i, e.type == "tensile" ? 1 : e.type == "implosive" ? -1 : 0);
+        bonds->SetValue(i, e.bonds), step->SetValue(i, int(e.step));
+    }
+    offsets->SetValue(n, n);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, connectivity);
+    auto grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
+    grid->SetPoints(points);
+    grid->SetCells(VTK_VERTEX, cells);
+    add_cell_arrays(grid, mw, m0, r, time, energy, fracture, length, type, bonds, step);
+    write_grid(grid, file);
+}
+
 void write_fractures_vtu(const meshing::BlockAssembly& a, const fs::path& file) {
     const auto n = static_cast<vtkIdType>(a.fracture_traces.size());
     std::vector<Vec2> ends;

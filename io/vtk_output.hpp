@@ -72,6 +72,9 @@ void write_state_contacts_vtu(const World& w, const std::filesystem::path& file)
 void write_flow_vtu(const World& w, const std::filesystem::path& file);
 /// An installed support type (core/supports/support.hpp) as line cells with the
 /// arrays its lines() names (each type's header documents its own).
+/// The seismic events (core/events.hpp) as points: magnitude, moment, type
+/// (1 tensile, 0 shear, −1 implosive), time and energies as cell data.
+void write_events_vtu(const std::vector<SeismicEvent>& events, const std::filesystem::path& file);
 void write_support_vtu(const SupportLines& lines, const std::filesystem::path& file);
 
 } // namespace bbm::io

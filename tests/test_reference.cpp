@@ -8,6 +8,7 @@
 #include "contact/joint_keys.hpp"
 #include "contact/joint_law.hpp"
 #include "core/boundary_keys.hpp"
+#include "core/event_keys.hpp"
 #include "core/flow_keys.hpp"
 #include "core/history_keys.hpp"
 #include "core/supports/registry.hpp"
@@ -111,6 +112,7 @@ TEST_CASE("docs/reference/ is the tables the code reads the keys by") {
     });
     check_reference("boundary.md", boundary_keys_markdown());
     check_reference("history.md", history_keys_markdown());
+    check_reference("events.md", event_keys_markdown());
     check_reference("model.md", meshing::model_keys_markdown());
     check_reference("region.md", meshing::region_keys_markdown());
     check_reference("dfn.md", meshing::dfn_keys_markdown());

@@ -173,6 +173,7 @@ struct StressStrainPoint {
     int cracks_tensile, cracks_shear;
     double unbalanced_ratio;  ///< largest over the steps since the last point
     double strain_per_step;   ///< the platens' loading rate over those steps
+    int events = 0;           ///< seismic events so far (core/events.hpp): the test's acoustic emission
 };
 
 struct LabTestResult {
@@ -183,6 +184,12 @@ struct LabTestResult {
     double linear_limit_stress = 0.0;
     /// σci and σcd (compression tests): onset of sustained cracking, and of dilation.
     double crack_initiation_stress = 0.0, crack_damage_stress = 0.0;
+    /// σci as a laboratory reads it from acoustic emission: the axial stress at which
+    /// the seismic events so far first reach 2% of those at the peak (at least 3),
+    /// the end of the quiet before sustained cracking (labtest_run.cpp). 0: none.
+    double crack_initiation_events = 0.0;
+    int events = 0, events_at_peak = 0; ///< seismic events of the whole test, and up to its peak
+    double b_value = 0.0;               ///< their Gutenberg–Richter b (0: fewer than 10 above completeness)
     double tensile_strength = 0.0; ///< brazilian: 2P/(πD)
     int blocks = 0, contacts = 0;
     long steps = 0;

@@ -67,6 +67,8 @@ nlohmann::json labtest_json(const LabTestResult& r) {
             {"residual_stress", r.residual_stress}, {"residual_friction_angle", r.residual_friction_angle},
             {"joint_slip_stress", r.joint_slip_stress}, {"joint_slip_stress_half", r.joint_slip_stress_half},
             {"cracks", {{"tensile", r.cracks_tensile}, {"shear", r.cracks_shear}}},
+            {"events", {{"count", r.events}, {"at_peak", r.events_at_peak}, {"b_value", r.b_value},
+                        {"crack_initiation_stress", r.crack_initiation_events}}},
             {"crack_orientation", {{"bin_degrees", 15}, {"counts", r.crack_orientation},
                                    {"within_30_of_vertical", r.cracks_near_vertical},
                                    {"within_30_of_horizontal", r.cracks_near_horizontal},
@@ -82,7 +84,7 @@ nlohmann::json labtest_record(const LabTestResult& r) {
     nlohmann::json curve = nlohmann::json::array();
     for (const auto& p : r.curve)
         curve.push_back({p.step, p.axial_strain, p.axial_stress, p.lateral_strain, p.cracks_tensile, p.cracks_shear,
-                         p.unbalanced_ratio, p.strain_per_step});
+                         p.unbalanced_ratio, p.strain_per_step, p.events});
     j["curve"] = std::move(curve);
     return j;
 }
@@ -103,6 +105,11 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.residual_friction_angle = j.value("residual_friction_angle", 0.0);
     r.joint_slip_stress = j["joint_slip_stress"], r.joint_slip_stress_half = j["joint_slip_stress_half"];
     r.cracks_tensile = j["cracks"]["tensile"], r.cracks_shear = j["cracks"]["shear"];
+    if (j.contains("events")) {
+        const auto& e = j["events"];
+        r.events = e["count"], r.events_at_peak = e["at_peak"], r.b_value = e["b_value"];
+        r.crack_initiation_events = e["crack_initiation_stress"];
+    }
     const auto& o = j["crack_orientation"];
     r.crack_orientation = o["counts"].get<std::array<int, 12>>();
     r.cracks_near_vertical = o["within_30_of_vertical"], r.cracks_near_horizontal = o["within_30_of_horizontal"];
@@ -110,7 +117,8 @@ LabTestResult labtest_from_record(const nlohmann::json& j) {
     r.cracks_near_horizontal_at_peak = o["within_30_of_horizontal_at_peak"];
     for (const auto& p : j["curve"])
         r.curve.push_back({p[0].get<long>(), p[1].get<double>(), p[2].get<double>(), p[3].get<double>(),
-                           p[4].get<int>(), p[5].get<int>(), p[6].get<double>(), p[7].get<double>()});
+                           p[4].get<int>(), p[5].get<int>(), p[6].get<double>(), p[7].get<double>(),
+                           p.size() > 8 ? p[8].get<int>() : 0});
     return r;
 }
 
@@ -132,7 +140,7 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
     fs::create_directories(dir / "vtk");
     std::ostringstream csv;
     csv << "step,axial_strain,axial_stress_Pa,lateral_strain,cracks_tensile,cracks_shear,unbalanced_ratio,"
-           "strain_per_step\n";
+           "strain_per_step,events\n";
     csv.precision(10);
     // Stress against the axial, lateral (expansion negative) and volumetric strains,
     // as Martin & Chandler draw them, with σci and σcd marked.
@@ -140,7 +148,7 @@ void write_labtest_files(const LabTestResult& r, const Solver& s, const fs::path
     for (const auto& p : r.curve) {
         csv << p.step << ',' << p.axial_strain << ',' << p.axial_stress << ',' << p.lateral_strain << ','
             << p.cracks_tensile << ',' << p.cracks_shear << ',' << p.unbalanced_ratio << ',' << p.strain_per_step
-            << '\n';
+            << ',' << p.events << '\n';
         const double sigma = 1e-6 * p.axial_stress;
         axial.x.push_back(1e3 * p.axial_strain), axial.y.push_back(sigma);
         lateral.x.push_back(-1e3 * p.lateral_strain), lateral.y.push_back(sigma);

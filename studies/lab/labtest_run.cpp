@@ -43,6 +43,14 @@ private:
     double sign_ = -1.0;
 };
 
+/// Seismic events so far: the catalogue and the open events with a broken bond.
+int event_count(const World& w) {
+    if (!w.events) return 0;
+    int n = w.events->count();
+    for (int b : w.events->open_broken) n += b > 0;
+    return n;
+}
+
 /// Applies the biaxial confinement gradually with the platens held still, then lets
 /// the specimen settle; returns the step at which axial loading starts.
 long confine(Solver& s, MovingPlaten& platen) {
@@ -111,6 +119,7 @@ public:
         p.cracks_shear = cracks(s_.world(), contact::JointState::broken_shear);
         p.unbalanced_ratio = s_.world().clock.ratio;
         p.strain_per_step = at_rate;
+        p.events = event_count(s_.world());
         return p;
     }
 
@@ -139,6 +148,22 @@ private:
     double sign_;
     std::vector<int> left_, right_;
 };
+
+/// σci from the events, as a laboratory reads it from acoustic emission: the
+/// first point whose events reach 2% of those at the peak (at least 3).
+void measure_event_onset(LabTestResult& r, long peak_step) {
+    int at_peak = 0;
+    for (const auto& p : r.curve)
+        if (p.step <= peak_step) at_peak = p.events;
+    r.events_at_peak = at_peak;
+    const int onset = std::max(3, int(std::ceil(0.02 * at_peak)));
+    if (at_peak < onset) return;
+    for (const auto& p : r.curve)
+        if (p.events >= onset) {
+            r.crack_initiation_events = p.axial_stress;
+            return;
+        }
+}
 
 /// Crack orientation when each crack forms (later the fragments rotate): the
 /// angle of its joint from horizontal, 0–180°.
@@ -502,6 +527,14 @@ void finish_labtest_result(Solver& s, const LabTestOptions& o, const StopRules& 
     record_new_cracks(s, r);
     r.cracks_tensile = cracks(s.world(), contact::JointState::broken_tension);
     r.cracks_shear = cracks(s.world(), contact::JointState::broken_shear);
+    r.events = event_count(s.world());
+    if (!brazilian && o.kind != LabTestOptions::Kind::tension) measure_event_onset(r, rules.peak_step());
+    if (s.world().events) {
+        std::vector<double> magnitudes;
+        for (const SeismicEvent& e : event_catalogue(*s.world().events)) magnitudes.push_back(e.magnitude);
+        const GutenbergRichter g = gutenberg_richter(magnitudes);
+        r.b_value = g.fitted ? g.b : 0.0;
+    }
 }
 
 } // namespace

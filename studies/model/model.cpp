@@ -249,6 +249,40 @@ nlohmann::json creep_summary(const World& w) {
             {"mean_section", intact > 0 ? mean / intact : 0.0}};
 }
 
+/// The seismic events (core/events.hpp): counts by type, the largest, the total
+/// moment and the Gutenberg–Richter fit of their magnitudes.
+nlohmann::json events_summary(const Events& ev) {
+    const std::vector<SeismicEvent> events = event_catalogue(ev);
+    std::vector<double> magnitudes;
+    int tensile = 0, shear = 0, implosive = 0, bonds = 0;
+    double total = 0.0, largest = -99.0, energy = 0.0, fracture = 0.0;
+    for (const SeismicEvent& e : events) {
+        magnitudes.push_back(e.magnitude);
+        tensile += e.type == "tensile", shear += e.type == "shear", implosive += e.type == "implosive";
+        bonds += e.bonds, total += e.moment_nm, largest = std::max(largest, e.magnitude);
+        energy += e.energy, fracture += e.fracture_energy;
+    }
+    nlohmann::json j{{"count", events.size()},
+                     {"bonds", bonds},
+                     {"tensile", tensile},
+                     {"shear", shear},
+                     {"implosive", implosive},
+                     {"largest_mw", events.empty() ? nlohmann::json() : nlohmann::json(largest)},
+                     {"total_moment", total},
+                     {"kinetic_energy", energy},
+                     {"fracture_energy", fracture},
+                     {"join_distance", ev.join_distance},
+                     {"window_steps", ev.window}};
+    const GutenbergRichter g = gutenberg_richter(magnitudes);
+    auto& gr = j["gutenberg_richter"];
+    gr["events_above_completeness"] = g.count;
+    if (g.fitted)
+        gr["completeness"] = g.completeness, gr["b"] = g.b, gr["b_error"] = g.b_error, gr["a"] = g.a;
+    else
+        gr["note"] = "fewer than 10 events above the magnitude of completeness: no fit";
+    return j;
+}
+
 /// The water in the joints: the network, its conducting pipes, the inflow, the highest pressure.
 nlohmann::json flow_summary(const JointFlow& flow) {
     const auto& st = flow.state;
@@ -312,6 +346,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         for (const auto& r : reports)
             if (r.failed) summary["creep"]["failed_at"] = r.creep_time;
     }
+    if (w.events) summary["events"] = events_summary(*w.events);
     if (w.viscous.count() > 0) {
         // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
         auto& e = summary["energy"];

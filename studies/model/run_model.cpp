@@ -656,6 +656,12 @@ nlohmann::json write_run_output(const BuiltModel& built, RunOutput& output, cons
     } else {
         draw_pictures(solver, output, opt, fo);
     }
+    if (const auto& events = solver.world().events) {
+        // The catalogue (core/events.hpp): a table and points for ParaView.
+        const std::vector<SeismicEvent> catalogue = event_catalogue(*events);
+        write_text_atomically(opt.out / "events.csv", events_csv(catalogue));
+        write_events_vtu(catalogue, opt.out / "events.vtu");
+    }
     write_text_atomically(opt.out / "summary.json", summary.dump(2) + "\n");
     return summary;
 }
