@@ -220,7 +220,9 @@ namespace {
 // nodes with the same weights (so the contact does no work the nodes do not see).
 template <bool Mixed, class Law>
 double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const BlockView& b, double dt,
-                    double corner_radius) {
+                    double corner_radius, double beta) {
+    // Rayleigh's stiffness part: viscous stresses of the step's rates.
+    const double viscous_n = beta > 0.0 ? beta * law.kn / dt : 0.0, viscous_s = beta > 0.0 ? beta * law.ks / dt : 0.0;
     const int* __restrict va = c.vertex_block.data();
     const int* __restrict vid = c.vertex_id.data();
     const int* __restrict eb = c.edge_block.data();
@@ -272,8 +274,10 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
         const bool was_bonded = h.bonded, was_sound = h.damage == 0.0f;
         const double sn_before = h.sn, tau_before = h.tau;
         law.update(h, du_n, du_s);
-        const double sn = wet ? h.sn + wet[i] : h.sn; // effective stress + the fluid's
-        const Vec2 f = len[i] * (sn * n - h.tau * t);
+        double sn = wet ? h.sn + wet[i] : h.sn; // effective stress + the fluid's
+        double tau = h.tau;
+        if (viscous_n > 0.0 && (h.bonded || h.sn > 0.0)) sn -= viscous_n * du_n, tau += viscous_s * du_s;
+        const Vec2 f = len[i] * (sn * n - tau * t);
         if (changed && was_bonded && (!h.bonded || (was_sound && h.damage > 0.0f))) {
             changed[i] = 1;
             before[i] = len[i] * ((wet ? sn_before + wet[i] : sn_before) * n - tau_before * t);
@@ -311,15 +315,15 @@ std::pair<int, int> team_share(const std::vector<double>& cost_before, int threa
 }
 
 void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                  double corner_radius, int first, int last) {
+                  double corner_radius, int first, int last, double stiffness_damping) {
     for (int w = first; w < last; ++w) {
         const auto& item = c.work[w];
         const std::span<const int> ids(c.batch_contact.data() + c.batch_first[item.batch] + item.begin,
                                        item.end - item.begin);
         c.partial_sum[w] = std::visit(
             [&](const auto& law) {
-                return item.batch % 2 ? batch_pass<true>(law, ids, c, b, dt, corner_radius)
-                                      : batch_pass<false>(law, ids, c, b, dt, corner_radius);
+                return item.batch % 2 ? batch_pass<true>(law, ids, c, b, dt, corner_radius, stiffness_damping)
+                                      : batch_pass<false>(law, ids, c, b, dt, corner_radius, stiffness_damping);
             },
             laws[item.batch / 2]);
     }

@@ -335,9 +335,11 @@ inline Vec2 contact_force(const Contacts& c, int i) {
 /// (each law dispatched once per batch) its kinematics, the law, and its force
 /// and moments into `c.force` — no contact writes anything another contact
 /// reads, so a team shares the items (contact_share) and meets at a barrier
-/// before the gathers below.
+/// before the gathers below. `stiffness_damping` β > 0 adds Rayleigh's
+/// stiffness-proportional viscous stresses −β kn u̇n and β ks u̇s to the forces of
+/// bonded and closed contacts (not to their histories).
 void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockView& b, double dt,
-                  double corner_radius, int first, int last);
+                  double corner_radius, int first, int last, double stiffness_damping = 0.0);
 inline int contact_items(const Contacts& c) { return static_cast<int>(c.work.size()); }
 
 /// The work items [first, last) of `thread` in a team of `team`: contiguous runs

@@ -107,6 +107,15 @@ struct SolverSpec {
     /// as UDEC shares a face between its two end contacts.
     enum class NewContactLength { edge, overlap };
     NewContactLength new_contact_length = NewContactLength::edge;
+    /// Rayleigh damping (dynamic mode): the critical ratio ξ at the centre
+    /// frequency f (Hz), half from the mass and half from the stiffness:
+    /// C = α M + β K, α = ξ ω, β = ξ / ω, ω = 2π f (docs/theory.md §19).
+    double rayleigh_ratio = 0.0;
+    double rayleigh_frequency = 0.0;
+    double rayleigh_alpha() const { return rayleigh_ratio * 2.0 * 3.141592653589793 * rayleigh_frequency; }
+    double rayleigh_beta() const {
+        return rayleigh_frequency > 0.0 ? rayleigh_ratio / (2.0 * 3.141592653589793 * rayleigh_frequency) : 0.0;
+    }
     int output_every = 0;             ///< steps between VTK outputs; 0 = at stage ends only
     int history_every = 10;           ///< steps between history rows
     int threads = 1;                  ///< threads of the contact loop (from the command line)

@@ -26,6 +26,15 @@ inline constexpr SolverKey solver_keys[] = {
                 "out of a wave)",
      .absent = "0.8; in the dynamic mode 0 (waves are not damped away unless asked)",
      BBM_KEY_FIELD(SolverSpec, damping)},
+    {.key = "rayleigh_ratio", .bounds = below(0, 1, ""),
+     .meaning = "Rayleigh damping's critical ratio ξ at rayleigh_frequency (dynamic mode; with it): C = α M + β K, "
+                "α = ξ ω, β = ξ / ω, ω = 2π f — the ratio is ξ at f and larger on either side; the stable step is "
+                "reduced as the stiffness part requires",
+     .absent = "0: none", BBM_KEY_FIELD(SolverSpec, rayleigh_ratio)},
+    {.key = "rayleigh_frequency", .bounds = above(0, " Hz"),
+     .meaning = "Rayleigh damping's centre frequency (with rayleigh_ratio), e.g. the model's fundamental or the "
+                "input's dominant frequency",
+     .absent = "none", BBM_KEY_FIELD(SolverSpec, rayleigh_frequency)},
     {.key = "safety", .bounds = {.lo = 0, .hi = 1, .lo_open = true}, .meaning = "Time step over the critical time step",
      .absent = "0.5", BBM_KEY_FIELD(SolverSpec, safety)},
     {.key = "timestep", .bounds = at_least(0, " s"),

@@ -175,7 +175,7 @@ bool timed(const World& w, const StepContext& ctx) {
 void contact_stage(World& w, const StepContext& ctx, Range r) {
     const double t0 = timed(w, ctx) ? omp_get_wtime() : 0.0;
     contact::contact_pass(w.contacts, w.properties.laws, block_view(w), w.clock.dt, w.detection.corner_radius, r.first,
-                          r.last);
+                          r.last, w.settings.rayleigh_beta());
     w.normals_stale = true;
     if (timed(w, ctx)) w.team.pass_time[ctx.thread].contacts += omp_get_wtime() - t0;
 }
@@ -187,7 +187,7 @@ Range contact_share(const World& w, const StepContext& ctx) {
 void zone_stage(World& w, const StepContext& ctx, Range r) {
     const double t0 = timed(w, ctx) ? omp_get_wtime() : 0.0;
     fem::zone_pass(w.zones, w.nodes.position.data(), w.nodes.velocity.data(), w.clock.dt, w.bodies.removed.data(),
-                   r.first, r.last);
+                   r.first, r.last, w.settings.rayleigh_beta());
     if (timed(w, ctx)) w.team.pass_time[ctx.thread].zones += omp_get_wtime() - t0;
 }
 Range zone_share(const World& w, const StepContext& ctx) { return equal_share(fem::zone_items(w.zones), ctx); }
@@ -347,12 +347,21 @@ inline double damped(double f, double v, double alpha) { return f - alpha * std:
 /// its prescribed components held; returns the work of its loads and of the
 /// supports on the prescribed components (reaction −F) over the step, and raises
 /// `unbalanced` to its largest free force component.
+/// Mass-proportional (Rayleigh) damping −a m v, taken implicitly over the step:
+/// v⁺ = ((1 − a Δt/2) v + F Δt/m) / (1 + a Δt/2), `keep` = 1 − a Δt/2 and
+/// `scale` = 1 / (1 + a Δt/2) (both 1 without it: the same bits).
+struct MassDamping {
+    double keep = 1.0, scale = 1.0;
+    MassDamping(double a, double dt) : keep(1.0 - 0.5 * a * dt), scale(1.0 / (1.0 + 0.5 * a * dt)) {}
+    double operator()(double v, double dv) const { return keep == 1.0 ? v + dv : (keep * v + dv) * scale; }
+};
+
 inline double translate(std::uint8_t fx, Vec2& v, Vec2 f, Vec2 fixed_v, double mass, Vec2 load, double alpha, double dt,
-                        double& unbalanced) {
+                        const MassDamping& md, double& unbalanced) {
     if (!(fx & 1)) unbalanced = std::max(unbalanced, std::abs(f.x));
     if (!(fx & 2)) unbalanced = std::max(unbalanced, std::abs(f.y));
-    v.x = (fx & 1) ? fixed_v.x : v.x + damped(f.x, v.x, alpha) / mass * dt;
-    v.y = (fx & 2) ? fixed_v.y : v.y + damped(f.y, v.y, alpha) / mass * dt;
+    v.x = (fx & 1) ? fixed_v.x : md(v.x, damped(f.x, v.x, alpha) / mass * dt);
+    v.y = (fx & 2) ? fixed_v.y : md(v.y, damped(f.y, v.y, alpha) / mass * dt);
     double work = dot(load, v) * dt;
     if (fx & 1) work -= f.x * v.x * dt;
     if (fx & 2) work -= f.y * v.y * dt;
@@ -365,10 +374,11 @@ double integrate_block(World& w, int i, double& unbalanced) {
     const auto& l = w.loads;
     const std::uint8_t fx = l.block_fixed[i];
     contact::BodyState& b = w.bodies.state[i];
+    const MassDamping md(w.settings.rayleigh_alpha(), dt);
     double work = translate(fx, b.velocity, w.bodies.force[i], l.block_velocity[i], w.bodies.mass[i],
-                            l.block_force[i] + w.blocks.real_mass[i] * w.settings.gravity, alpha, dt, unbalanced);
+                            l.block_force[i] + w.blocks.real_mass[i] * w.settings.gravity, alpha, dt, md, unbalanced);
     const double m = w.bodies.moment[i];
-    b.omega = (fx & 4) ? l.block_omega[i] : b.omega + damped(m, b.omega, alpha) / w.bodies.inertia[i] * dt;
+    b.omega = (fx & 4) ? l.block_omega[i] : md(b.omega, damped(m, b.omega, alpha) / w.bodies.inertia[i] * dt);
     work += (l.block_moment[i] - ((fx & 4) ? m : 0.0)) * b.omega * dt;
     b.centroid += dt * b.velocity;
     b.theta += dt * b.omega;
@@ -381,7 +391,7 @@ double integrate_node(World& w, int i, double& unbalanced) {
     Vec2& v = w.nodes.velocity[i];
     const double work = translate(l.node_fixed[i], v, w.nodes.force[i], l.node_velocity[i], w.nodes.mass[i],
                                   l.node_force[i] + w.nodes.real_mass[i] * w.settings.gravity, w.settings.damping,
-                                  w.clock.dt, unbalanced);
+                                  w.clock.dt, MassDamping(w.settings.rayleigh_alpha(), w.clock.dt), unbalanced);
     w.nodes.position[i] += w.clock.dt * v;
     return work;
 }

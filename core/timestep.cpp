@@ -86,6 +86,12 @@ void real_masses(World& w, const std::vector<double>& k, const std::vector<doubl
         using T = typename decltype(type)::type;
         if (T::tie_count(state) > 0) limit = std::min(limit, T::time_limit(state));
     });
+    // Stiffness-proportional damping shortens the stable step (Belytschko et al.
+    // 2000, §6.2): Δt ≤ (2/ω_max)(√(1 + ξ²) − ξ), ξ = β ω_max / 2, ω_max = 2 / limit.
+    if (const double beta = w.settings.rayleigh_beta(); beta > 0.0 && std::isfinite(limit)) {
+        const double xi = beta / limit;
+        limit *= std::sqrt(1.0 + xi * xi) - xi;
+    }
     w.clock.dt = w.settings.timestep > 0 ? w.settings.timestep : (std::isfinite(limit) ? w.settings.safety * limit : 1e-3);
     w.bodies.mass = w.blocks.real_mass;
     w.bodies.inertia = w.blocks.real_inertia;

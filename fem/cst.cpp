@@ -37,7 +37,7 @@ void index_zone_nodes(Zones& z, int nodes) {
 namespace {
 /// One zone's update: its stress from the step's velocity gradient, and the
 /// nodal forces of that stress; returns Σ|f|² over its three nodes.
-inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double dt) {
+inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double dt, double beta) {
     const auto& n = z.node[k];
     const auto g = gradients(x[n[0]], x[n[1]], x[n[2]]);
     // Velocity gradient × Δt: the step's displacement gradient.
@@ -60,10 +60,18 @@ inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double 
     s[2] += rot_xy + 2.0 * e.shear * exy;
     auto& eps = z.strain[k];
     eps[0] += exx, eps[1] += eyy, eps[2] += exy;
+    // Rayleigh's stiffness part: the viscous stress β D ε̇ (ε̇ = the step's strain / Δt).
+    std::array<double, 3> t = s;
+    if (beta > 0.0) {
+        const double b = beta / dt;
+        t[0] += b * (tr + 2.0 * e.shear * exx);
+        t[1] += b * (tr + 2.0 * e.shear * eyy);
+        t[2] += b * 2.0 * e.shear * exy;
+    }
     // f_i = −A σ ∇N_i = −½ σ (b_i, c_i).
     double sum = 0.0;
     for (int i = 0; i < 3; ++i) {
-        const Vec2 fi{-0.5 * (s[0] * g.b[i] + s[2] * g.c[i]), -0.5 * (s[2] * g.b[i] + s[1] * g.c[i])};
+        const Vec2 fi{-0.5 * (t[0] * g.b[i] + t[2] * g.c[i]), -0.5 * (t[2] * g.b[i] + t[1] * g.c[i])};
         z.nodal_force[k][i] = fi;
         sum += norm2(fi);
     }
@@ -72,7 +80,7 @@ inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double 
 } // namespace
 
 void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uint8_t* skip, int first_item,
-               int last_item) {
+               int last_item, double stiffness_damping) {
     const int count = z.size();
     for (int w = first_item; w < last_item; ++w) {
         double sum = 0.0;
@@ -81,7 +89,7 @@ void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uin
                 z.nodal_force[k] = {};
                 continue;
             }
-            sum += zone_update(z, k, x, v, dt);
+            sum += zone_update(z, k, x, v, dt, stiffness_damping);
         }
         z.partial_sum[w] = sum;
     }

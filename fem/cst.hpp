@@ -105,9 +105,11 @@ void index_zone_nodes(Zones& z, int nodes);
 /// partial sum of Σ|f|² each). Who computes an item does not change its result:
 /// a team shares the items and meets at a barrier before gathering with
 /// node_zone_force(). Zones of removed blocks are skipped (`skip[block]`
-/// non-zero) and contribute nothing. Needs index_zone_nodes().
+/// non-zero) and contribute nothing. Needs index_zone_nodes(). `stiffness_damping`
+/// β > 0 adds Rayleigh's stiffness-proportional viscous stress β D ε̇ to the
+/// nodal forces (not to the stored stress).
 void zone_pass(Zones& z, const Vec2* position, const Vec2* velocity, double dt, const std::uint8_t* skip,
-               int first_item, int last_item);
+               int first_item, int last_item, double stiffness_damping = 0.0);
 inline int zone_items(const Zones& z) { return static_cast<int>(z.partial_sum.size()); }
 
 /// Second pass, per node: the forces of its zones in zone order (the same sum on

@@ -347,6 +347,17 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
             choice(c, t, p, "mode", key_words(find_key(solver_keys, "mode")->words), "solver mode"));
     // Local damping is a quasi-static device: a dynamic run has none unless asked.
     if (s.mode == SolverSpec::Mode::dynamic && !t.contains("damping")) s.damping = 0.0;
+    // Rayleigh damping: its ratio and centre frequency together, in real time.
+    if (t.contains("rayleigh_ratio") != t.contains("rayleigh_frequency")) {
+        const char* given = t.contains("rayleigh_ratio") ? "rayleigh_ratio" : "rayleigh_frequency";
+        c.fail(*find(c, t, p, given), p.key(given),
+               "Rayleigh damping needs both rayleigh_ratio (the critical ratio) and rayleigh_frequency (Hz, where it "
+               "holds)");
+    }
+    if (t.contains("rayleigh_ratio") && s.mode != SolverSpec::Mode::dynamic)
+        c.fail(*find(c, t, p, "rayleigh_ratio"), p.key("rayleigh_ratio"),
+               "Rayleigh damping is for the dynamic mode (real masses, real time): a quasi-static run's time and "
+               "masses are fictitious; give [solver] mode = \"dynamic\" or use `damping`");
     s.gravity = vector(c, t, p, "gravity").value_or(s.gravity);
     if (t.contains("new_contact_length"))
         s.new_contact_length = static_cast<SolverSpec::NewContactLength>(choice(

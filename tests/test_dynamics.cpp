@@ -6,6 +6,7 @@
 #include "core/measures.hpp"
 #include "core/state.hpp"
 #include "core/solver.hpp"
+#include "core/stages.hpp"
 #include "core/step.hpp"
 
 #include "model_text.hpp"
@@ -14,6 +15,7 @@
 
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -218,4 +220,137 @@ TEST_CASE("local damping is 0 by default in the dynamic mode, 0.8 in the quasi-s
     text.replace(text.find("mode = \"dynamic\""), 16, "mode = \"quasi_static\"");
     // (a viscous boundary then is refused when the world is built, not when read)
     CHECK(test::build_model(text, "column.toml").file.analysis.solver.damping == 0.8);
+}
+
+namespace {
+
+/// examples/verification/oscillator.toml (a 1 m block on a joint, ω = 1000 rad/s)
+/// with Rayleigh damping of ratio ξ at `frequency` Hz.
+std::string damped_oscillator(double ratio, double frequency) {
+    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/verification/oscillator.toml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string t = text.str();
+    t.replace(t.find("damping = 0.0\n"), 14,
+              "damping = 0.0\nrayleigh_ratio = " + std::to_string(ratio) + "\nrayleigh_frequency = " +
+                  std::to_string(frequency) + "\n");
+    return t;
+}
+
+/// The damping ratio of the block's free vibration from the decay of its
+/// displacement peaks over `periods` periods (the logarithmic decrement δ:
+/// ξ = δ / √(4π² + δ²)), and the time step.
+std::pair<double, double> measured_ratio(double ratio, double frequency, int periods) {
+    const auto m = test::build_model(damped_oscillator(ratio, frequency), "oscillator.toml");
+    Solver s(m.blocks, m.file.analysis);
+    StageObserver quiet;
+    run_stages(s, {m.file.analysis.stages[0]}, quiet);
+    const World& w = s.world();
+    const int block = w.blocks.centroid0[0].y > w.blocks.centroid0[1].y ? 0 : 1;
+    // About its rest position: the pre-compression's σ/kn = 1 mm above where it started.
+    auto u = [&] { return w.bodies.state[block].centroid.y - w.blocks.centroid0[block].y - 1e-3; };
+    std::vector<double> peaks;
+    double before = u(), now = u();
+    s.step();
+    now = u();
+    while (int(peaks.size()) <= periods) {
+        s.step();
+        const double next = u();
+        if (now > before && now >= next && now > 0.0) peaks.push_back(now);
+        before = now, now = next;
+    }
+    const double delta = std::log(peaks.front() / peaks.back()) / periods;
+    return {delta / std::sqrt(4.0 * std::numbers::pi * std::numbers::pi + delta * delta), w.clock.dt};
+}
+
+} // namespace
+
+TEST_CASE("Rayleigh damping gives its ratio at its centre frequency, and ξ(ω) = (α/ω + β ω)/2 away from it") {
+    const double omega = 1000.0, f0 = omega / (2.0 * std::numbers::pi), xi = 0.05;
+    // At the block's own frequency: ξ; at twice it (ω = ω0/2): ξ/2 (2 + 1/2); at half (ω = 2 ω0): the same.
+    for (const auto [centre, expected] : {std::pair{f0, xi}, std::pair{2.0 * f0, 1.25 * xi}, std::pair{0.5 * f0, 1.25 * xi}}) {
+        const auto [measured, dt] = measured_ratio(xi, centre, 8);
+        MESSAGE("centre ", centre, " Hz: ratio ", measured, " (expected ", expected, "), dt ", dt);
+        CHECK(measured == doctest::Approx(expected).epsilon(0.01));
+    }
+    // The stable step shrinks as the stiffness part needs: by √(1 + ξ²) − ξ,
+    // ξ = β ω_max / 2 with ω_max = 2 / Δt_crit.
+    const double dt0 = measured_ratio(0.0, 1.0, 1).second;
+    const double beta = 0.5 / (2.0 * std::numbers::pi * 1.0); // ξ 0.5 at 1 Hz: β = 0.0796 s, ω_max β / 2 ≫ 1
+    const auto m = test::build_model(damped_oscillator(0.5, 1.0), "oscillator.toml");
+    Solver s(m.blocks, m.file.analysis);
+    const double limit = dt0 / 0.1, x = beta / limit;
+    CHECK(s.world().clock.dt == doctest::Approx(dt0 * (std::sqrt(1.0 + x * x) - x)).epsilon(1e-9));
+}
+
+TEST_CASE("Rayleigh damping needs its two keys and the dynamic mode, and says so with its key") {
+    auto error = [](const std::string& text) -> std::string {
+        try {
+            test::build_model(text, "oscillator.toml");
+        } catch (const InputError& e) {
+            return e.key();
+        }
+        return "accepted";
+    };
+    std::string t = damped_oscillator(0.05, 100.0);
+    CHECK(error(t) == "accepted");
+    std::string one = t;
+    one.erase(one.find("rayleigh_frequency"), one.find('\n', one.find("rayleigh_frequency")) - one.find("rayleigh_frequency") + 1);
+    CHECK(error(one) == "solver.rayleigh_ratio");
+    std::string quasi = t;
+    quasi.replace(quasi.find("mode = \"dynamic\""), 16, "mode = \"quasi_static\"");
+    CHECK(error(quasi) == "solver.rayleigh_ratio");
+    std::string bad = t;
+    bad.replace(bad.find("rayleigh_ratio = 0.05"), 21, "rayleigh_ratio = 1.5");
+    CHECK(error(bad) == "solver.rayleigh_ratio");
+}
+
+TEST_CASE("Rayleigh damping of the far field's zones: a column's fundamental mode decays at its ratio") {
+    // The elastic column (c_p, 40 m, sides on rollers) fixed at its base, free at
+    // its top, released from a uniform 1 MPa compression: its quarter-wave mode
+    // f1 = c_p / 4H carries 81% of the top's motion (8/π²), the next (3 f1) 9%.
+    // With ξ = 0.05 at f1 the first mode's peaks decay by e^{−2π ξ/√(1−ξ²)} a
+    // period; the third, at ξ(3 f1) = ξ (1/3 + 3)/2 = 1.67 ξ, dies sooner.
+    std::string t = column(false);
+    const std::size_t base = t.find("[[boundary]]\nname = \"base\"");
+    t.erase(base, t.find("start = 1e-3\n", base) + 13 - base);
+    const double c = p_wave_speed(), f1 = c / (4.0 * height), xi = 0.05;
+    t.replace(t.find("damping = 0.0\n"), 14,
+              "damping = 0.0\nrayleigh_ratio = 0.05\nrayleigh_frequency = " + std::to_string(f1) + "\n");
+    t += R"(
+[[boundary]]
+name = "base"
+type = "velocity"
+box = { min = [-1.0, -0.01], max = [2.0, 0.01] }
+vy = 0.0
+
+[[stage]]
+name = "compressed"
+type = "initialize"
+syy = -1e6
+)";
+    const auto m = test::build_model(t, "column.toml");
+    Solver s(m.blocks, m.file.analysis);
+    StageObserver quiet;
+    run_stages(s, m.file.analysis.stages, quiet);
+    World& w = s.world();
+    const int top = node_near(w, {0.5, height});
+    const double modulus = young * (1.0 - poisson) / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+    const double rest = 1e6 * height / modulus; // the released column's length change
+    auto u = [&] { return w.nodes.position[top].y - w.nodes.position0[top].y - rest; };
+    std::vector<double> peaks;
+    double before = u();
+    s.step();
+    double now = u();
+    while (peaks.size() < 7) {
+        s.step();
+        const double next = u();
+        if (now > before && now >= next && now > 0.0) peaks.push_back(now);
+        before = now, now = next;
+    }
+    // From the second peak on (the third mode has faded by then) over five periods.
+    const double delta = std::log(peaks[1] / peaks[6]) / 5.0;
+    const double measured = delta / std::sqrt(4.0 * std::numbers::pi * std::numbers::pi + delta * delta);
+    MESSAGE("first mode ", f1, " Hz: damping ratio ", measured, " (", xi, ")");
+    CHECK(measured == doctest::Approx(xi).epsilon(0.03));
 }
