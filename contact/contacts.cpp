@@ -119,6 +119,7 @@ void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std
     c.work_cost_before[c.work.size()] = cost;
     c.force.resize(n);
     c.partial_sum.resize(c.work.size());
+    c.partial_damped.assign(c.work.size(), 0.0);
     if (c.marking) c.bond_change.assign(c.length.size(), 0), c.force_before.resize(c.length.size());
 
     // Per-block and per-node lists in contact order: count, prefix sum, fill
@@ -220,7 +221,7 @@ namespace {
 // nodes with the same weights (so the contact does no work the nodes do not see).
 template <bool Mixed, class Law>
 double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const BlockView& b, double dt,
-                    double corner_radius, double beta) {
+                    double corner_radius, double beta, double& viscous_work) {
     // Rayleigh's stiffness part: viscous stresses of the step's rates.
     const double viscous_n = beta > 0.0 ? beta * law.kn / dt : 0.0, viscous_s = beta > 0.0 ? beta * law.ks / dt : 0.0;
     const int* __restrict va = c.vertex_block.data();
@@ -276,7 +277,10 @@ double batch_pass(const Law& law, std::span<const int> ids, Contacts& c, const B
         law.update(h, du_n, du_s);
         double sn = wet ? h.sn + wet[i] : h.sn; // effective stress + the fluid's
         double tau = h.tau;
-        if (viscous_n > 0.0 && (h.bonded || h.sn > 0.0)) sn -= viscous_n * du_n, tau += viscous_s * du_s;
+        if (viscous_n > 0.0 && (h.bonded || h.sn > 0.0)) {
+            sn -= viscous_n * du_n, tau += viscous_s * du_s;
+            viscous_work += len[i] * (viscous_n * du_n * du_n + viscous_s * du_s * du_s);
+        }
         const Vec2 f = len[i] * (sn * n - tau * t);
         if (changed && was_bonded && (!h.bonded || (was_sound && h.damage > 0.0f))) {
             changed[i] = 1;
@@ -320,12 +324,15 @@ void contact_pass(Contacts& c, const std::vector<JointLaw>& laws, const BlockVie
         const auto& item = c.work[w];
         const std::span<const int> ids(c.batch_contact.data() + c.batch_first[item.batch] + item.begin,
                                        item.end - item.begin);
+        double viscous_work = 0.0;
         c.partial_sum[w] = std::visit(
             [&](const auto& law) {
-                return item.batch % 2 ? batch_pass<true>(law, ids, c, b, dt, corner_radius, stiffness_damping)
-                                      : batch_pass<false>(law, ids, c, b, dt, corner_radius, stiffness_damping);
+                return item.batch % 2
+                           ? batch_pass<true>(law, ids, c, b, dt, corner_radius, stiffness_damping, viscous_work)
+                           : batch_pass<false>(law, ids, c, b, dt, corner_radius, stiffness_damping, viscous_work);
             },
             laws[item.batch / 2]);
+        c.partial_damped[w] = viscous_work;
     }
 }
 

@@ -184,6 +184,7 @@ struct Contacts {
     // Per-step scratch of contact_pass (sized by rebuild_contact_index, never in a step).
     std::vector<ContactForce> force;
     std::vector<double> partial_sum; ///< per work item
+    std::vector<double> partial_damped; ///< per work item: Rayleigh's stiffness part's work this step, J/m
     /// Seismic events (core/events.hpp): per contact, 1 where the last contact pass
     /// saw its bond start to soften or break (written only then: the loop's cost is
     /// a compare), cleared by the events row of the same step. Empty, and never
@@ -227,6 +228,7 @@ void visit_index_fields(C& c, Visit&& v) {
     v(FieldInfo{"contacts.node_entry", G::contacts, R}, c.node_entry);
     v(FieldInfo{"contacts.fill", G::contacts, R}, c.fill);
     v(FieldInfo{"contacts.partial_sum", G::contacts, R}, c.partial_sum);
+    v(FieldInfo{"contacts.partial_damped", G::contacts, R}, c.partial_damped);
     v(FieldInfo{"contacts.bond_change", G::contacts, R}, c.bond_change);
     v(FieldInfo{"contacts.force_before", G::contacts, R}, c.force_before);
     v(FieldInfo{"contacts.work", G::contacts, R}, c.work);

@@ -19,7 +19,7 @@ using ReportKey = Key<ReportSpec>;
 inline constexpr std::string_view history_quantity_words =
     "unbalanced_ratio, displacement_x, displacement_y, velocity_x, velocity_y, rotation, boundary_force_x, "
     "boundary_force_y, cracks_tensile, cracks_shear, kinetic_energy, strain_energy, dissipated_energy, work, inflow, absorbed_energy, "
-    "wave_energy, creep_time";
+    "wave_energy, creep_time, damping_energy, energy_error";
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"

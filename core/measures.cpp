@@ -93,6 +93,39 @@ double dissipated_energy(const World& w) {
     return e;
 }
 
+namespace {
+/// Kinetic energy at the masses the step integrates (before any step: the
+/// account then uses this; after one, the step's own, Clock::kinetic).
+double integrated_kinetic_energy(const World& w) {
+    double e = 0.0;
+    for (int i = 0; i < w.bodies.count(); ++i)
+        if (!w.bodies.removed[i] && !w.blocks.deformable[i]) {
+            const auto& b = w.bodies.state[i];
+            e += 0.5 * w.bodies.mass[i] * norm2(b.velocity) + 0.5 * w.bodies.inertia[i] * b.omega * b.omega;
+        }
+    for (int i = 0; i < w.nodes.count(); ++i)
+        if (!w.bodies.removed[w.nodes.block[i]]) e += 0.5 * w.nodes.mass[i] * norm2(w.nodes.velocity[i]);
+    return e;
+}
+
+EnergyAccount raw_account(const World& w) {
+    EnergyAccount a;
+    a.work = w.clock.work, a.wave_input = wave_energy(w);
+    a.kinetic = w.clock.steps > 0 ? w.clock.kinetic : integrated_kinetic_energy(w), a.strain = strain_energy(w), a.joints = dissipated_energy(w);
+    a.damping = w.clock.damped, a.radiated = absorbed_energy(w);
+    a.error = a.work + a.wave_input - (a.kinetic + a.strain + a.joints + a.damping + a.radiated);
+    return a;
+}
+} // namespace
+
+EnergyAccount energy_account(const World& w) {
+    EnergyAccount a = raw_account(w);
+    a.error -= w.clock.energy_origin;
+    return a;
+}
+
+void start_energy_account(World& w) { w.clock.energy_origin = raw_account(w).error; }
+
 double absorbed_energy(const World& w) {
     double e = 0.0;
     for (double a : w.viscous.absorbed) e += a;

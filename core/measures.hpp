@@ -31,6 +31,21 @@ double dissipated_energy(const World& w);
 double absorbed_energy(const World& w);
 /// The work their incident waves have done so far, J/m.
 double wave_energy(const World& w);
+/// The energy account (J/m): what the loads, the prescribed velocities and the
+/// incident waves supplied, against what is stored (kinetic at the masses as
+/// integrated — scaled in the quasi-static mode —, strain in contacts and zones)
+/// and spent (the joints' plastic work, damping's, the viscous boundaries'
+/// radiation), all since the model was built; `error` is supplied − stored − spent
+/// since the current stage started (an initialize, elastic or excavate stage sets
+/// stresses or removes rock without work: the account starts again after it).
+struct EnergyAccount {
+    double work = 0.0, wave_input = 0.0, kinetic = 0.0, strain = 0.0, joints = 0.0, damping = 0.0, radiated = 0.0;
+    double error = 0.0;
+};
+EnergyAccount energy_account(const World& w);
+/// The account's origin at the start of a stage (core/stages.cpp).
+void start_energy_account(World& w);
+
 /// Cracks (broken bonds) so far, by mode; cumulative.
 int cracks(const World& w, contact::JointState mode);
 /// Total contact force on a boundary's blocks in the last step, N/m (for a

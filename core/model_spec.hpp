@@ -129,7 +129,9 @@ struct HistorySpec {
         inflow, ///< into the drained openings, m²/s per unit depth ([flow])
         absorbed_energy, ///< taken by the viscous boundaries' dashpots so far, J/m
         wave_energy,     ///< the work of their incident waves so far, J/m
-        creep_time       ///< stress corrosion's creep time so far, s (core/creep.hpp)
+        creep_time,      ///< stress corrosion's creep time so far, s (core/creep.hpp)
+        damping_energy,  ///< taken by damping so far (local and Rayleigh), J/m
+        energy_error     ///< the energy account's error since the stage started, J/m (core/measures.hpp)
     };
     std::string name;
     Quantity quantity = Quantity::unbalanced_ratio;

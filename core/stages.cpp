@@ -116,6 +116,7 @@ private:
         case StageSpec::Kind::solve:
         case StageSpec::Kind::cycle: break;
         }
+        start_energy_account(w_);
         obs_.at(s_, cursor_);
     }
 
@@ -298,6 +299,8 @@ double quantity(const World& w, const HistorySpec& h, int i) {
     case Q::absorbed_energy: return absorbed_energy(w);
     case Q::wave_energy: return wave_energy(w);
     case Q::creep_time: return w.creep ? w.creep->time : 0.0;
+    case Q::damping_energy: return w.clock.damped;
+    case Q::energy_error: return energy_account(w).error;
     }
     return 0.0;
 }

@@ -357,18 +357,24 @@ struct MassDamping {
 };
 
 inline double translate(std::uint8_t fx, Vec2& v, Vec2 f, Vec2 fixed_v, double mass, Vec2 load, double alpha, double dt,
-                        const MassDamping& md, double& unbalanced) {
+                        const MassDamping& md, double& unbalanced, double& taken, double& kinetic) {
     if (!(fx & 1)) unbalanced = std::max(unbalanced, std::abs(f.x));
     if (!(fx & 2)) unbalanced = std::max(unbalanced, std::abs(f.y));
+    const Vec2 before = v;
     v.x = (fx & 1) ? fixed_v.x : md(v.x, damped(f.x, v.x, alpha) / mass * dt);
     v.y = (fx & 2) ? fixed_v.y : md(v.y, damped(f.y, v.y, alpha) / mass * dt);
+    // The damping's work over the step at the mean velocity: F − (the force that
+    // changed the momentum) on the free components.
+    if (!(fx & 1)) taken += (f.x - mass * (v.x - before.x) / dt) * 0.5 * (v.x + before.x) * dt;
+    if (!(fx & 2)) taken += (f.y - mass * (v.y - before.y) / dt) * 0.5 * (v.y + before.y) * dt;
+    kinetic += 0.5 * mass * dot(before, v);
     double work = dot(load, v) * dt;
     if (fx & 1) work -= f.x * v.x * dt;
     if (fx & 2) work -= f.y * v.y * dt;
     return work;
 }
 
-double integrate_block(World& w, int i, double& unbalanced) {
+double integrate_block(World& w, int i, double& unbalanced, double& taken, double& kinetic) {
     if (w.bodies.removed[i] || w.blocks.deformable[i]) return 0.0;
     const double alpha = w.settings.damping, dt = w.clock.dt;
     const auto& l = w.loads;
@@ -376,22 +382,25 @@ double integrate_block(World& w, int i, double& unbalanced) {
     contact::BodyState& b = w.bodies.state[i];
     const MassDamping md(w.settings.rayleigh_alpha(), dt);
     double work = translate(fx, b.velocity, w.bodies.force[i], l.block_velocity[i], w.bodies.mass[i],
-                            l.block_force[i] + w.blocks.real_mass[i] * w.settings.gravity, alpha, dt, md, unbalanced);
-    const double m = w.bodies.moment[i];
+                            l.block_force[i] + w.blocks.real_mass[i] * w.settings.gravity, alpha, dt, md, unbalanced,
+                            taken, kinetic);
+    const double m = w.bodies.moment[i], omega = b.omega;
     b.omega = (fx & 4) ? l.block_omega[i] : md(b.omega, damped(m, b.omega, alpha) / w.bodies.inertia[i] * dt);
+    if (!(fx & 4)) taken += (m - w.bodies.inertia[i] * (b.omega - omega) / dt) * 0.5 * (b.omega + omega) * dt;
+    kinetic += 0.5 * w.bodies.inertia[i] * omega * b.omega;
     work += (l.block_moment[i] - ((fx & 4) ? m : 0.0)) * b.omega * dt;
     b.centroid += dt * b.velocity;
     b.theta += dt * b.omega;
     return work;
 }
 
-double integrate_node(World& w, int i, double& unbalanced) {
+double integrate_node(World& w, int i, double& unbalanced, double& taken, double& kinetic) {
     if (w.bodies.removed[w.nodes.block[i]]) return 0.0;
     const auto& l = w.loads;
     Vec2& v = w.nodes.velocity[i];
     const double work = translate(l.node_fixed[i], v, w.nodes.force[i], l.node_velocity[i], w.nodes.mass[i],
                                   l.node_force[i] + w.nodes.real_mass[i] * w.settings.gravity, w.settings.damping,
-                                  w.clock.dt, MassDamping(w.settings.rayleigh_alpha(), w.clock.dt), unbalanced);
+                                  w.clock.dt, MassDamping(w.settings.rayleigh_alpha(), w.clock.dt), unbalanced, taken, kinetic);
     w.nodes.position[i] += w.clock.dt * v;
     return work;
 }
@@ -402,15 +411,16 @@ void integrate_stage(World& w, const StepContext&, Range r) {
     constexpr int chunk_size = Team::sum_chunk;
     const int nb = w.bodies.count(), nn = w.nodes.count(), block_chunks = Team::chunks_of(nb);
     for (int chunk = r.first; chunk < r.last; ++chunk) {
-        double work = 0.0, unbalanced = 0.0;
+        double work = 0.0, unbalanced = 0.0, taken = 0.0, kinetic = 0.0;
         if (chunk < block_chunks) {
             for (int i = chunk * chunk_size; i < std::min(nb, (chunk + 1) * chunk_size); ++i)
-                work += integrate_block(w, i, unbalanced);
+                work += integrate_block(w, i, unbalanced, taken, kinetic);
         } else {
             const int c = chunk - block_chunks;
-            for (int i = c * chunk_size; i < std::min(nn, (c + 1) * chunk_size); ++i) work += integrate_node(w, i, unbalanced);
+            for (int i = c * chunk_size; i < std::min(nn, (c + 1) * chunk_size); ++i)
+                work += integrate_node(w, i, unbalanced, taken, kinetic);
         }
-        w.team.chunk_sums[chunk] = {work, unbalanced};
+        w.team.chunk_sums[chunk] = {work, unbalanced, taken, kinetic};
     }
 }
 Range chunk_share(const World& w, const StepContext& ctx) { return by_cost(w.team.chunk_cost_before, ctx); }
@@ -442,9 +452,17 @@ void ratio_stage(World& w, const StepContext&, Range) {
     sum_boundary_forces(w);
     double max_unbalanced = 0.0;
     const int chunks = Team::chunks_of(w.bodies.count()) + Team::chunks_of(w.nodes.count());
+    w.clock.kinetic = 0.0;
     for (int chunk = 0; chunk < chunks; ++chunk) {
         w.clock.work += w.team.chunk_sums[chunk].work;
+        w.clock.damped += w.team.chunk_sums[chunk].damped;
+        w.clock.kinetic += w.team.chunk_sums[chunk].kinetic;
         max_unbalanced = std::max(max_unbalanced, w.team.chunk_sums[chunk].unbalanced);
+    }
+    // Rayleigh's stiffness part, in the contact and zone passes' partial sums.
+    if (w.settings.rayleigh_beta() > 0.0) {
+        for (double d : w.contacts.partial_damped) w.clock.damped += d;
+        for (double d : w.zones.partial_damped) w.clock.damped += d;
     }
     const SupportMotion motion{w.clock.dt, w.settings.damping, w.settings.gravity};
     for_each_support(w.supports, [&](auto type, auto& state) {

@@ -266,6 +266,16 @@ struct Clock {
     double first_dt = 0.0; ///< the step the model started with (a collapsing step: a sliver, a runaway stiffness)
     double ratio = 0.0;    ///< unbalanced-force ratio of the last step
     double work = 0.0;     ///< of the loads and the prescribed velocities, J/m
+    /// Taken by damping so far — local, and Rayleigh's mass and stiffness parts —,
+    /// J/m (the energy account's, core/measures.hpp: saved, not hashed).
+    double damped = 0.0;
+    /// The energy account's origin: stored + spent − supplied when the current
+    /// stage started (its error is the change since; saved, not hashed).
+    double energy_origin = 0.0;
+    /// Kinetic energy at the last step's time, Σ ½ m v⁻·v⁺ of the velocities half
+    /// a step before and after it (central differences' own, in step with the
+    /// strain energy of the forces it used; saved, not hashed).
+    double kinetic = 0.0;
 };
 template <part_of<Clock> P, class V>
 void visit_fields(P& c, V&& v) {
@@ -363,7 +373,7 @@ struct Team {
     /// the gather and for placing the blocks; per chunk, for integration.
     std::vector<double> gather_cost_before, place_cost_before, chunk_cost_before;
     struct ChunkSums {
-        double work, unbalanced;
+        double work, unbalanced, damped, kinetic;
     };
     std::vector<ChunkSums> chunk_sums;
     /// Per thread, the seconds its share of the contact and zone passes took since
@@ -455,6 +465,10 @@ void for_each_field(W& w, V&& v) {
     // Seismic events (core/events.hpp): saved, not hashed (a record, not state).
     if (w.events) visit_fields(*w.events, v);
     visit_fields(w.team, v);
+    // The energy taken by damping (a measure: saved, not in the state hash).
+    v(FieldInfo{"solver.damped", MemoryGroup::other, field_use::saved}, w.clock.damped);
+    v(FieldInfo{"solver.energy_origin", MemoryGroup::other, field_use::saved}, w.clock.energy_origin);
+    v(FieldInfo{"solver.kinetic", MemoryGroup::other, field_use::saved}, w.clock.kinetic);
     // What the stage did so far, for its verdict (not physics: not in the state hash).
     v(FieldInfo{"monitor.samples", MemoryGroup::other, field_use::saved}, w.monitor.samples);
 }

@@ -32,12 +32,13 @@ void index_zone_nodes(Zones& z, int nodes) {
         for (int c = 0; c < 3; ++c) z.node_entry[fill[z.node[k][c]]++] = 3 * k + c;
     z.nodal_force.resize(z.size());
     z.partial_sum.resize((z.size() + Zones::work_item_size - 1) / Zones::work_item_size);
+    z.partial_damped.assign(z.partial_sum.size(), 0.0);
 }
 
 namespace {
 /// One zone's update: its stress from the step's velocity gradient, and the
 /// nodal forces of that stress; returns Σ|f|² over its three nodes.
-inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double dt, double beta) {
+inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double dt, double beta, double& viscous_work) {
     const auto& n = z.node[k];
     const auto g = gradients(x[n[0]], x[n[1]], x[n[2]]);
     // Velocity gradient × Δt: the step's displacement gradient.
@@ -67,6 +68,8 @@ inline double zone_update(Zones& z, int k, const Vec2* x, const Vec2* v, double 
         t[0] += b * (tr + 2.0 * e.shear * exx);
         t[1] += b * (tr + 2.0 * e.shear * eyy);
         t[2] += b * 2.0 * e.shear * exy;
+        // Its work over the step: A (β/Δt) ε:D:ε, ε the step's strain.
+        viscous_work += g.area * b * (tr * (exx + eyy) + 2.0 * e.shear * (exx * exx + eyy * eyy + 2.0 * exy * exy));
     }
     // f_i = −A σ ∇N_i = −½ σ (b_i, c_i).
     double sum = 0.0;
@@ -83,15 +86,16 @@ void zone_pass(Zones& z, const Vec2* x, const Vec2* v, double dt, const std::uin
                int last_item, double stiffness_damping) {
     const int count = z.size();
     for (int w = first_item; w < last_item; ++w) {
-        double sum = 0.0;
+        double sum = 0.0, viscous_work = 0.0;
         for (int k = w * Zones::work_item_size; k < std::min(count, (w + 1) * Zones::work_item_size); ++k) {
             if (skip[z.block[k]]) {
                 z.nodal_force[k] = {};
                 continue;
             }
-            sum += zone_update(z, k, x, v, dt, stiffness_damping);
+            sum += zone_update(z, k, x, v, dt, stiffness_damping, viscous_work);
         }
         z.partial_sum[w] = sum;
+        if (!z.partial_damped.empty()) z.partial_damped[w] = viscous_work;
     }
 }
 

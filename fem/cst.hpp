@@ -71,6 +71,7 @@ struct Zones {
     // Per-step scratch of zone_pass.
     std::vector<std::array<Vec2, 3>> nodal_force;
     std::vector<double> partial_sum;
+    std::vector<double> partial_damped; ///< per work item: Rayleigh's stiffness part's work this step, J/m
 };
 static_assert(sizeof(Elasticity) == 2 * sizeof(double)); // in the model fingerprint as raw bytes
 } // namespace bbm::fem
@@ -94,6 +95,7 @@ void visit_fields(Z& z, Visit&& v) {
     v(FieldInfo{"zones.node_entry", G::zones, R}, z.node_entry);
     v(FieldInfo{"zones.nodal_force", G::zones, R}, z.nodal_force);
     v(FieldInfo{"zones.partial_sum", G::zones, R}, z.partial_sum);
+    v(FieldInfo{"zones.partial_damped", G::zones, R}, z.partial_damped);
 }
 
 /// Builds the per-node index and sizes the scratch; `nodes` = number of FE nodes.

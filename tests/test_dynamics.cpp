@@ -354,3 +354,44 @@ syy = -1e6
     MESSAGE("first mode ", f1, " Hz: damping ratio ", measured, " (", xi, ")");
     CHECK(measured == doctest::Approx(xi).epsilon(0.03));
 }
+
+TEST_CASE("the energy account closes: a damped oscillator's damping takes what it loses, a pulse's edges what it brings") {
+    // The block on its joint released from 1 MPa: 500 J/m of strain energy, no
+    // work; damping (Rayleigh's, or local) takes it. The account starts after the
+    // initialize stage that sets the stress.
+    for (const bool rayleigh : {true, false}) {
+        std::string t = damped_oscillator(0.05, 1000.0 / (2.0 * std::numbers::pi));
+        if (!rayleigh) {
+            t.erase(t.find("rayleigh_ratio"), t.find("\n", t.find("rayleigh_frequency")) + 1 - t.find("rayleigh_ratio"));
+            t.replace(t.find("damping = 0.0"), 13, "damping = 0.1");
+        }
+        const auto m = test::build_model(t, "oscillator.toml");
+        Solver s(m.blocks, m.file.analysis);
+        StageObserver quiet;
+        run_stages(s, {m.file.analysis.stages[0]}, quiet);
+        const double e0 = strain_energy(s.world());
+        double worst = 0.0;
+        for (int k = 0; k < 2000; ++k) {
+            s.step();
+            worst = std::max(worst, std::abs(energy_account(s.world()).error));
+        }
+        const EnergyAccount a = energy_account(s.world());
+        MESSAGE(std::string(rayleigh ? "Rayleigh" : "local"), ": stored ", a.kinetic + a.strain, " of ", e0, " J/m, damping took ",
+                a.damping, ", worst error ", worst, " (", worst / e0, " of it)");
+        CHECK(a.damping > 0.5 * e0);
+        CHECK(worst < 0.01 * e0);
+    }
+    // The P pulse through the viscous base into an absorbing top: the waves'
+    // work against what the column holds and its edges radiated.
+    const auto m = test::build_model(column(true), "column.toml");
+    Solver s(m.blocks, m.file.analysis);
+    const double end = start + 1.5 * height / p_wave_speed();
+    double worst = 0.0;
+    while (s.world().clock.time < end) {
+        s.step();
+        worst = std::max(worst, std::abs(energy_account(s.world()).error));
+    }
+    const EnergyAccount a = energy_account(s.world());
+    MESSAGE("pulse: wave input ", a.wave_input, " J/m, radiated ", a.radiated, ", worst error ", worst);
+    CHECK(worst < 0.01 * a.wave_input);
+}

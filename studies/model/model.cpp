@@ -347,6 +347,15 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             if (r.failed) summary["creep"]["failed_at"] = r.creep_time;
     }
     if (w.events) summary["events"] = events_summary(*w.events);
+    {
+        // The energy account (core/measures.hpp), the last stage's error.
+        const EnergyAccount a = energy_account(w);
+        const double scale = std::max({std::abs(a.work + a.wave_input), a.kinetic + a.strain, 1e-300});
+        summary["energy_balance"] = {{"work", a.work},       {"wave_input", a.wave_input}, {"kinetic", a.kinetic},
+                                     {"strain", a.strain},   {"joints", a.joints},         {"damping", a.damping},
+                                     {"radiated", a.radiated}, {"error_in_stage", a.error},
+                                     {"relative_error", std::abs(a.error) / scale}};
+    }
     if (w.viscous.count() > 0) {
         // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
         auto& e = summary["energy"];
