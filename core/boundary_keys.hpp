@@ -18,7 +18,7 @@ using AssignmentKey = Key<JointAssignmentSpec>;
 /// A boundary's types, in the order of BoundarySpec::Kind.
 inline constexpr std::string_view boundary_type_words = "velocity, stress, viscous";
 /// An incident wave's pulses and kinds, in the order of IncidentWaveSpec's enums.
-inline constexpr std::string_view pulse_words = "none, ricker, half_sine, harmonic";
+inline constexpr std::string_view pulse_words = "none, ricker, half_sine, harmonic, file";
 inline constexpr std::string_view wave_words = "p, s";
 /// The joint tags, in the order of meshing::JointTag.
 inline constexpr std::string_view joint_tag_words = "inner, radial, peripheral, real_joint, interface, fracture";
@@ -65,17 +65,24 @@ inline constexpr BoundaryKey boundary_keys[] = {
     {.key = "pulse", .kind = KeyKind::choice, .only = "viscous",
      .meaning = "The incident wave's particle velocity at the boundary, v(t) from `start`: ricker (peak frequency "
                 "f, its peak 1.2/f after start), half_sine (one half period of sin 2πft), harmonic (sin 2πft "
-                "over `cycles` periods); sent in as the traction 2 ρ c v(t) (the dashpot takes half)",
+                "over `cycles` periods), file (a CSV record of time and particle velocity: `file`); sent in as the "
+                "traction 2 ρ c v(t) (the dashpot takes half)",
      .absent = "none: the boundary only absorbs", .words = pulse_words},
     {.key = "wave", .kind = KeyKind::choice, .only = "viscous",
      .meaning = "p: the particle velocity along the inward normal (c = c_p); s: along the edge, counter-clockwise "
                 "about the model (c = c_s)",
      .absent = "p", .words = wave_words},
+    {.key = "file", .kind = KeyKind::text, .only = "viscous",
+     .meaning = "pulse = \"file\": a CSV of rows time (s, from `start`), particle velocity (m/s), times increasing "
+                "(a header line and # comments skipped), relative to the model file; linear between rows, 0 after "
+                "the last",
+     .absent = "required with pulse = \"file\""},
     {.key = "velocity", .bounds = unbounded(" m/s"), .only = "viscous",
-     .meaning = "The incident wave's peak particle velocity", .absent = "0",
+     .meaning = "The incident wave's peak particle velocity; with a file, the factor on its velocities",
+     .absent = "0; with a file, 1",
      .set = [](BoundarySpec& s, double v) { s.incident.velocity = v; }},
     {.key = "frequency", .bounds = above(0, " Hz"), .only = "viscous", .meaning = "Of the pulse",
-     .absent = "required with a pulse", .set = [](BoundarySpec& s, double v) { s.incident.frequency = v; }},
+     .absent = "required with a named pulse (not with a file)", .set = [](BoundarySpec& s, double v) { s.incident.frequency = v; }},
     {.key = "cycles", .bounds = above(0, ""), .only = "viscous", .meaning = "harmonic: the train's length in periods",
      .absent = "1", .set = [](BoundarySpec& s, double v) { s.incident.cycles = v; }},
     {.key = "start", .bounds = at_least(0, " s"), .only = "viscous",

@@ -64,7 +64,7 @@ struct StressFieldSpec {
 /// A plane wave sent in through a viscous boundary: its particle velocity v(t) at
 /// the boundary, of a named pulse (core/viscous.hpp has their formulas).
 struct IncidentWaveSpec {
-    enum class Pulse { none, ricker, half_sine, harmonic };
+    enum class Pulse { none, ricker, half_sine, harmonic, file };
     enum class Wave { p, s }; ///< p: particle motion along the inward normal; s: along the edge
     Pulse pulse = Pulse::none;
     Wave wave = Wave::p;
@@ -72,6 +72,10 @@ struct IncidentWaveSpec {
     double frequency = 0.0; ///< Hz (Ricker: its peak frequency)
     double cycles = 1.0;    ///< harmonic: the train's length in periods
     double start = 0.0;     ///< s: when the pulse starts at the boundary
+    /// file: the record's (time since start, s; particle velocity, m/s) rows,
+    /// times increasing; linear between rows, 0 outside them. Times `velocity`.
+    std::vector<std::pair<double, double>> record;
+    std::string record_file; ///< where it was read from (messages)
 };
 
 struct BoundarySpec {

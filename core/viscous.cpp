@@ -20,6 +20,16 @@ double incident_velocity(const IncidentWaveSpec& wave, double t) {
     }
     case Pulse::half_sine: return tau <= 0.5 / f ? wave.velocity * std::sin(2.0 * pi * f * tau) : 0.0;
     case Pulse::harmonic: return tau <= wave.cycles / f ? wave.velocity * std::sin(2.0 * pi * f * tau) : 0.0;
+    case Pulse::file: {
+        const auto& r = wave.record;
+        if (r.empty() || tau < r.front().first || tau > r.back().first) return 0.0;
+        const auto after = std::upper_bound(r.begin(), r.end(), tau,
+                                            [](double x, const std::pair<double, double>& row) { return x < row.first; });
+        if (after == r.end()) return wave.velocity * r.back().second;
+        const auto before = after - 1;
+        const double s = (tau - before->first) / (after->first - before->first);
+        return wave.velocity * ((1.0 - s) * before->second + s * after->second);
+    }
     case Pulse::none: break;
     }
     return 0.0;

@@ -492,8 +492,53 @@ JointAssignmentSpec read_joint_assignment(Ctx& c, const toml::table& t, const Pa
     return a;
 }
 
+/// An incident wave's record: rows time, particle velocity (CSV; a header line,
+/// blank lines and # comments skipped), times increasing, at least two rows.
+std::vector<std::pair<double, double>> read_pulse_record(const Ctx& c, const toml::node& n, const Path& p,
+                                                         const std::string& path) {
+    std::ifstream in(path);
+    if (!in) c.fail(n, p, "cannot open the pulse record " + path);
+    std::vector<std::pair<double, double>> rows;
+    std::string text;
+    int line_no = 0;
+    bool header_allowed = true;
+    while (std::getline(in, text)) {
+        ++line_no;
+        if (!text.empty() && text.back() == '\r') text.pop_back();
+        const auto first = text.find_first_not_of(" \t");
+        if (first == std::string::npos || text[first] == '#') continue;
+        const auto comma = text.find(',');
+        double v[2] = {0.0, 0.0};
+        bool numeric = comma != std::string::npos && text.find(',', comma + 1) == std::string::npos;
+        for (int k = 0; numeric && k < 2; ++k) {
+            const std::string cell = k == 0 ? text.substr(0, comma) : text.substr(comma + 1);
+            const auto a = cell.find_first_not_of(" \t"), b = cell.find_last_not_of(" \t");
+            const std::string trimmed = a == std::string::npos ? "" : cell.substr(a, b - a + 1);
+            const auto [end, ec] = std::from_chars(trimmed.data(), trimmed.data() + trimmed.size(), v[k]);
+            numeric = ec == std::errc() && end == trimmed.data() + trimmed.size() && !trimmed.empty() && std::isfinite(v[k]);
+        }
+        if (!numeric && header_allowed) {
+            header_allowed = false;
+            continue;
+        }
+        header_allowed = false;
+        if (!numeric)
+            throw InputError(path, line_no, p.full, "expected time (s), particle velocity (m/s), got \"" + text + "\"");
+        if (v[0] < 0.0)
+            throw InputError(path, line_no, p.full, "a time before the pulse's start (" + shortest_text(v[0]) +
+                                                        " s): times are from `start`");
+        if (!rows.empty() && !(v[0] > rows.back().first))
+            throw InputError(path, line_no, p.full,
+                             "time " + shortest_text(v[0]) + " s does not come after the row before's " +
+                                 shortest_text(rows.back().first) + " s: a record's times go forward");
+        rows.emplace_back(v[0], v[1]);
+    }
+    if (rows.size() < 2) c.fail(n, p, "the pulse record " + path + " has fewer than two rows of time, velocity");
+    return rows;
+}
+
 /// A viscous boundary's incident wave: its pulse, kind and the numbers of its
-/// formula (a frequency with every pulse).
+/// formula (a frequency with every named pulse; a record with a file).
 void read_incident_wave(const Ctx& c, const toml::table& t, const Path& p, BoundarySpec& b) {
     using Wave = IncidentWaveSpec;
     for (const BoundaryKey& k : boundary_keys)
@@ -504,7 +549,24 @@ void read_incident_wave(const Ctx& c, const toml::table& t, const Path& p, Bound
     if (t.contains("wave"))
         b.incident.wave =
             static_cast<Wave::Wave>(choice(c, t, p, "wave", key_words(find_key(boundary_keys, "wave")->words), "wave"));
-    const bool pulse = b.incident.pulse != Wave::Pulse::none;
+    const bool pulse = b.incident.pulse != Wave::Pulse::none, recorded = b.incident.pulse == Wave::Pulse::file;
+    if (recorded) {
+        if (!t.contains("file")) c.fail(t, p, c.in_owner() + "pulse = \"file\" needs its record (file = \"...csv\")");
+        for (const char* key : {"frequency", "cycles"})
+            if (const toml::node* n = t.get(key))
+                c.fail(*n, p.key(key), c.in_owner() + "'" + key + "' is a named pulse's: a record has its own times");
+        const toml::node& f = *find(c, t, p, "file");
+        b.incident.record_file = to_str(c, f, p.key("file"));
+        // Relative to the model file's folder (as a DFN's traces are).
+        const std::size_t slash = c.file.find_last_of('/');
+        const std::string& name = b.incident.record_file;
+        const std::string path = name.starts_with('/') || slash == std::string::npos ? name : c.file.substr(0, slash + 1) + name;
+        b.incident.record = read_pulse_record(c, f, p.key("file"), path);
+        if (!t.contains("velocity")) b.incident.velocity = 1.0;
+        return;
+    }
+    if (const toml::node* n = t.get("file"))
+        c.fail(*n, p.key("file"), c.in_owner() + "'file' is a recorded pulse's: give pulse = \"file\"");
     if (pulse && !t.contains("frequency"))
         c.fail(t, p, c.in_owner() + "a pulse needs its frequency (Hz)");
     if (pulse && !t.contains("velocity"))

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <numbers>
@@ -100,8 +101,8 @@ struct Record {
     double base_absorbed_in_transit = 0.0;
 };
 
-Record send_pulse(bool absorbing_top) {
-    const auto m = test::build_model(column(absorbing_top), "column.toml");
+Record send_pulse(const std::string& text, const std::string& name) {
+    const auto m = test::build_model(text, name);
     Solver s(m.blocks, m.file.analysis);
     World& w = s.world();
     const int mid = node_near(w, {0.5, 20.0}), top = node_near(w, {0.5, height});
@@ -131,6 +132,8 @@ Record send_pulse(bool absorbing_top) {
     }
     return r;
 }
+
+Record send_pulse(bool absorbing_top) { return send_pulse(column(absorbing_top), "column.toml"); }
 
 } // namespace
 
@@ -394,4 +397,48 @@ TEST_CASE("the energy account closes: a damped oscillator's damping takes what i
     const EnergyAccount a = energy_account(s.world());
     MESSAGE("pulse: wave input ", a.wave_input, " J/m, radiated ", a.radiated, ", worst error ", worst);
     CHECK(worst < 0.01 * a.wave_input);
+}
+
+TEST_CASE("a pulse read from a CSV record is the named pulse it samples; a record whose times go back is refused") {
+    // The half-sine of the column's base, written as 201 rows of time and velocity.
+    const auto dir = std::filesystem::temp_directory_path() / "bbm_pulse_record";
+    std::filesystem::create_directories(dir);
+    {
+        std::ofstream csv(dir / "half_sine.csv");
+        csv << "time_s,velocity_m_per_s\n";
+        for (int k = 0; k <= 200; ++k) {
+            const double t = 0.5 / frequency * k / 200.0;
+            csv << t << ',' << v_in * std::sin(2.0 * std::numbers::pi * frequency * t) << '\n';
+        }
+    }
+    std::string text = column(true);
+    const std::size_t from = text.find("pulse = \"half_sine\"");
+    text.replace(from, text.find("start = 1e-3", from) - from, "pulse = \"file\"\nfile = \"half_sine.csv\"\n");
+    const Record named = send_pulse(true), recorded = send_pulse(text, (dir / "column.toml").string());
+    MESSAGE("peak velocity half-way up: named ", named.peak_mid, " m/s, recorded ", recorded.peak_mid,
+            "; wave input ", named.supplied, " and ", recorded.supplied, " J/m");
+    CHECK(recorded.peak_mid == doctest::Approx(named.peak_mid).epsilon(0.005));
+    CHECK(recorded.supplied == doctest::Approx(named.supplied).epsilon(0.005));
+    // Bad records: a time that goes back, a lone row; a frequency with a record.
+    {
+        std::ofstream csv(dir / "back.csv");
+        csv << "0,0\n0.001,0.1\n0.0005,0.05\n";
+    }
+    auto error = [&](const std::string& t) -> std::string {
+        try {
+            test::build_model(t, (dir / "column.toml").string());
+        } catch (const InputError& e) {
+            return e.file() + ":" + std::to_string(e.line()) + ": " + e.key() + ": " + e.what();
+        }
+        return "accepted";
+    };
+    std::string back = text;
+    back.replace(back.find("half_sine.csv"), 13, "back.csv");
+    const std::string said = error(back);
+    MESSAGE(said);
+    CHECK(said.find("back.csv:3") != std::string::npos);
+    CHECK(said.find("go forward") != std::string::npos);
+    std::string with_frequency = text;
+    with_frequency.replace(with_frequency.find("file = \"half_sine.csv\""), 22, "file = \"half_sine.csv\"\nfrequency = 200.0");
+    CHECK(error(with_frequency).find("boundary[2].frequency") != std::string::npos);
 }
