@@ -269,6 +269,9 @@ void add_loading_options(CLI::App* sub, LabTestOptions& o) {
         ->check(positive())->capture_default_str();
     sub->add_option("--servo-post-peak", o.servo.post_peak_factor, "Servo: platen speed after failure, times --strain-rate")
         ->check(positive())->capture_default_str();
+    sub->add_flag("--events", o.events,
+                  "Record seismic events from breaking bonds (acoustic emission): the events column of "
+                  "stress_strain.csv, summary.json's events (count, b-value, sigma_ci from events); slower");
     sub->add_option("--preload", o.elastic_preload,
                     "The linear part by one implicit solve, up to just below the first joint's yield")
         ->capture_default_str();

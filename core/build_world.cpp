@@ -573,6 +573,12 @@ void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAsse
 World build_world(const meshing::BlockAssembly& a, const AnalysisSpec& an) {
     World w;
     w.settings = an.solver;
+    // The energy account where it is asked for or a dynamic run reports it.
+    w.settings.energy_account = w.settings.energy_account || w.settings.mode == SolverSpec::Mode::dynamic ||
+                                std::ranges::any_of(an.histories, [](const HistorySpec& h) {
+                                    return h.quantity == HistorySpec::Quantity::damping_energy ||
+                                           h.quantity == HistorySpec::Quantity::energy_error;
+                                });
     w.region_names = a.region_names;
     const RegionMaterials materials = region_materials(w.region_names, an);
     build_blocks(w, a, materials);

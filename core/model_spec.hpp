@@ -120,6 +120,10 @@ struct SolverSpec {
     double rayleigh_beta() const {
         return rayleigh_frequency > 0.0 ? rayleigh_ratio / (2.0 * 3.141592653589793 * rayleigh_frequency) : 0.0;
     }
+    /// Keep the energy account's damping and kinetic terms (core/measures.hpp):
+    /// on in the dynamic mode and where a history asks for them; a quasi-static
+    /// run asks with this key (integration costs more with it).
+    bool energy_account = false;
     int output_every = 0;             ///< steps between VTK outputs; 0 = at stage ends only
     int history_every = 10;           ///< steps between history rows
     int threads = 1;                  ///< threads of the contact loop (from the command line)

@@ -35,6 +35,11 @@ inline constexpr SolverKey solver_keys[] = {
      .meaning = "Rayleigh damping's centre frequency (with rayleigh_ratio), e.g. the model's fundamental or the "
                 "input's dominant frequency",
      .absent = "none", BBM_KEY_FIELD(SolverSpec, rayleigh_frequency)},
+    {.key = "energy_account", .kind = KeyKind::boolean,
+     .meaning = "Keep the energy account's damping work and kinetic energy every step (summary.json energy_balance, "
+                "history damping_energy and energy_error; docs/theory.md §19.1)",
+     .absent = "true in the dynamic mode or with a damping_energy or energy_error history; false otherwise",
+     BBM_KEY_FIELD(SolverSpec, energy_account)},
     {.key = "safety", .bounds = {.lo = 0, .hi = 1, .lo_open = true}, .meaning = "Time step over the critical time step",
      .absent = "0.5", BBM_KEY_FIELD(SolverSpec, safety)},
     {.key = "timestep", .bounds = at_least(0, " s"),

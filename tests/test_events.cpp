@@ -188,7 +188,7 @@ TEST_CASE("a lab specimen's events hold every broken bond, on 1 and 2 threads an
     // The paper's UCS specimen (2 x 4 m) at a constant platen rate: cracking from
     // about step 4,500, the peak near 9,800, failure after (tests/test_restart.cpp).
     auto o = LabTestOptions::paper_ucs();
-    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7;
+    o.width = 2.0, o.height = 4.0, o.strain_per_step = 2e-7, o.events = true;
     test::RestartModel m = test::labtest_model(o, 11000);
     m.analysis.solver.threads = 1;
     Solver one(m.blocks, m.analysis);

@@ -213,7 +213,7 @@ AnalysisSpec labtest_analysis(const LabTestOptions& o) {
     an.solver.mode = SolverSpec::Mode::quasi_static;
     an.solver.damping = 0.8;
     an.solver.threads = o.threads;
-    an.events.on = true; // the test's acoustic emission (core/events.hpp)
+    an.events.on = o.events; // the test's acoustic emission (core/events.hpp)
     return an;
 }
 

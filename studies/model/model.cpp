@@ -347,7 +347,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
             if (r.failed) summary["creep"]["failed_at"] = r.creep_time;
     }
     if (w.events) summary["events"] = events_summary(*w.events);
-    {
+    if (w.settings.energy_account) {
         // The energy account (core/measures.hpp), the last stage's error.
         const EnergyAccount a = energy_account(w);
         const double scale = std::max({std::abs(a.work + a.wave_input), a.kinetic + a.strain, 1e-300});
