@@ -133,8 +133,11 @@ void take_failure(World& w, int i) {
 void follow_open_events(World& w) {
     Events& ev = *w.events;
     const int n = ev.open_count();
-    std::vector<Tensor> sum(std::size_t(n), Tensor{});
-    std::vector<double> energy(std::size_t(n), 0.0);
+    // Scratch kept in the part: it grows with the open events, not every step.
+    auto& sum = ev.scratch_moment;
+    auto& energy = ev.scratch_kinetic;
+    sum.assign(std::size_t(n), Tensor{});
+    energy.assign(std::size_t(n), 0.0);
     for (std::size_t k = 0; k < ev.member_block.size(); ++k) {
         const int e = ev.member_event[k], b = ev.member_block[k];
         const Tensor m = first_moment(w, b);
@@ -187,7 +190,8 @@ void close_events(World& w) {
     Events& ev = *w.events;
     const long step = w.clock.steps;
     const int n = ev.open_count();
-    std::vector<int> renumber(std::size_t(n), 0);
+    auto& renumber = ev.scratch_renumber;
+    renumber.assign(std::size_t(n), 0);
     int kept = 0, closed = 0;
     for (int e = 0; e < n; ++e) {
         const long quiet = step - ev.open_last[e];

@@ -99,6 +99,12 @@ struct Events {
     std::vector<int> bonds, tensile_bonds;
     std::vector<double> energy, fracture_energy; ///< J/m
 
+    // The row's scratch (rebuilt): sized as the open events grow, so a step allocates
+    // only when there are more of them than ever before.
+    std::vector<std::array<double, 3>> scratch_moment;
+    std::vector<double> scratch_kinetic;
+    std::vector<int> scratch_renumber;
+
     int count() const { return int(time.size()); }
     int open_count() const { return int(open_step.size()); }
 };
@@ -146,6 +152,10 @@ void visit_fields(P& e, V&& v) {
     v(FieldInfo{"events.tensile_bonds", G::other, S}, e.tensile_bonds);
     v(FieldInfo{"events.energy", G::other, S}, e.energy);
     v(FieldInfo{"events.fracture_energy", G::other, S}, e.fracture_energy);
+    constexpr unsigned R = field_use::rebuilt;
+    v(FieldInfo{"events.scratch_moment", G::other, R}, e.scratch_moment);
+    v(FieldInfo{"events.scratch_kinetic", G::other, R}, e.scratch_kinetic);
+    v(FieldInfo{"events.scratch_renumber", G::other, R}, e.scratch_renumber);
 }
 
 struct World;
