@@ -174,6 +174,7 @@ struct StageSpec {
     Until until = Until::ratio;
     long quiet_steps = 2000;
     long steps = 0;                    ///< cycle; excavate: steps run in the stage (<= relax_steps); pressurise: ramp
+    double time = 0.0;                 ///< cycle, dynamic mode: the model time it runs instead (s)
     std::vector<std::string> regions;  ///< excavate
     long relax_steps = 0;              ///< excavate: support relaxed to zero over these steps
     double keep = 0.0;                 ///< excavate: fraction of the support kept for good (a support pressure)

@@ -90,9 +90,12 @@ inline constexpr StageKey stage_keys[] = {
      .absent = "0"},
     {.key = "steps", .kind = KeyKind::integer, .bounds = at_least(0, " steps"), .only = "excavate, cycle, pressurise",
      .meaning = "excavate: steps run in this stage, at most relax_steps (fewer stop part-way through the relaxation, "
-                "to install support there); cycle (required, ≥ 1): run exactly this many steps; pressurise: the "
+                "to install support there); cycle (≥ 1; or its time): run exactly this many steps; pressurise: the "
                 "ramp's steps (0: at once; under steady flow the water is solved at every step of it)",
      .absent = "excavate: relax_steps; pressurise: 0"},
+    {.key = "time", .bounds = {.lo = 0, .hi = 1e4, .lo_open = true, .unit = " s"}, .only = "cycle",
+     .meaning = "cycle, [solver] mode = \"dynamic\" only: the model time the stage runs, instead of steps (one or "
+                "the other); it ends on its energy, settled or still moving (theory.md §19.2)"},
     {.key = "supports", .kind = KeyKind::names, .required = true, .only = "install",
      .meaning = "Names of support sets (the tables of any registered support type), not empty, no repeats: put in "
                 "place, tied to the rock where it is now and unstressed (theory.md §13); a bar's ends must lie in rock"},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 namespace bbm {
@@ -128,7 +129,7 @@ private:
             r_.converged = w_.clock.ratio <= st_.ratio;
             break;
         case StageSpec::Kind::excavate: run_steps(st_.steps, false); break;
-        case StageSpec::Kind::cycle: run_steps(st_.steps, false); break;
+        case StageSpec::Kind::cycle: run_steps(st_.time > 0.0 ? std::numeric_limits<long>::max() : st_.steps, false); break;
         case StageSpec::Kind::pressurise: run_steps(st_.steps, false); break;
         case StageSpec::Kind::creep: {
             const long creep_steps = w_.creep->steps;
@@ -205,14 +206,25 @@ private:
             if (judged_ && w_.clock.steps % StageMonitor::sample_every == 0) sample_monitor(w_.monitor, w_);
             obs_.step_done(s_, st_, k);
             obs_.at(s_, cursor_);
-            if (obs_.stop_requested() || (solve && solved(k))) return;
+            if (obs_.stop_requested() || (solve && solved(k)) || time_reached()) return;
         }
     }
 
-    /// The stage's verdict, from a last sample at its end.
+    /// A cycle stage given in model time has run it (to within a part in 10⁹ of a
+    /// step: the clock's sum of steps is not exact).
+    bool time_reached() const {
+        return st_.time > 0.0 && w_.clock.time >= stage_start_time(w_.monitor) + st_.time - 1e-9 * w_.clock.dt;
+    }
+
+    /// The stage's verdict, from a last sample at its end: a dynamic cycle's on
+    /// its energy, the others' on their unbalanced force.
     void judge() {
         const auto& samples = w_.monitor.samples;
         if (samples.empty() || samples.back().step != w_.clock.steps) sample_monitor(w_.monitor, w_);
+        if (st_.kind == StageSpec::Kind::cycle && w_.settings.mode == SolverSpec::Mode::dynamic) {
+            r_.verdict = judge_dynamic(w_.monitor.samples);
+            return;
+        }
         const bool own_ratio = st_.kind == StageSpec::Kind::solve || st_.kind == StageSpec::Kind::creep;
         r_.verdict = verdict(w_.monitor, own_ratio ? st_.ratio : StageSpec{}.ratio);
     }

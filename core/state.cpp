@@ -23,9 +23,10 @@ namespace {
 // opening's pressure scale (a pressurise stage); A an excavation's support path;
 // B the same fields, with a fingerprint of every parameter of every property
 // and support set (A's hashed only the stiffnesses); C the yielding bolts' and the
-// viscous boundaries' fields.
+// viscous boundaries' fields; D the monitor's samples with their model time (a
+// dynamic stage's verdict and its end in time).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = 'C';
+constexpr std::uint64_t format = 'D';
 constexpr std::uint64_t magic = magic_base | format;
 
 /// FNV-1a, 64 bits.

@@ -72,6 +72,7 @@ void sample_monitor(StageMonitor& monitor, const World& w) {
     const auto& fixed = w.loads.block_fixed;
     MonitorSample m;
     m.step = w.clock.steps;
+    m.time = w.clock.time;
     m.cracks = cracks(w, contact::JointState::broken_tension) + cracks(w, contact::JointState::broken_shear);
     m.ratio = w.clock.ratio;
     m.fragments = fragments.groups, m.fragment_blocks = fragments.blocks, m.fragment_mass = fragments.mass;
@@ -126,11 +127,15 @@ double mean_speed(const std::vector<MonitorSample>& v, std::size_t from, std::si
 
 } // namespace
 
-Verdict judge(const std::vector<MonitorSample>& samples, double target) {
+namespace {
+
+/// What a verdict is read from: the window's cracks, the last sample's ratios,
+/// fragments and speed, the kinetic energy's trend over the window; and whether
+/// the rock's fastest body sped up through each of the window's four quarters (a
+/// collapse accelerates through all four; a burst of cracks rises and falls).
+Verdict evidence(const std::vector<MonitorSample>& samples, double target, bool& rising) {
     Verdict v;
     v.target_ratio = target;
-    // Fewer than 5 samples (500 steps) say nothing about a trend.
-    if (samples.size() < 5) return v;
     const auto& last = samples.back();
     v.window_steps = window_of(samples);
     const std::size_t begin = first_from(samples, last.step - v.window_steps);
@@ -140,12 +145,11 @@ Verdict judge(const std::vector<MonitorSample>& samples, double target) {
     v.ratio = last.ratio, v.rock_ratio = last.rock_ratio;
     v.fragments = last.fragments, v.fragment_blocks = last.fragment_blocks, v.fragment_mass = last.fragment_mass;
     v.rock_speed = 1000.0 * last.rock_speed;
+    v.model_time = last.time;
     const double ke_first = first.rock_kinetic;
     v.kinetic_trend = ke_first > 0.0 ? last.rock_kinetic / ke_first : (last.rock_kinetic > 0.0 ? INFINITY : 1.0);
-    // The rock's fastest body, averaged over each quarter of the window: a
-    // collapse accelerates through all four; a burst of cracks rises and falls.
     double quarter[4];
-    bool rising = true;
+    rising = true;
     for (int q = 0; q < 4; ++q) {
         const std::size_t from = first_from(samples, last.step - v.window_steps + q * v.window_steps / 4);
         const std::size_t to = q == 3 ? samples.size() : first_from(samples, last.step - v.window_steps + (q + 1) * v.window_steps / 4);
@@ -153,12 +157,53 @@ Verdict judge(const std::vector<MonitorSample>& samples, double target) {
         if (q > 0 && !(quarter[q] > quarter[q - 1])) rising = false;
     }
     v.speed_trend = quarter[0] > 0.0 ? quarter[3] / quarter[0] : (quarter[3] > 0.0 ? INFINITY : 1.0);
+    return v;
+}
+
+/// The rock accelerating: its fastest body faster in each quarter of the window,
+/// by 10% or more in all, and its kinetic energy rising.
+bool collapsing(const Verdict& v, bool rising) { return rising && v.speed_trend > 1.1 && v.kinetic_trend > 1.0; }
+
+} // namespace
+
+Verdict judge(const std::vector<MonitorSample>& samples, double target) {
+    // Fewer than 5 samples (500 steps) say nothing about a trend.
+    if (samples.size() < 5) {
+        Verdict none;
+        none.target_ratio = target;
+        return none;
+    }
+    bool rising = false;
+    Verdict v = evidence(samples, target, rising);
+    const auto& last = samples.back();
     using K = Verdict::Kind;
     if (v.cracks_in_window == 0 && last.ratio <= target) v.kind = K::equilibrium;
     else if (v.cracks_in_window == 0 && last.fragments > 0 && last.rock_ratio <= target) v.kind = K::equilibrium_with_fragments;
-    else if (rising && v.speed_trend > 1.1 && v.kinetic_trend > 1.0) v.kind = K::collapsing;
+    else if (collapsing(v, rising)) v.kind = K::collapsing;
     else if (v.cracks_in_window > 0) v.kind = K::failing;
     else v.kind = K::not_converged;
+    return v;
+}
+
+Verdict judge_dynamic(const std::vector<MonitorSample>& samples) {
+    if (samples.size() < 5) return Verdict{};
+    bool rising = false;
+    Verdict v = evidence(samples, 0.0, rising);
+    // The window's largest kinetic energy: a ringing body passes through none twice
+    // a period.
+    double peak = 0.0, in_window = 0.0;
+    for (const auto& m : samples) peak = std::max(peak, m.rock_kinetic);
+    for (std::size_t k = first_from(samples, samples.back().step - v.window_steps); k < samples.size(); ++k)
+        in_window = std::max(in_window, samples[k].rock_kinetic);
+    v.kinetic_fraction = peak > 0.0 ? in_window / peak : 0.0;
+    using K = Verdict::Kind;
+    if (v.cracks_in_window == 0 && v.kinetic_fraction <= settled_kinetic_fraction) v.kind = K::settled;
+    // A wave in transit keeps its kinetic energy and may speed up where it
+    // reflects: a dynamic collapse gains energy too (a block sliding under gravity
+    // 78% over the stage's last quarter).
+    else if (collapsing(v, rising) && v.kinetic_trend > 1.1) v.kind = K::collapsing;
+    else if (v.cracks_in_window > 0) v.kind = K::failing;
+    else v.kind = K::moving;
     return v;
 }
 
@@ -179,6 +224,8 @@ const char* to_string(Verdict::Kind k) {
     case Verdict::Kind::not_converged: return "not converged";
     case Verdict::Kind::failing: return "failing";
     case Verdict::Kind::collapsing: return "collapsing";
+    case Verdict::Kind::settled: return "settled";
+    case Verdict::Kind::moving: return "moving";
     }
     return "?";
 }
@@ -186,6 +233,14 @@ const char* to_string(Verdict::Kind k) {
 std::string describe(const Verdict& v) {
     if (v.kind == Verdict::Kind::none) return "too short to judge";
     char line[512];
+    if (v.kind == Verdict::Kind::settled || v.kind == Verdict::Kind::moving) {
+        std::snprintf(line, sizeof line,
+                      "%s: at %.4g s, the rock's kinetic energy %.3g%% of its peak in the stage, %ld cracks in the last "
+                      "%ld steps, fastest rock %.3g mm per 1000 steps",
+                      to_string(v.kind), v.model_time, 100.0 * v.kinetic_fraction, v.cracks_in_window, v.window_steps,
+                      1000.0 * v.rock_speed);
+        return line;
+    }
     int n = std::snprintf(line, sizeof line, "%s: %ld cracks in the last %ld steps (%.2f per 1000), ratio %.2e",
                           to_string(v.kind), v.cracks_in_window, v.window_steps, v.crack_rate, v.ratio);
     if (v.fragments > 0)

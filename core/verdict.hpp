@@ -22,6 +22,16 @@
 //                               the last quarter of its run; a burst of cracks rises and falls);
 //   failing                     cracks still forming in the window;
 //   not converged               no crack and no acceleration, but the rock's ratio above target.
+// A dynamic run (real masses, real time: a wave, a burst) is not judged on its
+// unbalanced force, which a wave in transit keeps high. A cycle stage of the
+// dynamic mode runs its steps or its model time and ends on what its energy did
+// (judge_dynamic), in this order:
+//   settled                     no crack in the window and the rock's kinetic energy in it below
+//                               1% of its peak in the stage: the wave has passed, the ejecta stopped;
+//   collapsing, failing         as above (collapsing: the kinetic energy up 10% over the window too);
+//   moving                      no crack, but kinetic energy above 1% of the peak: the time was
+//                               reached with the rock still ringing (run longer, or absorb the
+//                               waves: viscous boundaries).
 // The samples are part of the solver's checkpoint, so a resumed run gives the
 // verdict the uninterrupted one gives.
 #pragma once
@@ -47,8 +57,9 @@ struct MonitorSample {
     int fragments = 0;          ///< groups of bodies detached from the rock mass
     int fragment_blocks = 0;    ///< bodies in them
     double fragment_mass = 0;   ///< their mass, kg/m
+    double time = 0;            ///< model time, s (a dynamic stage's start and end)
 };
-static_assert(sizeof(MonitorSample) == 64); // no padding: saved raw in checkpoints
+static_assert(sizeof(MonitorSample) == 72); // no padding: saved raw in checkpoints
 template <>
 struct ElementTraits<MonitorSample> : PackedRecordTraits<MonitorSample> {};
 
@@ -63,7 +74,9 @@ Fragments find_fragments(const World& w);
 
 /// Trivially copyable without padding (written raw into checkpoints).
 struct Verdict {
-    enum class Kind : std::int64_t { none, equilibrium, equilibrium_with_fragments, not_converged, failing, collapsing };
+    enum class Kind : std::int64_t {
+        none, equilibrium, equilibrium_with_fragments, not_converged, failing, collapsing, settled, moving
+    };
     Kind kind = Kind::none; ///< none: the stage had too few samples to judge
     long window_steps = 0;  ///< the window the evidence is taken over
     long cracks_in_window = 0;
@@ -74,17 +87,28 @@ struct Verdict {
     double rock_speed = 0;          ///< fastest rock body at the end, m per 1,000 steps
     int fragments = 0, fragment_blocks = 0;
     double fragment_mass = 0;       ///< kg/m
+    /// Dynamic (judge_dynamic): the model time at the end, s, and the rock's largest
+    /// kinetic energy in the window over its peak in the stage.
+    double model_time = 0, kinetic_fraction = 0;
     /// Rock at rest: equilibrium, with fragments or not.
-    bool at_rest() const { return kind == Kind::equilibrium || kind == Kind::equilibrium_with_fragments; }
-    bool valid() const { return kind >= Kind::none && kind <= Kind::collapsing; }
+    bool at_rest() const {
+        return kind == Kind::equilibrium || kind == Kind::equilibrium_with_fragments || kind == Kind::settled;
+    }
+    bool valid() const { return kind >= Kind::none && kind <= Kind::moving; }
 };
-static_assert(sizeof(Verdict) == 96);
+static_assert(sizeof(Verdict) == 112);
 const char* to_string(Verdict::Kind k);
 /// One line of evidence, e.g. "failing: 42 cracks in the last 5000 steps (8.4 per 1000), ...".
 std::string describe(const Verdict& v);
 
 /// The verdict over the window ending at the last sample (samples in step order).
 Verdict judge(const std::vector<MonitorSample>& samples, double target_ratio);
+/// A dynamic stage's verdict over the same window: settled, collapsing, failing
+/// or moving (the stage's samples from its start: its kinetic energy's peak).
+Verdict judge_dynamic(const std::vector<MonitorSample>& samples);
+/// The share of its peak the rock's kinetic energy falls to where a dynamic
+/// stage has settled.
+inline constexpr double settled_kinetic_fraction = 0.01;
 
 /// What the current stage did so far: its samples (part of the world: a
 /// checkpoint saves them, so a resumed run gives the verdict the uninterrupted
@@ -100,6 +124,8 @@ inline void start_stage(StageMonitor& m) { m.samples.clear(); }
 void sample_monitor(StageMonitor& m, const World& w);
 /// The verdict over the window ending at the last sample.
 inline Verdict verdict(const StageMonitor& m, double target_ratio) { return judge(m.samples, target_ratio); }
+/// The model time the current stage started at (its first sample's).
+inline double stage_start_time(const StageMonitor& m) { return m.samples.empty() ? 0.0 : m.samples.front().time; }
 /// At rest now: no crack over the last `quiet_steps` and the rock's ratio at
 /// the target (a stage asked to stop at its verdict stops here).
 bool at_rest(const StageMonitor& m, double target_ratio, long quiet_steps);

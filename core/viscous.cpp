@@ -35,6 +35,19 @@ double incident_velocity(const IncidentWaveSpec& wave, double t) {
     return 0.0;
 }
 
+double incident_end(const IncidentWaveSpec& wave) {
+    using Pulse = IncidentWaveSpec::Pulse;
+    const double f = wave.frequency;
+    switch (wave.pulse) {
+    case Pulse::ricker: return wave.start + 2.4 / f;
+    case Pulse::half_sine: return wave.start + 0.5 / f;
+    case Pulse::harmonic: return wave.start + wave.cycles / f;
+    case Pulse::file: return wave.start + (wave.record.empty() ? 0.0 : wave.record.back().first);
+    case Pulse::none: break;
+    }
+    return 0.0;
+}
+
 void add_dashpot(ViscousBoundaries& b, int boundary, int node, double length, Vec2 n, double density,
                  double p_modulus, double shear_modulus) {
     const double cp = std::sqrt(p_modulus / density), cs = std::sqrt(shear_modulus / density);

@@ -40,6 +40,10 @@ namespace bbm {
 
 /// The particle velocity of an incident wave at its boundary at time t (m/s).
 double incident_velocity(const IncidentWaveSpec& wave, double t);
+/// When the incident wave has passed its boundary (s): its start plus its length
+/// (a Ricker wavelet's 2.4/f, its peak in the middle; a half-sine's 1/(2f); a
+/// train's cycles/f; a record's last time). 0 without a pulse.
+double incident_end(const IncidentWaveSpec& wave);
 
 /// The model's viscous boundaries: one dashpot entry per (node, edge stretch), in
 /// node order; per boundary its incident wave and its energy account.

@@ -18,6 +18,7 @@
 #include "core/solver_keys.hpp"
 
 #include "core/verdict.hpp"
+#include "core/viscous.hpp"
 #include "meshing/model_keys.hpp"
 #include "meshing/region_keys.hpp"
 
@@ -781,6 +782,42 @@ void check_flow_needs(const Ctx& c, const ModelFile& mf) {
     }
 }
 
+/// What a dynamic run's time needs: a cycle stage given in model time the dynamic
+/// mode; a pulse no longer than the run, where the run's model time is known when
+/// it is read (every stage that steps given in time, or a fixed time step).
+void check_dynamic_needs(const Ctx& c, const ModelFile& mf) {
+    const AnalysisSpec& an = mf.analysis;
+    const bool dynamic = an.solver.mode == SolverSpec::Mode::dynamic;
+    double run_time = 0.0;
+    bool known = true;
+    for (std::size_t i = 0; i < an.stages.size(); ++i) {
+        const StageSpec& st = an.stages[i];
+        const Path tp = Path{}.key("stage").at(i).key("time");
+        if (st.time > 0.0 && !dynamic)
+            c.fail(mf.source.line_of(tp.full), tp,
+                   "a stage in model time needs [solver] mode = \"dynamic\": a quasi-static run's time is not real "
+                   "time (give steps)");
+        using K = StageSpec::Kind;
+        if (st.time > 0.0) run_time += st.time;
+        else if (an.solver.timestep > 0.0 && (st.kind == K::cycle || st.kind == K::excavate || st.kind == K::pressurise))
+            run_time += double(st.steps) * an.solver.timestep;
+        else if (st.kind == K::cycle || st.kind == K::excavate || st.kind == K::pressurise || st.kind == K::solve)
+            known = false;
+    }
+    if (!dynamic || !known || an.stages.empty()) return;
+    for (std::size_t i = 0; i < an.boundaries.size(); ++i) {
+        const IncidentWaveSpec& wave = an.boundaries[i].incident;
+        if (an.boundaries[i].kind != BoundarySpec::Kind::viscous || wave.pulse == IncidentWaveSpec::Pulse::none) continue;
+        if (const double end = incident_end(wave); end > run_time) {
+            const Path pp = Path{}.key("boundary").at(i).key("pulse");
+            c.fail(mf.source.line_of(pp.full), pp,
+                   "the pulse of boundary " + quoted(an.boundaries[i].name) + " lasts until " + fmt(end) +
+                       " s, after the run ends (" + fmt(run_time) + " s of model time in its stages): run longer, or "
+                       "start it earlier");
+        }
+    }
+}
+
 /// The analysis tables, after the regions (whose names they refer to) are read.
 /// `region_material` is the `material` key of each region, if given.
 void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
@@ -815,6 +852,7 @@ void read_analysis(Ctx& c, const toml::table& doc, ModelFile& mf,
     read_flow(c, doc, an.flow, regions);
     check_flow_needs(c, mf);
     read_stages(c, doc, an.stages, regions, supports);
+    check_dynamic_needs(c, mf);
     read_report(c, doc, an.report);
     read_events(c, doc, an.events);
     c.scale = nullptr;

@@ -145,8 +145,15 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         read_excavate_stage(c, t, p, regions, s);
         break;
     case Kind::cycle:
-        // A cycle runs at least one step.
-        s.steps = required_integer(c, t, p, "steps", 1, std::numeric_limits<long>::max());
+        // A cycle runs at least one step, or a model time (dynamic mode: checked
+        // with the solver's table).
+        if (const toml::node* n = t.get("time")) {
+            if (t.contains("steps"))
+                c.fail(*n, p.key("time"), c.in_owner() + "a cycle stage runs its steps or its time, not both");
+            s.time = required_number(c, t, p, "time", bounds("time"));
+        } else {
+            s.steps = required_integer(c, t, p, "steps", 1, std::numeric_limits<long>::max());
+        }
         break;
     case Kind::elastic:
         break;

@@ -10,11 +10,14 @@
 #include "core/step.hpp"
 
 #include "model_text.hpp"
+#include "tests/validation.hpp"
+#include "tests/validation_record.hpp"
 
 #include <doctest/doctest.h>
 
 #include <array>
 #include <cmath>
+#include <complex>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -161,6 +164,13 @@ TEST_CASE("a P pulse through a viscous base travels up an elastic column at c_p 
     CHECK(std::abs(r.base_absorbed_in_transit / carried - 1.0) < 0.01);
     // Gone through the top: less than 1% of it is left, and the account balances.
     CHECK(r.left_after < 0.01 * carried);
+    test::record_check(test::Against::closed_form, "a P pulse leaving through a viscous boundary at normal incidence",
+                       "reflected energy 0 (Lysmer & Kuhlemeyer 1969)", "under 1% of the incident",
+                       test::figure(100.0 * r.left_after / carried, 2) + "% left in the column",
+                       r.left_after < 0.01 * carried);
+    test::record_check(test::Against::closed_form, "speed of a P pulse sent in through a viscous base",
+                       "c_p = " + test::figure(c, 4) + " m/s", "within 1%",
+                       test::figure(speed, 4) + " m/s (" + test::percent(speed, c) + ")", std::abs(speed / c - 1.0) < 0.01);
     CHECK(std::abs(r.supplied / (2.0 * carried) - 1.0) < 0.01);
     // Supplied = absorbed + kinetic + strain at every step, to the O(Δt) of the
     // kinetic energy of half-step velocities (it halves with the time step).
@@ -275,6 +285,12 @@ TEST_CASE("Rayleigh damping gives its ratio at its centre frequency, and ξ(ω) 
         const auto [measured, dt] = measured_ratio(xi, centre, 8);
         MESSAGE("centre ", centre, " Hz: ratio ", measured, " (expected ", expected, "), dt ", dt);
         CHECK(measured == doctest::Approx(expected).epsilon(0.01));
+        test::record_check(test::Against::closed_form,
+                           "Rayleigh damping of a block on a joint, centre at " + test::figure(centre / f0, 2) +
+                               " × its frequency",
+                           "ξ(ω) = (α/ω + β ω)/2 = " + test::figure(expected, 4) + " (Chopra §11.4)", "within 1%",
+                           test::figure(measured, 4) + " (" + test::percent(measured, expected) + ")",
+                           std::abs(measured / expected - 1.0) < 0.01);
     }
     // The stable step shrinks as the stiffness part needs: by √(1 + ξ²) − ξ,
     // ξ = β ω_max / 2 with ω_max = 2 / Δt_crit.
@@ -314,7 +330,10 @@ TEST_CASE("Rayleigh damping of the far field's zones: a column's fundamental mod
     // f1 = c_p / 4H carries 81% of the top's motion (8/π²), the next (3 f1) 9%.
     // With ξ = 0.05 at f1 the first mode's peaks decay by e^{−2π ξ/√(1−ξ²)} a
     // period; the third, at ξ(3 f1) = ξ (1/3 + 3)/2 = 1.67 ξ, dies sooner.
+    // Triangles of 0.5 m (320 a wavelength of the mode): the stiffness part at
+    // so low a frequency cuts the step ~20-fold, and the step scales with them.
     std::string t = column(false);
+    t.replace(t.find("mesh = { size = 0.25 }"), 22, "mesh = { size = 0.5 }");
     const std::size_t base = t.find("[[boundary]]\nname = \"base\"");
     t.erase(base, t.find("start = 1e-3\n", base) + 13 - base);
     const double c = p_wave_speed(), f1 = c / (4.0 * height), xi = 0.05;
@@ -383,6 +402,11 @@ TEST_CASE("the energy account closes: a damped oscillator's damping takes what i
                 a.damping, ", worst error ", worst, " (", worst / e0, " of it)");
         CHECK(a.damping > 0.5 * e0);
         CHECK(worst < 0.01 * e0);
+        test::record_check(test::Against::closed_form,
+                           std::string("energy balance of a block on a joint damped by ") + (rayleigh ? "Rayleigh" : "local") +
+                               " damping, 2,000 steps",
+                           "supplied = stored + dissipated", "error within 1% of the 500 J/m released",
+                           "worst " + test::figure(100.0 * worst / e0, 2) + "%", worst < 0.01 * e0);
     }
     // The P pulse through the viscous base into an absorbing top: the waves'
     // work against what the column holds and its edges radiated.
@@ -397,9 +421,14 @@ TEST_CASE("the energy account closes: a damped oscillator's damping takes what i
     const EnergyAccount a = energy_account(s.world());
     MESSAGE("pulse: wave input ", a.wave_input, " J/m, radiated ", a.radiated, ", worst error ", worst);
     CHECK(worst < 0.01 * a.wave_input);
+    test::record_check(test::Against::closed_form, "energy balance of a P pulse through a column's viscous edges",
+                       "wave input = stored + radiated", "error within 1% of the wave's input",
+                       "worst " + test::figure(100.0 * worst / a.wave_input, 2) + "% of " + test::figure(a.wave_input, 3) +
+                           " J/m",
+                       worst < 0.01 * a.wave_input);
 }
 
-TEST_CASE("a pulse read from a CSV record is the named pulse it samples; a record whose times go back is refused") {
+TEST_CASE("a pulse read from a CSV record is the named pulse it samples, and a record whose times go back is refused") {
     // The half-sine of the column's base, written as 201 rows of time and velocity.
     const auto dir = std::filesystem::temp_directory_path() / "bbm_pulse_record";
     std::filesystem::create_directories(dir);
@@ -441,4 +470,240 @@ TEST_CASE("a pulse read from a CSV record is the named pulse it samples; a recor
     std::string with_frequency = text;
     with_frequency.replace(with_frequency.find("file = \"half_sine.csv\""), 22, "file = \"half_sine.csv\"\nfrequency = 200.0");
     CHECK(error(with_frequency).find("boundary[2].frequency") != std::string::npos);
+}
+
+namespace {
+
+/// A model's cycle stage of `time` seconds, after its other stages; its verdict.
+StageReport cycle_for(const std::string& model, double time) {
+    std::ostringstream text;
+    text << model << "\n[[stage]]\nname = \"wave\"\ntype = \"cycle\"\ntime = " << time << "\n";
+    const auto m = test::build_model(text.str(), "column.toml");
+    Solver s(m.blocks, m.file.analysis);
+    StageObserver quiet;
+    const auto reports = run_stages(s, m.file.analysis.stages, quiet);
+    REQUIRE(!reports.empty());
+    CHECK(s.world().clock.time >= time);
+    CHECK(s.world().clock.time < time + s.world().clock.dt);
+    return reports.back();
+}
+
+/// The column on a fixed base, released from 1 MPa: it rings in its quarter-wave
+/// mode (13.7 Hz) for ever.
+std::string released_column() {
+    std::string t = column(false);
+    const std::size_t base = t.find("[[boundary]]\nname = \"base\"");
+    t.erase(base, t.find("start = 1e-3\n", base) + 13 - base);
+    return t + "\n[[boundary]]\nname = \"base\"\ntype = \"velocity\"\nbox = { min = [-1.0, -0.01], max = [2.0, 0.01] }\n"
+               "vy = 0.0\n\n[[stage]]\nname = \"compressed\"\ntype = \"initialize\"\nsyy = -1e6\n";
+}
+
+std::string refusal(const std::string& text) {
+    try {
+        test::build_model(text, "column.toml");
+    } catch (const InputError& e) {
+        return e.key();
+    }
+    return "accepted";
+}
+
+} // namespace
+
+TEST_CASE("a dynamic stage runs its model time and ends settled once the wave has left, moving while it rings") {
+    // The pulse through the absorbing top by 0.022 s (1 ms start, 2.5 ms pulse, 18.3
+    // ms up the column): nothing left in the stage's last 1,000 steps (from 0.03 s).
+    const StageReport gone = cycle_for(column(true), 0.06);
+    // The released column, undamped: its kinetic energy back to its peak every half
+    // period (36 ms).
+    const StageReport ringing = cycle_for(released_column(), 0.2);
+    MESSAGE("absorbing top: ", describe(gone.verdict), "\nringing: ", describe(ringing.verdict));
+    CHECK(gone.verdict.kind == Verdict::Kind::settled);
+    CHECK(gone.verdict.kinetic_fraction < settled_kinetic_fraction);
+    CHECK(gone.verdict.model_time == doctest::Approx(0.06).epsilon(1e-3));
+    CHECK(ringing.verdict.kind == Verdict::Kind::moving);
+    CHECK(ringing.verdict.kinetic_fraction > 0.9);
+}
+
+TEST_CASE("a stage in model time needs the dynamic mode, one of steps or time, and a run no shorter than its pulse") {
+    const std::string stage = "\n[[stage]]\nname = \"wave\"\ntype = \"cycle\"\n";
+    CHECK(refusal(column(true) + stage + "time = 0.01\n") == "accepted");
+    CHECK(refusal(column(true) + stage + "time = 0.01\nsteps = 100\n") == "stage[0].time");
+    CHECK(refusal(column(true) + stage + "time = -0.01\n") == "stage[0].time");
+    // The half-sine ends at 1 ms + 2.5 ms, after a run of 3 ms.
+    CHECK(refusal(column(true) + stage + "time = 0.003\n") == "boundary[2].pulse");
+    const std::string second = "\n[[stage]]\nname = \"after\"\ntype = \"cycle\"\n";
+    CHECK(refusal(column(true) + stage + "time = 0.002\n" + second + "time = 0.002\n") == "accepted");
+    // A fixed step makes a run in steps known too: 100 steps of 10 µs.
+    std::string fixed = column(true);
+    fixed.replace(fixed.find("damping = 0.0"), 13, "damping = 0.0\ntimestep = 1e-5");
+    CHECK(refusal(fixed + stage + "steps = 100\n") == "boundary[2].pulse");
+    CHECK(refusal(fixed + stage + "steps = 400\n") == "accepted");
+    // A quasi-static run has no time to give (its viscous boundaries refused too,
+    // but by the solver: a model of only blocks reads the stage first).
+    std::string quasi = column(false);
+    quasi.replace(quasi.find("mode = \"dynamic\""), 16, "mode = \"quasi_static\"");
+    quasi.erase(quasi.find("[[boundary]]\nname = \"base\""));
+    CHECK(refusal(quasi + stage + "time = 0.01\n") == "stage[0].time");
+}
+
+namespace {
+
+// A plane wave across one joint (Schoenberg 1980; Pyrak-Nolte, Myer & Cook 1990):
+// a displacement discontinuity of specific stiffness κ between two half-spaces of
+// impedance Z transmits T(ω) = 1 / (1 − i ω Z / 2κ), |T| = 1/√(1 + (ωZ/2κ)²), with
+// the group delay (Z/2κ) / (1 + (ωZ/2κ)²). A column half a metre wide (rollers on
+// its sides hold the motion the wave does not have), cut half-way up by a joint of
+// normal and shear stiffness κ (or not cut: the reference), a Ricker wavelet of
+// 200 Hz sent in at its viscous base; the particle velocity 10 m above the joint,
+// every step, until the joint's reflection, sent back up by the base's dashpots
+// (1% of it: discrete ones are not perfect), would reach the gauge. The ratio of
+// the two records' spectra is the joint's T, the mesh's own dispersion divided out.
+struct JointedColumn {
+    bool shear = false;
+    double height = 80.0; ///< m: the joint's reflection 2·height/2 behind the wave
+    double mesh = 0.125;  ///< m
+};
+
+std::string jointed_column(const JointedColumn& col, double kappa) {
+    const double h = col.height, mid = 0.5 * col.height;
+    std::ostringstream s;
+    s.precision(10);
+    s << "[solver]\nmode = \"dynamic\"\ndamping = 0.0\n\n"
+      << "[[material]]\nname = \"rock\"\ndensity = 2500.0\nyoung = 10e9\npoisson = 0.25\n\n"
+      << "[[region]]\nname = \"column\"\noutline = { type = \"rectangle\", min = [0.0, 0.0], max = [0.5, " << h << "] }\n"
+      << "pattern = { type = \"single\" }\nmesh = { size = " << col.mesh << " }\n";
+    if (kappa > 0.0)
+        s << "joints = [ { from = [0.0, " << mid << "], to = [0.5, " << mid << "] } ]\n"
+          << "\n[[joint_property]]\nname = \"joint\"\nlaw = \"elastic\"\nkn = " << kappa << "\nks = " << kappa
+          << "\n\n[[joint_assignment]]\nproperty = \"joint\"\n";
+    const char* held = col.shear ? "vy" : "vx";
+    s << "\n[[boundary]]\nname = \"left side\"\ntype = \"velocity\"\nbox = { min = [-0.01, -1.0], max = [0.01, "
+      << h + 1.0 << "] }\n" << held << " = 0.0\n"
+      << "\n[[boundary]]\nname = \"right side\"\ntype = \"velocity\"\nbox = { min = [0.49, -1.0], max = [0.51, "
+      << h + 1.0 << "] }\n" << held << " = 0.0\n"
+      << "\n[[boundary]]\nname = \"base\"\ntype = \"viscous\"\nbox = { min = [-1.0, -0.01], max = [2.0, 0.01] }\n"
+      << "pulse = \"ricker\"\nvelocity = 0.1\nfrequency = 200.0\nwave = \"" << (col.shear ? "s" : "p") << "\"\n"
+      << "\n[[boundary]]\nname = \"top\"\ntype = \"viscous\"\nbox = { min = [-1.0, " << h - 0.01 << "], max = [2.0, "
+      << h + 0.01 << "] }\n";
+    return s.str();
+}
+
+struct Trace {
+    std::vector<double> t, v;
+    double impedance = 0.0; ///< ρ c of the wave
+    double speed = 0.0;     ///< c
+    double gauge_y = 0.0;   ///< the height of the node recorded (the meshes differ)
+};
+
+Trace gauge_record(const JointedColumn& col, double kappa) {
+    const auto m = test::build_model(jointed_column(col, kappa), "jointed_column.toml");
+    Solver s(m.blocks, m.file.analysis);
+    World& w = s.world();
+    const double gauge_at = 0.5 * col.height + 10.0;
+    const int gauge = node_near(w, {0.25, gauge_at});
+    const double pm = young * (1.0 - poisson) / ((1.0 + poisson) * (1.0 - 2.0 * poisson)), g = young / (2.0 * (1.0 + poisson));
+    Trace r;
+    r.impedance = std::sqrt(density * (col.shear ? g : pm));
+    // The wavelet's peak passes the gauge at 1.2/f + y/c; the reflection `height`/c
+    // later, its front half a period before its peak.
+    const double c = r.impedance / density, until = 1.2 / 200.0 + (gauge_at + col.height) / c - 0.5 / 200.0;
+    r.speed = c, r.gauge_y = w.nodes.position0[gauge].y;
+    while (w.clock.time < until) {
+        s.step();
+        r.t.push_back(w.clock.time);
+        r.v.push_back(col.shear ? w.nodes.velocity[gauge].x : w.nodes.velocity[gauge].y);
+    }
+    return r;
+}
+
+/// ∫ v(t) e^{iωt} dt by the trapezoid rule over the record.
+std::complex<double> spectrum(const Trace& r, double omega) {
+    std::complex<double> sum = 0.0;
+    for (std::size_t k = 1; k < r.t.size(); ++k) {
+        const double dt = r.t[k] - r.t[k - 1];
+        sum += 0.5 * dt * (r.v[k] * std::polar(1.0, omega * r.t[k]) + r.v[k - 1] * std::polar(1.0, omega * r.t[k - 1]));
+    }
+    return sum;
+}
+
+/// Measured against theory over the Ricker's band, 50-500 Hz (5% of its peak
+/// amplitude at the ends): the worst relative errors of |T| and of the group delay
+/// where ωZ/2κ ≤ 5 and f ≤ 400 Hz, and the worst error of the delay over all the band
+/// in parts of its scale Z/2κ (beyond ωZ/2κ = 5 the delay is under 4% of it, and
+/// the scheme's error, about a time step, is a larger share: SPEC's target missed
+/// there, the figures in docs/validation.md; the S wave at 500 Hz, 40 triangles
+/// a wavelength, 2.8% of it).
+struct Transmission {
+    double worst_modulus = 0.0, worst_delay = 0.0, worst_delay_of_scale = 0.0;
+    double lowest = 1e300, highest = 0.0; ///< the band of ωZ/2κ covered
+};
+
+Transmission transmission(const JointedColumn& col, double kappa, const Trace& free, const Trace& cut) {
+    Transmission out;
+    const double scale = free.impedance / (2.0 * kappa);
+    // The jointed column's gauge node lies (y_cut − y_free) higher: its wave that
+    // much later, whatever the joint does.
+    const double offset = (cut.gauge_y - free.gauge_y) / free.speed;
+    const auto ratio = [&](double omega) {
+        return spectrum(cut, omega) / spectrum(free, omega) * std::polar(1.0, -omega * offset);
+    };
+    for (double f = 50.0; f <= 500.0 * 1.0001; f *= std::pow(10.0, 0.1)) {
+        const double w = 2.0 * std::numbers::pi * f, x = w * scale;
+        const auto t = ratio(w);
+        // The delay as the phase's slope over ω ± 5%, the theory's over the same band.
+        const double dw = 0.05 * w;
+        const double delay = std::arg(ratio(w + dw) / ratio(w - dw)) / (2.0 * dw);
+        const double modulus_theory = 1.0 / std::sqrt(1.0 + x * x);
+        const double delay_theory = (std::atan((w + dw) * scale) - std::atan((w - dw) * scale)) / (2.0 * dw);
+        MESSAGE((col.shear ? "S" : "P"), "  f ", f, " Hz  ωZ/2κ ", x, "  |T| ", std::abs(t), " vs ", modulus_theory,
+                "  delay ", delay, " vs ", delay_theory, " s");
+        out.worst_modulus = std::max(out.worst_modulus, std::abs(std::abs(t) / modulus_theory - 1.0));
+        if (x <= 5.0 && f <= 400.0) out.worst_delay = std::max(out.worst_delay, std::abs(delay / delay_theory - 1.0));
+        out.worst_delay_of_scale = std::max(out.worst_delay_of_scale, std::abs(delay - delay_theory) / scale);
+        out.lowest = std::min(out.lowest, x), out.highest = std::max(out.highest, x);
+    }
+    return out;
+}
+
+/// ωZ/2κ from 0.1 to 1 (κ = Z ω(50 Hz) / 0.2) and from 1 to 10: two joints.
+void check_transmission(const JointedColumn& col) {
+    const Trace free = gauge_record(col, 0.0);
+    const double omega50 = 2.0 * std::numbers::pi * 50.0;
+    for (const double x50 : {0.1, 1.0}) {
+        const double kappa = free.impedance * omega50 / (2.0 * x50);
+        const Transmission t = transmission(col, kappa, free, gauge_record(col, kappa));
+        CAPTURE(kappa);
+        CHECK(t.lowest == doctest::Approx(x50).epsilon(1e-6));
+        CHECK(t.highest == doctest::Approx(10.0 * x50).epsilon(1e-3));
+        MESSAGE("worst: |T| ", t.worst_modulus, ", delay ", t.worst_delay, " (ωZ/2κ ≤ 5, f ≤ 400 Hz), ",
+                t.worst_delay_of_scale, " of Z/2κ");
+        CHECK(t.worst_modulus < 0.05);
+        CHECK(t.worst_delay < 0.05);
+        CHECK(t.worst_delay_of_scale < 0.03);
+        const std::string wave = col.shear ? "an S" : "a P", band = "ωZ/2κ " + test::figure(t.lowest, 2) + "–" +
+                                                                     test::figure(t.highest, 2);
+        test::record_check(test::Against::closed_form, wave + " wave's transmission across one joint, " + band,
+                           "|T| = 1/√(1 + (ωZ/2κ)²) (Schoenberg 1980; Pyrak-Nolte, Myer & Cook 1990)", "within 5%",
+                           "worst " + test::figure(100.0 * t.worst_modulus, 2) + "%", t.worst_modulus < 0.05);
+        test::record_check(test::Against::closed_form, wave + " wave's group delay across one joint, " + band,
+                           "(Z/2κ)/(1 + (ωZ/2κ)²) (Pyrak-Nolte, Myer & Cook 1990)",
+                           "within 5% where ωZ/2κ ≤ 5 and f ≤ 400 Hz; within 3% of Z/2κ over the band",
+                           "worst " + test::figure(100.0 * t.worst_delay, 2) + "%; " +
+                               test::figure(100.0 * t.worst_delay_of_scale, 2) + "% of Z/2κ" +
+                               (t.highest > 5.0 ? " (SPEC's 5% missed above ωZ/2κ 6)" : ""),
+                           t.worst_delay < 0.05 && t.worst_delay_of_scale < 0.03);
+    }
+}
+
+} // namespace
+
+TEST_CASE("a P wave across one joint: the displacement-discontinuity model's transmission and group delay" * validation) {
+    // 0.125 m triangles: 350 a P wavelength at 50 Hz, 35 at 500.
+    check_transmission({.shear = false, .height = 80.0, .mesh = 0.125});
+}
+
+TEST_CASE("an S wave across one joint's shear stiffness: its transmission and group delay" * validation) {
+    // Slower: a 40 m column holds the record, of 0.0625 m triangles (40 an S wavelength
+    // at 500 Hz; at 0.125 m the delay is 28% long there).
+    check_transmission({.shear = true, .height = 40.0, .mesh = 0.0625});
 }

@@ -124,14 +124,46 @@ TEST_CASE("verdict rules on recorded samples: equilibrium, fragments, failing, a
     CHECK(judge(samples(300, [](long) { return MonitorSample{}; }), target).kind == K::none);
 }
 
-TEST_CASE("verdict: a dropped block comes to rest on its base (equilibrium)") {
+TEST_CASE("a dynamic stage's verdict: a wave that has passed settles, one still ringing moves, cracks fail") {
+    // A pulse's kinetic energy: rising to a peak of 1 J/m at 0.01 s, then decaying
+    // with a time constant `tau` (a step of 1e-6 s).
+    auto pulse = [](double tau, long cracks_from) {
+        return samples(20000, [=](long k) {
+            const double t = 1e-6 * double(k);
+            const double ke = t < 0.01 ? t / 0.01 : std::exp(-(t - 0.01) / tau);
+            return MonitorSample{.cracks = k >= cracks_from ? k / 100 : 0, .ratio = 0.3, .rock_ratio = 0.3,
+                                 .rock_kinetic = ke, .rock_speed = 1e-6 * std::sqrt(ke), .time = t};
+        });
+    };
+    // Absorbed in a millisecond: at most e^-5 of its peak in the window (the last
+    // 5,000 steps), below 1%.
+    auto v = judge_dynamic(pulse(1e-3, 1L << 40));
+    CHECK(v.kind == K::settled);
+    CHECK(v.at_rest());
+    CHECK(v.model_time == doctest::Approx(0.02));
+    CHECK(v.kinetic_fraction == doctest::Approx(std::exp(-5.0)).epsilon(1e-9));
+    // Ringing on (a 0.1 s decay): 95% of its peak in the window, the ratio no matter.
+    v = judge_dynamic(pulse(0.1, 1L << 40));
+    CHECK(v.kind == K::moving);
+    CHECK(!v.at_rest());
+    CHECK(v.kinetic_fraction == doctest::Approx(std::exp(-0.05)).epsilon(1e-9));
+    // The energy gone but bonds still breaking in the window's last quarter: failing.
+    CHECK(judge_dynamic(pulse(1e-3, 19000)).kind == K::failing);
+    // The unbalanced ratio's verdict of the same samples would have said "failing"
+    // or "not converged" for a passed wave: its ratio is a wave's, not a load's.
+    CHECK(judge(pulse(1e-3, 1L << 40), 1e-5).kind == K::not_converged);
+    CHECK(judge_dynamic(samples(300, [](long) { return MonitorSample{}; })).kind == K::none);
+}
+
+TEST_CASE("verdict: a dropped block comes to rest on its base (settled: a dynamic stage's rest)") {
     auto m = load("dropped_block.toml");
     Solver s(m.blocks, m.file.analysis);
     Silent quiet;
     const auto r = run_stages(s, m.file.analysis.stages, quiet);
     const auto& v = r.back().verdict;
     INFO(describe(v));
-    CHECK(v.kind == K::equilibrium);
+    CHECK(v.kind == K::settled);
+    CHECK(v.at_rest());
     CHECK(v.fragments == 0);
     CHECK(v.cracks_in_window == 0);
 }
@@ -152,7 +184,7 @@ TEST_CASE("verdict: a block sliding down a plane steeper than its friction angle
         INFO("theta " << theta << ": " << describe(v));
         // The sliding block touches the plane: it is rock mass, not a fragment.
         CHECK(v.fragments == 0);
-        CHECK(v.kind == (theta > 20.0 ? K::collapsing : K::equilibrium));
+        CHECK(v.kind == (theta > 20.0 ? K::collapsing : K::settled));
     }
 }
 

@@ -98,7 +98,7 @@ void check_run_health(const Solver& s) {
 }
 
 nlohmann::json verdict_json(const Verdict& v) {
-    return {{"kind", to_string(v.kind)},
+    nlohmann::json j = {{"kind", to_string(v.kind)},
             {"evidence", describe(v)},
             {"window_steps", v.window_steps},
             {"cracks_in_window", v.cracks_in_window},
@@ -112,6 +112,12 @@ nlohmann::json verdict_json(const Verdict& v) {
             {"fragments", v.fragments},
             {"fragment_blocks", v.fragment_blocks},
             {"fragment_mass_t_per_m", v.fragment_mass / 1000.0}};
+    // A dynamic stage's verdict is read from its time and its kinetic energy.
+    if (v.kind == Verdict::Kind::settled || v.kind == Verdict::Kind::moving || v.kinetic_fraction > 0.0) {
+        j["model_time_s"] = v.model_time;
+        j["kinetic_energy_of_peak"] = v.kinetic_fraction;
+    }
+    return j;
 }
 
 namespace {
