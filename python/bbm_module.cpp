@@ -16,6 +16,8 @@
 // stresses) are the groups' properties. The GIL is released while the loop
 // runs; a callback, or Ctrl-C every 1,000 steps, takes it back.
 #include "base/error.hpp"
+#include "core/events.hpp"
+#include "core/measures.hpp"
 #include "apps/flags.hpp"
 #include "studies/lab/envelope.hpp"
 #include "studies/model/model.hpp"
@@ -272,6 +274,50 @@ py::object flow_arrays(const Model& m) {
     d["domain_position"] = domains, d["pressure"] = pressure, d["pipes"] = pipes, d["aperture"] = aperture;
     d["flow_rate"] = rate, d["inflow"] = inflow(*f);
     return d;
+}
+
+/// The events catalogue ([events]; None without it), copied as numpy arrays, one
+/// row an event: the closed ones and, as if closed now, the open ones with a
+/// broken bond (core/events.hpp).
+py::object event_arrays(const Model& m) {
+    const auto& events = m.solver().world().events;
+    if (!events) return py::none();
+    const std::vector<SeismicEvent> cat = event_catalogue(*events);
+    const auto n = py::ssize_t(cat.size());
+    auto time = fresh<double>(n), moment = fresh<double>(n), moment_nm = fresh<double>(n), magnitude = fresh<double>(n);
+    auto r_value = fresh<double>(n), length = fresh<double>(n), energy = fresh<double>(n), fracture = fresh<double>(n);
+    auto position = fresh<double>(n, 2), tensor = fresh<double>(n, 3), settled = fresh<double>(n, 3);
+    auto step = fresh<std::int64_t>(n), first_step = fresh<std::int64_t>(n);
+    auto bonds = fresh<std::int32_t>(n), tensile = fresh<std::int32_t>(n);
+    std::vector<std::string> type;
+    for (py::ssize_t k = 0; k < n; ++k) {
+        const SeismicEvent& e = cat[std::size_t(k)];
+        time.mutable_data()[k] = e.time, step.mutable_data()[k] = e.step, first_step.mutable_data()[k] = e.first_step;
+        position.mutable_data()[2 * k] = e.position.x, position.mutable_data()[2 * k + 1] = e.position.y;
+        for (int c = 0; c < 3; ++c)
+            tensor.mutable_data()[3 * k + c] = e.tensor[std::size_t(c)], settled.mutable_data()[3 * k + c] = e.static_tensor[std::size_t(c)];
+        moment.mutable_data()[k] = e.moment, moment_nm.mutable_data()[k] = e.moment_nm, magnitude.mutable_data()[k] = e.magnitude;
+        r_value.mutable_data()[k] = e.r_value, length.mutable_data()[k] = e.length;
+        bonds.mutable_data()[k] = e.bonds, tensile.mutable_data()[k] = e.tensile_bonds;
+        energy.mutable_data()[k] = e.energy, fracture.mutable_data()[k] = e.fracture_energy;
+        type.push_back(e.type);
+    }
+    py::dict d;
+    d["time"] = time, d["step"] = step, d["first_step"] = first_step, d["position"] = position;
+    d["tensor"] = tensor, d["static_tensor"] = settled, d["moment"] = moment, d["moment_nm"] = moment_nm;
+    d["magnitude"] = magnitude, d["r_value"] = r_value, d["type"] = type, d["length"] = length;
+    d["bonds"] = bonds, d["tensile_bonds"] = tensile, d["energy"] = energy, d["fracture_energy"] = fracture;
+    return d;
+}
+
+/// The energy account now (core/measures.hpp; summary.json's energy_balance), J/m;
+/// None where it is not kept (a quasi-static run without [solver] energy_account).
+py::object energy_dict(const Model& m) {
+    if (!m.solver().world().settings.energy_account) return py::none();
+    const EnergyAccount a = energy_account(m.solver().world());
+    return py::dict(py::arg("work") = a.work, py::arg("wave_input") = a.wave_input, py::arg("kinetic") = a.kinetic,
+                    py::arg("strain") = a.strain, py::arg("joints") = a.joints, py::arg("damping") = a.damping,
+                    py::arg("radiated") = a.radiated, py::arg("error_in_stage") = a.error);
 }
 
 /// A lab test run as its command with these options, the GIL released; a callback
@@ -636,6 +682,16 @@ void add_model_groups(py::class_<Model>& model) {
             return group_of<FieldGroup>(self, prefix, false);
         }, py::arg("prefix"), "Any group of the state list (Model.state_fields(): 'relax', 'detection', 'flow', "
                               "…) with its fields as attributes (fresh copies)")
+        .def_property_readonly("events", &event_arrays,
+                               "The seismic events ([events]; None without it), copied, a row an event: time (s), "
+                               "step, first_step, position (N×2, m), tensor (N×3: Mxx, Myy, Mxy, N·m/m, the largest "
+                               "over its duration), static_tensor (at its close), moment (M0, N·m/m), moment_nm "
+                               "(N·m), magnitude (Mw), r_value (%), type (tensile, shear or implosive), length (m), "
+                               "bonds, tensile_bonds, energy and fracture_energy (J/m); as events.csv")
+        .def_property_readonly("energy", &energy_dict,
+                               "The energy account now, J/m (summary.json's energy_balance): work, wave_input, "
+                               "kinetic, strain, joints, damping, radiated, error_in_stage; None where it is not "
+                               "kept (a quasi-static run without [solver] energy_account)")
         .def_property_readonly("flow", &flow_arrays,
                                "Water in the joints ([flow]; None when dry), copied: domain_position (D×2, m), "
                                "pressure (D, Pa), pipes (P×2 domains), aperture (P, m), flow_rate (P, m²/s per m, "

@@ -431,3 +431,36 @@ def test_static_fatigue_creep_time_and_bond_sections(tmp_path):
     assert section.shape == (m.contacts.count,)
     assert 0.0 < section.min() < 1.0 and section.max() == 1.0
     assert s["state_hash"] == cli_run(path, tmp_path / "cli")["state_hash"]
+
+
+def test_events_and_energy_as_numpy(tmp_path):
+    """The calibrated tunnel's events ([events]) as arrays, the same catalogue as
+    the program's events.csv; the energy account as summary.json's."""
+    d = tomllib.loads((SOURCE / "examples/tunnel_voronoi_calibrated.toml").read_text())
+    for stage in d["stage"]:
+        if stage["name"] == "excavation":
+            stage["relax_steps"] = 1500
+        if stage["name"] == "failure":
+            stage["max_steps"] = 500
+    d["solver"]["energy_account"] = True
+    path = tmp_path / "tunnel.toml"
+    path.write_text(bbm.to_toml(d))
+    cli_run(path, tmp_path / "cli")
+    m = bbm.Model.from_dict(d, threads=2)
+    m.run()
+    e = m.events
+    n = len(e["time"])
+    rows = (tmp_path / "cli" / "events.csv").read_text().strip().splitlines()
+    assert n > 0 and n == len(rows) - 1
+    assert e["position"].shape == (n, 2) and e["tensor"].shape == (n, 3) and len(e["type"]) == n
+    assert set(e["type"]) <= {"tensile", "shear", "implosive"}
+    # Hanks and Kanamori's magnitude of the moment (core/events.hpp).
+    assert np.allclose(e["magnitude"], (np.log10(e["moment_nm"]) - 9.1) / 1.5)
+    assert np.all(e["bonds"] >= 1) and e["bonds"].sum() <= sum(m.cracks.values())
+    acc = m.energy
+    bal = m.summary()["energy_balance"]
+    for k in ("work", "kinetic", "strain", "joints", "damping", "radiated"):
+        assert acc[k] == pytest.approx(bal[k], rel=1e-12, abs=1e-9)
+    # A model without [events] has none, and a quasi-static one without the account none.
+    assert bbm.Model(str(INSITU)).events is None
+    assert bbm.Model(str(INSITU)).energy is None
