@@ -510,10 +510,12 @@ void apply_stress_boundary(World& w, const BoundarySpec& bc, const meshing::Bloc
 }
 
 /// A viscous boundary (core/viscous.hpp): dashpots on the exposed edges of the
-/// deformable blocks selected, of their material, each stretch's to its two
-/// nodes by position. A rigid block's face is refused (not yet taken).
+/// blocks selected, of their material: a deformable block's stretch to its two
+/// nodes by position, a rigid block's at the stretch's two ends as points of the
+/// body (its region's material must give E for the wave speeds).
 void apply_viscous_boundary(World& w, const BoundarySpec& bc, int index, const meshing::BlockAssembly& a,
-                            const std::vector<std::vector<std::pair<double, double>>>& covered, std::vector<int>& nodes) {
+                            const std::vector<std::vector<std::pair<double, double>>>& covered,
+                            const RegionMaterials& materials, std::vector<int>& blocks, std::vector<int>& nodes) {
     const std::string key = "boundary[" + std::to_string(index) + "]";
     if (w.settings.mode != SolverSpec::Mode::dynamic)
         throw InputError("", 0, key + ".type",
@@ -525,12 +527,21 @@ void apply_viscous_boundary(World& w, const BoundarySpec& bc, int index, const m
     std::vector<int> zone_of_block(std::size_t(a.block_count()), -1);
     for (int z = w.zones.size() - 1; z >= 0; --z) zone_of_block[std::size_t(w.zones.block[z])] = z;
     for_each_exposed_stretch(w, bc, a, covered, [&](int i, int v0, int v1, Vec2 x0, Vec2 x1, double w0, double w1, Vec2 n) {
-        if (!w.blocks.deformable[i])
-            throw InputError("", 0, key + ".box",
-                             "viscous boundary '" + bc.name + "' selects an exposed face of rigid block " +
-                                 std::to_string(i) + " near (" + std::to_string(x0.x) + ", " + std::to_string(x0.y) +
-                                 "): viscous boundaries take the edges of deformable blocks only (mesh the region "
-                                 "at the model's edge, as its far field)");
+        if (!w.blocks.deformable[i]) {
+            const MaterialSpec* m = materials.spec[std::size_t(a.region[i])];
+            if (m == nullptr || !(m->young > 0.0))
+                throw InputError("", 0, key + ".box",
+                                 "viscous boundary '" + bc.name + "' selects a face of rigid block " + std::to_string(i) +
+                                     " near (" + std::to_string(x0.x) + ", " + std::to_string(x0.y) +
+                                     "), whose region's material gives no young: its wave speeds need E and ν");
+            const auto el = fem::Elasticity::from_young(m->young, m->poisson);
+            const Vec2 c0 = w.blocks.centroid0[i];
+            const double half = 0.5 * norm(x1 - x0);
+            for (const Vec2 x : {x0, x1})
+                add_face_dashpot(vb, k, i, x - c0, half, n, m->density, el.p_modulus(), el.shear);
+            if (blocks.empty() || blocks.back() != i) blocks.push_back(i);
+            return;
+        }
         const int z = zone_of_block[std::size_t(i)];
         const double rho = w.zones.density[z], pm = w.zones.elasticity[z].p_modulus(), g = w.zones.elasticity[z].shear;
         const double length = norm(x1 - x0), along = 0.5 * (w0 + w1);
@@ -540,12 +551,12 @@ void apply_viscous_boundary(World& w, const BoundarySpec& bc, int index, const m
         for (int m : {n0, n1})
             if (std::find(nodes.begin(), nodes.end(), m) == nodes.end()) nodes.push_back(m);
     });
-    if (nodes.empty())
+    if (nodes.empty() && blocks.empty())
         throw InputError("", 0, key + ".box", "viscous boundary '" + bc.name + "' selects no exposed edge");
 }
 
 /// The model's boundaries: prescribed velocities and stress tractions.
-void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAssembly& a) {
+void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAssembly& a, const RegionMaterials& materials) {
     const int nb = w.bodies.count(), nn = w.nodes.count();
     auto& l = w.loads;
     l.block_fixed.assign(nb, 0), l.block_velocity.assign(nb, {}), l.block_omega.assign(nb, 0.0);
@@ -556,7 +567,7 @@ void apply_boundaries(World& w, const AnalysisSpec& an, const meshing::BlockAsse
         std::vector<int> blocks, nodes;
         if (bc.kind == BoundarySpec::Kind::velocity) apply_velocity_boundary(w, bc, blocks, nodes);
         else if (bc.kind == BoundarySpec::Kind::stress) apply_stress_boundary(w, bc, a, covered, blocks, nodes);
-        else apply_viscous_boundary(w, bc, int(&bc - an.boundaries.data()), a, covered, nodes);
+        else apply_viscous_boundary(w, bc, int(&bc - an.boundaries.data()), a, covered, materials, blocks, nodes);
         auto& b = w.boundaries;
         b.names.push_back(bc.name);
         b.block_list.insert(b.block_list.end(), blocks.begin(), blocks.end());
@@ -588,7 +599,7 @@ World build_world(const meshing::BlockAssembly& a, const AnalysisSpec& an) {
     start_events(w, an.events);
     prepare_team(w);
     reindex_contacts(w);
-    apply_boundaries(w, an, a);
+    apply_boundaries(w, an, a, materials);
     // Support types (core/supports/registry.hpp), their sets installed by stages.
     for_each_support(w.supports, [&](auto type, auto& state) {
         using T = typename decltype(type)::type;

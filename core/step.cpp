@@ -285,6 +285,7 @@ Range node_share(const World& w, const StepContext& ctx) { return equal_share(w.
 /// node's force gains F_in − C v̄, v̄ the mean of its velocity before and after
 /// this step's central difference, solved for with the gathered force; the
 /// energy each boundary absorbs and supplies is added in entry order.
+void viscous_faces(World& w);
 void viscous_stage(World& w, const StepContext&, Range) {
     auto& b = w.viscous;
     const double dt = w.clock.dt, time = w.clock.time;
@@ -324,8 +325,107 @@ void viscous_stage(World& w, const StepContext&, Range) {
             b.supplied[k] += incident_velocity(b.waves[k], time) * dot(b.input[e], moving) * dt;
         }
     }
+    viscous_faces(w);
 }
-bool has_viscous(const World& w) { return w.viscous.count() > 0; }
+
+namespace {
+
+/// x solving the symmetric 3 × 3 system a x = b (a positive definite: M/Δt + C₃/2).
+std::array<double, 3> solve3(const std::array<double, 9>& a, const std::array<double, 3>& b) {
+    const double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
+    const double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+    const double c11 = a[0] * a[8] - a[2] * a[6], c12 = a[2] * a[3] - a[0] * a[5], c22 = a[0] * a[4] - a[1] * a[3];
+    // Symmetric: the adjugate's (i, j) is its (j, i).
+    return {(c00 * b[0] + c01 * b[1] + c02 * b[2]) / det, (c01 * b[0] + c11 * b[1] + c12 * b[2]) / det,
+            (c02 * b[0] + c12 * b[1] + c22 * b[2]) / det};
+}
+
+/// The point's velocity on body u = (v, ω) at offset r: v + ω r⊥.
+Vec2 point_velocity(const std::array<double, 3>& u, Vec2 r) { return {u[0] - u[2] * r.y, u[1] + u[2] * r.x}; }
+
+} // namespace
+
+/// One rigid body's face dashpots, entries [first, end): C₃ = Σ Jᵀ C J and the
+/// incident waves' force and moment, at the points turned by the body's angle.
+struct BodyDashpots {
+    std::array<double, 9> c3{};
+    std::array<double, 3> input{};
+    int end = 0;
+};
+Vec2 turned(Vec2 r, double theta) {
+    const double c = std::cos(theta), s = std::sin(theta);
+    return {c * r.x - s * r.y, s * r.x + c * r.y};
+}
+BodyDashpots body_dashpots(const ViscousBoundaries& b, int first, double theta, double time) {
+    BodyDashpots out;
+    const int body = b.face_body[first];
+    for (out.end = first; out.end < b.face_count() && b.face_body[out.end] == body; ++out.end) {
+        const Vec2 r = turned(b.face_offset[out.end], theta);
+        const auto& c = b.face_damping[out.end];
+        // J = [1 0 −r_y; 0 1 r_x].
+        const double j0[3] = {1.0, 0.0, -r.y}, j1[3] = {0.0, 1.0, r.x};
+        for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q)
+                out.c3[3 * p + q] += j0[p] * (c[0] * j0[q] + c[1] * j1[q]) + j1[p] * (c[1] * j0[q] + c[2] * j1[q]);
+        const Vec2 f = incident_velocity(b.waves[b.face_boundary[out.end]], time) * b.face_input[out.end];
+        out.input[0] += f.x, out.input[1] += f.y, out.input[2] += cross(r, f);
+    }
+    return out;
+}
+
+/// The rigid faces' dashpots (core/viscous.hpp): per body, its three velocities
+/// after the step solved for with its points' C₃, the force and moment of the
+/// dashpots at their mean added to the gathered ones, and each boundary's energy.
+void viscous_faces(World& w) {
+    auto& b = w.viscous;
+    const double dt = w.clock.dt, time = w.clock.time;
+    for (int e = 0; e < b.face_count();) {
+        const int i = b.face_body[e];
+        const contact::BodyState& body = w.bodies.state[i];
+        BodyDashpots d = body_dashpots(b, e, body.theta, time);
+        if (w.bodies.removed[i]) {
+            e = d.end;
+            continue;
+        }
+        // A held velocity takes no dashpot (it is prescribed).
+        const std::uint8_t held = w.loads.block_fixed[i];
+        for (int p = 0; p < 3; ++p)
+            if (held & (1 << p)) {
+                d.input[p] = 0.0;
+                for (int q = 0; q < 3; ++q) d.c3[3 * p + q] = d.c3[3 * q + p] = 0.0;
+            }
+        const std::array<double, 3> u{body.velocity.x, body.velocity.y, body.omega};
+        const std::array<double, 3> f{w.bodies.force[i].x + d.input[0], w.bodies.force[i].y + d.input[1],
+                                      w.bodies.moment[i] + d.input[2]};
+        const double m[3] = {w.bodies.mass[i] / dt, w.bodies.mass[i] / dt, w.bodies.inertia[i] / dt};
+        // (M/Δt + C₃/2) u⁺ = (M/Δt − C₃/2) u + f.
+        std::array<double, 9> a{};
+        std::array<double, 3> rhs{};
+        for (int p = 0; p < 3; ++p) {
+            rhs[p] = m[p] * u[p] + f[p];
+            for (int q = 0; q < 3; ++q) {
+                a[3 * p + q] = (p == q ? m[p] : 0.0) + 0.5 * d.c3[3 * p + q];
+                rhs[p] -= 0.5 * d.c3[3 * p + q] * u[q];
+            }
+        }
+        const auto after = solve3(a, rhs);
+        std::array<double, 3> mean{}, g = f;
+        for (int p = 0; p < 3; ++p) mean[p] = held & (1 << p) ? 0.0 : 0.5 * (u[p] + after[p]);
+        for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q) g[p] -= d.c3[3 * p + q] * mean[q];
+        w.bodies.force[i] = {g[0], g[1]}, w.bodies.moment[i] = g[2];
+        for (; e < d.end; ++e) {
+            const Vec2 v = point_velocity(mean, turned(b.face_offset[e], body.theta));
+            const auto& c = b.face_damping[e];
+            const Vec2 fd{c[0] * v.x + c[1] * v.y, c[1] * v.x + c[2] * v.y};
+            const std::size_t k = std::size_t(b.face_boundary[e]);
+            b.absorbed[k] += dot(fd, v) * dt;
+            b.supplied[k] += incident_velocity(b.waves[k], time) * dot(b.face_input[e], v) * dt;
+        }
+    }
+}
+
+bool has_viscous(const World& w) { return w.viscous.count() > 0 || w.viscous.face_count() > 0; }
 
 /// A creep step of stress corrosion, armed by a creep stage at equilibrium
 /// (core/creep.hpp): the bonds' sections and lengths before the contact pass.
@@ -594,8 +694,8 @@ const Stage stage_table[] = {
      gather_block_stage, Share::team, gather_block_share, false, true},
     {"gather nodes", "4", "each FE node's force over its zones, contacts and ties, in a fixed order",
      gather_node_stage, Share::team, node_share, true, true},
-    {"viscous boundaries", "4", "the dashpots of the absorbing edges and the incident waves, on their nodes' forces "
-     "(core/viscous.hpp)", viscous_stage, Share::one_thread, nullptr, false, false, has_viscous},
+    {"viscous boundaries", "4", "the dashpots of the absorbing edges and the incident waves, on their nodes' and "
+     "rigid faces' forces (core/viscous.hpp)", viscous_stage, Share::one_thread, nullptr, false, false, has_viscous},
     {"integrate", "5", "damping, central differences, prescribed velocities", integrate_stage, Share::team,
      chunk_share, true},
     {"unbalanced", "6", "the unbalanced-force ratio, the convergence measure", ratio_stage, Share::one_thread},

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <utility>
 
 namespace bbm {
 
@@ -48,29 +49,60 @@ double incident_end(const IncidentWaveSpec& wave) {
     return 0.0;
 }
 
-void add_dashpot(ViscousBoundaries& b, int boundary, int node, double length, Vec2 n, double density,
-                 double p_modulus, double shear_modulus) {
+namespace {
+
+/// A dashpot's C = ρ c L (n nᵀ, t tᵀ) and its input force per m/s of incident velocity.
+std::pair<std::array<double, 3>, Vec2> dashpot(const IncidentWaveSpec& wave, double length, Vec2 n, double density,
+                                               double p_modulus, double shear_modulus) {
     const double cp = std::sqrt(p_modulus / density), cs = std::sqrt(shear_modulus / density);
     const double kn = density * cp * length, ks = density * cs * length;
     const Vec2 t{-n.y, n.x}; // counter-clockwise about the model
-    b.node.push_back(node);
-    b.boundary.push_back(boundary);
-    b.damping.push_back({kn * n.x * n.x + ks * t.x * t.x, kn * n.x * n.y + ks * t.x * t.y,
-                         kn * n.y * n.y + ks * t.y * t.y});
-    const IncidentWaveSpec& wave = b.waves[std::size_t(boundary)];
+    const std::array<double, 3> c{kn * n.x * n.x + ks * t.x * t.x, kn * n.x * n.y + ks * t.x * t.y,
+                                  kn * n.y * n.y + ks * t.y * t.y};
     // The traction 2 ρ c v_in along the incident motion: a P wave's inward, an S wave's along t.
-    b.input.push_back(wave.wave == IncidentWaveSpec::Wave::p ? -2.0 * kn * n : 2.0 * ks * t);
+    return {c, wave.wave == IncidentWaveSpec::Wave::p ? -2.0 * kn * n : 2.0 * ks * t};
 }
 
-void sort_dashpots(ViscousBoundaries& b) {
-    std::vector<int> order(b.node.size());
+} // namespace
+
+void add_dashpot(ViscousBoundaries& b, int boundary, int node, double length, Vec2 n, double density,
+                 double p_modulus, double shear_modulus) {
+    const auto [c, input] = dashpot(b.waves[std::size_t(boundary)], length, n, density, p_modulus, shear_modulus);
+    b.node.push_back(node), b.boundary.push_back(boundary), b.damping.push_back(c), b.input.push_back(input);
+}
+
+void add_face_dashpot(ViscousBoundaries& b, int boundary, int body, Vec2 offset, double length, Vec2 n,
+                      double density, double p_modulus, double shear_modulus) {
+    const auto [c, input] = dashpot(b.waves[std::size_t(boundary)], length, n, density, p_modulus, shear_modulus);
+    b.face_body.push_back(body), b.face_boundary.push_back(boundary), b.face_offset.push_back(offset);
+    b.face_damping.push_back(c), b.face_input.push_back(input);
+}
+
+namespace {
+
+/// The entries' order by `key` (stable: a node's or body's entries keep theirs).
+std::vector<int> order_by(const std::vector<int>& key) {
+    std::vector<int> order(key.size());
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return b.node[x] < b.node[y]; });
-    auto permute = [&](auto& v) {
-        auto copy = v;
-        for (std::size_t k = 0; k < order.size(); ++k) v[k] = copy[std::size_t(order[k])];
-    };
-    permute(b.node), permute(b.boundary), permute(b.damping), permute(b.input);
+    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return key[x] < key[y]; });
+    return order;
+}
+
+template <class V>
+void put_in_order(const std::vector<int>& order, V& v) {
+    const V copy = v;
+    for (std::size_t k = 0; k < order.size(); ++k) v[k] = copy[std::size_t(order[k])];
+}
+
+} // namespace
+
+void sort_dashpots(ViscousBoundaries& b) {
+    const auto nodes = order_by(b.node);
+    put_in_order(nodes, b.node), put_in_order(nodes, b.boundary), put_in_order(nodes, b.damping);
+    put_in_order(nodes, b.input);
+    const auto faces = order_by(b.face_body);
+    put_in_order(faces, b.face_body), put_in_order(faces, b.face_boundary), put_in_order(faces, b.face_offset);
+    put_in_order(faces, b.face_damping), put_in_order(faces, b.face_input);
 }
 
 } // namespace bbm

@@ -23,9 +23,15 @@
 // and the work its incident wave does are accumulated per boundary (J/m): the
 // dynamic run's energy account.
 //
+// A rigid block's face at the edge takes the same dashpots, of its region's
+// material (E, ν, ρ: the rock mass's), lumped at the ends of each exposed stretch
+// (half its length each) as points of the body: a point's velocity v + ω × r,
+// its force and moment on the body. The body's three velocities are solved for
+// together, (M/Δt + C₃/2) u⁺ = (M/Δt − C₃/2) u + f, C₃ = Σ Jᵀ C J over its points,
+// J = [1 0 −r_y; 0 1 r_x], M = diag(m, m, I).
+//
 // The world's part (ViscousBoundaries) is plain data, the stage a free function
-// (core/step.cpp's table, after the node gather); rigid blocks' faces at a model
-// edge are not yet taken (refused: mesh the outer region).
+// (core/step.cpp's table, after the gathers).
 #pragma once
 
 #include "base/fields.hpp"
@@ -52,11 +58,18 @@ struct ViscousBoundaries {
     std::vector<int> boundary;                  ///< per entry: which viscous boundary (0, 1, ...)
     std::vector<std::array<double, 3>> damping; ///< per entry: C = ρ c L (n nᵀ, t tᵀ) as cxx, cxy, cyy (N·s/m per m)
     std::vector<Vec2> input;                    ///< per entry: its force per m/s of incident velocity, 2 ρ c L d (N·s/m per m)
+    /// Rigid faces: per entry, in body order, its body, boundary, point (from the
+    /// centroid, in the body's frame as built), C and input as the nodes' above.
+    std::vector<int> face_body, face_boundary;
+    std::vector<Vec2> face_offset;
+    std::vector<std::array<double, 3>> face_damping;
+    std::vector<Vec2> face_input;
     std::vector<IncidentWaveSpec> waves;        ///< per boundary
     std::vector<std::string> names;             ///< per boundary: its [[boundary]] name
     std::vector<double> absorbed;               ///< per boundary: the energy its dashpots took, J/m
     std::vector<double> supplied;               ///< per boundary: the work of its incident wave, J/m
     int count() const { return static_cast<int>(node.size()); }
+    int face_count() const { return static_cast<int>(face_body.size()); }
 };
 
 /// Its fields (base/fields.hpp): the dashpots are the model's, the energies evolve;
@@ -69,6 +82,11 @@ void visit_fields(P& b, V&& v) {
     v(FieldInfo{"viscous.boundary", G::nodes, M}, b.boundary);
     v(FieldInfo{"viscous.damping", G::nodes, M}, b.damping);
     v(FieldInfo{"viscous.input", G::nodes, M}, b.input);
+    v(FieldInfo{"viscous.face_body", G::blocks, M}, b.face_body);
+    v(FieldInfo{"viscous.face_boundary", G::blocks, M}, b.face_boundary);
+    v(FieldInfo{"viscous.face_offset", G::blocks, M}, b.face_offset);
+    v(FieldInfo{"viscous.face_damping", G::blocks, M}, b.face_damping);
+    v(FieldInfo{"viscous.face_input", G::blocks, M}, b.face_input);
     v(FieldInfo{"viscous.absorbed", G::other, E}, b.absorbed);
     v(FieldInfo{"viscous.supplied", G::other, E}, b.supplied);
 }
@@ -77,6 +95,9 @@ void visit_fields(P& b, V&& v) {
 /// normal n, on node `node`, of a material ρ, λ + 2G, G.
 void add_dashpot(ViscousBoundaries& b, int boundary, int node, double length, Vec2 n, double density,
                  double p_modulus, double shear_modulus);
+/// The same at a point `offset` from rigid body `body`'s centroid (as built).
+void add_face_dashpot(ViscousBoundaries& b, int boundary, int body, Vec2 offset, double length, Vec2 n,
+                      double density, double p_modulus, double shear_modulus);
 
 /// Entries in node order (stable: a node's entries keep the order they were added).
 void sort_dashpots(ViscousBoundaries& b);

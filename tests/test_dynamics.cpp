@@ -707,3 +707,46 @@ TEST_CASE("an S wave across one joint's shear stiffness: its transmission and gr
     // at 500 Hz; at 0.125 m the delay is 28% long there).
     check_transmission({.shear = true, .height = 40.0, .mesh = 0.0625});
 }
+
+TEST_CASE("a viscous boundary on a rigid block's face damps it as its dashpot ρ c_p L: a block on a joint decays at "
+          "ξ = ρ c_p L / 2 m ω") {
+    // The oscillator's 1 m block (m = 1000 kg/m on kn L = 1e9 N/m per m: ω = 1000
+    // rad/s) with a viscous top of its own material: c_p = √(M/ρ) = 100 m/s for
+    // E = 8.333 MPa, ν = 0.25 (M = 1.2 E), so ρ c_p L = 1e5 N·s/m per m: ξ = 0.05.
+    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/verification/oscillator.toml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string t = text.str();
+    t.replace(t.find("density = 1000.0\n"), 17, "density = 1000.0\nyoung = 8.3333333333e6\npoisson = 0.25\n");
+    t += "\n[[boundary]]\nname = \"top\"\ntype = \"viscous\"\nbox = { min = [-0.5, 0.99], max = [1.5, 1.01] }\n";
+    const auto m = test::build_model(t, "oscillator.toml");
+    Solver s(m.blocks, m.file.analysis);
+    StageObserver quiet;
+    run_stages(s, {m.file.analysis.stages[0]}, quiet);
+    const World& w = s.world();
+    REQUIRE(w.viscous.face_count() == 2);
+    const int block = w.blocks.centroid0[0].y > w.blocks.centroid0[1].y ? 0 : 1;
+    auto u = [&] { return w.bodies.state[block].centroid.y - w.blocks.centroid0[block].y - 1e-3; };
+    const double e0 = strain_energy(w);
+    std::vector<double> peaks;
+    double before = u(), now = u(), worst = 0.0;
+    while (peaks.size() < 6) {
+        s.step();
+        const double next = u();
+        if (now > before && now >= next && now > 0.0) peaks.push_back(now);
+        before = now, now = next;
+        worst = std::max(worst, std::abs(energy_account(w).error));
+    }
+    const double delta = std::log(peaks.front() / peaks.back()) / 5.0;
+    const double xi = delta / std::sqrt(4.0 * std::numbers::pi * std::numbers::pi + delta * delta);
+    const EnergyAccount a = energy_account(w);
+    MESSAGE("rigid face's dashpot: ξ ", xi, " (0.05); radiated ", a.radiated, " of ", e0, " J/m, worst error ", worst,
+            "; the block's spin ", w.bodies.state[block].omega);
+    CHECK(xi == doctest::Approx(0.05).epsilon(0.01));
+    CHECK(a.radiated > 0.5 * e0);
+    CHECK(worst < 0.01 * e0);
+    CHECK(std::abs(w.bodies.state[block].omega) < 1e-9);
+    test::record_check(test::Against::closed_form, "a rigid block on a joint damped by a viscous boundary on its face",
+                       "ξ = ρ c_p L / (2 m ω) = 0.05 (Lysmer & Kuhlemeyer's dashpot)", "within 1%",
+                       test::figure(xi, 4) + " (" + test::percent(xi, 0.05) + ")", std::abs(xi / 0.05 - 1.0) < 0.01);
+}
