@@ -495,6 +495,7 @@ void accept_candidates(Detector& d, Contacts& c, const DetectionInput& in) {
             JointHistory h;
             h.bonded = false;
             h.un = cand.un;
+            if (in.overlap_at_rest) h.upn = std::min(0.0, cand.un);
             add_contact(c, cand.vertex_block, cand.vertex, cand.edge_block, cand.edge, cand.edge_end, cand.length,
                   in.new_contact_property, h);
             d.drop.push_back(0);

@@ -81,6 +81,13 @@ struct DetectionInput {
     /// most along B's edge; true, half of that edge's overlap with B's edge (at
     /// least corner_radius) — a face shared by its two end contacts, as UDEC does.
     bool overlap_length = false;
+    /// A new contact born overlapped (its vertex already up to the tolerance inside
+    /// the other block, having passed a corner unseen between passes) takes that
+    /// overlap as its rest position (upn = un < 0): only further approach loads it.
+    /// Without this, in a dynamic run, the overlap is a spring compressed at birth
+    /// whose energy no work paid for (docs/theory.md §19.4). Quasi-static runs keep
+    /// the stiff push-out, which relaxation dissipates.
+    bool overlap_at_rest = false;
 };
 
 /// Key of an unordered block pair.

@@ -68,7 +68,8 @@ void detection_pass(World& w) {
     auto& d = w.detection;
     contact::DetectionInput in{block_view(w), w.bodies.count(), w.bodies.removed.data(), d.active.data(),
                                d.tolerance, w.properties.new_contact, w.clock.dt, &d.junctions, d.corner_radius,
-                               w.settings.new_contact_length == SolverSpec::NewContactLength::overlap};
+                               w.settings.new_contact_length == SolverSpec::NewContactLength::overlap,
+                               w.settings.mode == SolverSpec::Mode::dynamic};
     const auto r = contact::detect(w.contacts, d.detector, in);
 #pragma omp single
     {

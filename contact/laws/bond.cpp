@@ -18,8 +18,10 @@ std::optional<KeyProblem> check_bond_keys(const JointPropertySpec& j) {
 }
 
 void unbonded_update(JointHistory& h, double kn, double ks, double tan_phi, double dus) {
-    h.upn = 0.0;
-    h.sn = std::max(0.0, -kn * h.un);
+    // upn < 0 only for a contact born overlapped in a dynamic run (DetectionInput::
+    // overlap_at_rest): the overlap it was born with is its rest, until it opens.
+    if (h.upn > 0.0 || h.un >= 0.0) h.upn = 0.0;
+    h.sn = std::max(0.0, -kn * (h.un - h.upn));
     h.tau += ks * dus;
     const double cap = h.sn * tan_phi;
     h.slipping = std::abs(h.tau) > cap;

@@ -152,8 +152,10 @@ inline bool intact_elastic_update(JointHistory& h, double kn, double ks, double 
     return true;
 }
 
-/// Frictional contact without a bond: no tension, |τ| <= σn tan φ. upn is zero
-/// here: crack faces meet again at their original position.
+/// Frictional contact without a bond: no tension, |τ| <= σn tan φ, σn = −kn (un − upn).
+/// upn is zero (crack faces meet again at their original position) except for a
+/// contact born overlapped in a dynamic run, whose birth overlap is its rest until
+/// it opens (DetectionInput::overlap_at_rest).
 void unbonded_update(JointHistory& h, double kn, double ks, double tan_phi, double dus);
 
 double tan_deg(double degrees);

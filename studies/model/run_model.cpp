@@ -5,6 +5,7 @@
 #include "io/picture.hpp"
 #include "io/binary_stream.hpp"
 #include "io/vtk_output.hpp"
+#include "core/creep.hpp"
 #include "core/stages.hpp"
 #include "studies/model/model.hpp"
 #include "studies/model/compare_envelopes.hpp"
@@ -134,15 +135,31 @@ public:
         if (options_.quiet) return;
         if (!progress_.due()) return;
         const auto now = std::chrono::steady_clock::now();
-        if (stage_name_ != st.name) stage_name_ = st.name, stage_t0_ = now, stage_k0_ = k;
+        const World& w = s.world();
+        // The stage's model time so far (a dynamic step is constant within a stage).
+        const double stage_time = k * w.clock.dt;
+        if (stage_name_ != st.name) stage_name_ = st.name, stage_t0_ = now, stage_k0_ = k, stage_time0_ = stage_time;
         const double el = std::chrono::duration<double>(now - stage_t0_).count();
         const double rate = el > 0 ? (k - stage_k0_) / el : 0.0;
         using K = StageSpec::Kind;
+        const int tensile = cracks(w, contact::JointState::broken_tension), shear = cracks(w, contact::JointState::broken_shear);
+        if (st.kind == K::cycle && st.time > 0.0) { // a dynamic stage runs model time, not steps
+            const double time_rate = el > 0 ? (stage_time - stage_time0_) / el : 0.0;
+            progress_.line("  %-12s time %9.4g/%-9.4g s  ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s",
+                           st.name.c_str(), stage_time, st.time, w.clock.ratio, tensile, shear, rate,
+                           time_rate > 0 ? (st.time - stage_time) / time_rate : 0.0);
+            return;
+        }
+        if (st.kind == K::creep && w.creep) { // creep time does not pass at a steady rate: no ETA
+            progress_.line("  %-12s creep %9.4g/%-9.4g years  ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s",
+                           st.name.c_str(), w.creep->time / seconds_per_year, w.creep->until / seconds_per_year,
+                           w.clock.ratio, tensile, shear, rate);
+            return;
+        }
         const long total = st.kind == K::cycle || st.kind == K::excavate || st.kind == K::pressurise ? st.steps
                                                                                                        : st.max_steps;
         progress_.line("  %-12s step %9ld/%-9ld ratio %9.3e  cracks %6d T %6d S  %7.0f steps/s  ETA %5.0f s",
-                     st.name.c_str(), k, total, s.world().clock.ratio, cracks(s.world(), contact::JointState::broken_tension),
-                        cracks(s.world(), contact::JointState::broken_shear), rate, rate > 0 ? (total - k) / rate : 0.0);
+                       st.name.c_str(), k, total, w.clock.ratio, tensile, shear, rate, rate > 0 ? (total - k) / rate : 0.0);
     }
     void at(const Solver& s, const StageCursor& c) override {
         cursor_ = c;
@@ -326,6 +343,7 @@ private:
     StageCursor cursor_;
     std::string stage_name_;
     long stage_k0_ = 0;
+    double stage_time0_ = 0.0;
     std::chrono::steady_clock::time_point stage_t0_ = std::chrono::steady_clock::now();
     Progress progress_;
 };
