@@ -501,7 +501,10 @@ void accept_candidates(Detector& d, Contacts& c, const DetectionInput& in) {
             d.drop.push_back(0);
             ++res.created;
         }
+        d.removed_dissipated = 0.0;
         if (res.removed > 0) {
+            for (int i = 0; i < c.size(); ++i)
+                if (d.drop[i]) d.removed_dissipated += c.length[i] * c.history[i].dissipated;
             remove_flagged_contacts(c, d.drop);
             d.drop.resize(c.size());
             std::fill(d.drop.begin(), d.drop.end(), 0);

@@ -154,6 +154,10 @@ struct Detector {
     std::vector<int> order, accepted;
     bool stale = false, left_box = false; ///< this pass: grid invalid, a piece left its box
     DetectionResult result;
+    /// Of the last pass's removed contacts, the energy their joints had dissipated
+    /// (friction, fracture; J/m): it leaves the contacts' sum with them, and the
+    /// energy account keeps it (core/measures.hpp dissipated_energy).
+    double removed_dissipated = 0.0;
     /// Of the last pass's transfers, those onto another edge of a deformable block:
     /// they change which nodes a contact loads, so the index is stale after them too.
     int transferred_on_nodes = 0;

@@ -88,7 +88,7 @@ double zone_strain_energy(const World& w) {
 }
 
 double dissipated_energy(const World& w) {
-    double e = 0.0;
+    double e = w.detection.dissipated_removed; // the joints since removed took theirs with them
     for (int i = 0; i < w.contacts.size(); ++i) e += w.contacts.length[i] * w.contacts.history[i].dissipated;
     return e;
 }

@@ -111,6 +111,18 @@ struct SolverSpec {
     /// as UDEC shares a face between its two end contacts.
     enum class NewContactLength { edge, overlap };
     NewContactLength new_contact_length = NewContactLength::edge;
+    /// A contact formed already overlapped (a vertex that passed into the other
+    /// block between detection passes): `push`, its overlap loads it at once
+    /// (σn = −kn un, energy no work paid for, which local damping takes out); `rest`,
+    /// its overlap is its rest position and only further approach loads it
+    /// (docs/theory.md §19.4). By mode: rest in the dynamic mode, push in the
+    /// quasi-static one (the mode the shipped calibrations were made in).
+    enum class NewContactOverlap { push, rest, by_mode };
+    NewContactOverlap new_contact_overlap = NewContactOverlap::by_mode;
+    bool overlap_at_rest() const {
+        return new_contact_overlap == NewContactOverlap::rest ||
+               (new_contact_overlap == NewContactOverlap::by_mode && mode == Mode::dynamic);
+    }
     /// Rayleigh damping (dynamic mode): the critical ratio ξ at the centre
     /// frequency f (Hz), half from the mass and half from the stiffness:
     /// C = α M + β K, α = ξ ω, β = ξ / ω, ω = 2π f (docs/theory.md §19).

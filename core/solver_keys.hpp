@@ -63,6 +63,11 @@ inline constexpr SolverKey solver_keys[] = {
                 "along the other block's edge; overlap, half of that edge's overlap with the other block's edge, at "
                 "least the corner radius (a face shared by its two end contacts, as UDEC does)",
      .absent = "edge", .words = "edge, overlap"},
+    {.key = "new_contact_overlap", .kind = KeyKind::choice,
+     .meaning = "A contact formed already overlapped (its vertex passed into the other block between detection "
+                "passes): push, the overlap loads it at once (energy no work paid for); rest, the overlap is its rest "
+                "position and only further approach loads it (the energy account closes; docs/theory.md §19.4)",
+     .absent = "rest in the dynamic mode, push in the quasi-static", .words = "push, rest"},
     {.key = "output_every", .kind = KeyKind::integer, .bounds = between(0, 2147483647, " steps"),
      .meaning = "Steps between VTK outputs; 0 = at the start and at the end of each stage only", .absent = "0",
      BBM_KEY_FIELD(SolverSpec, output_every)},

@@ -24,9 +24,10 @@ namespace {
 // B the same fields, with a fingerprint of every parameter of every property
 // and support set (A's hashed only the stiffnesses); C the yielding bolts' and the
 // viscous boundaries' fields; D the monitor's samples with their model time (a
-// dynamic stage's verdict and its end in time); E the rigid faces' dashpots.
+// dynamic stage's verdict and its end in time); E the rigid faces' dashpots; F
+// the removed contacts' dissipated energy (the energy account).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
-constexpr std::uint64_t format = 'E';
+constexpr std::uint64_t format = 'F';
 constexpr std::uint64_t magic = magic_base | format;
 
 /// FNV-1a, 64 bits.

@@ -69,7 +69,7 @@ void detection_pass(World& w) {
     contact::DetectionInput in{block_view(w), w.bodies.count(), w.bodies.removed.data(), d.active.data(),
                                d.tolerance, w.properties.new_contact, w.clock.dt, &d.junctions, d.corner_radius,
                                w.settings.new_contact_length == SolverSpec::NewContactLength::overlap,
-                               w.settings.mode == SolverSpec::Mode::dynamic};
+                               w.settings.overlap_at_rest()};
     const auto r = contact::detect(w.contacts, d.detector, in);
 #pragma omp single
     {
@@ -84,6 +84,7 @@ void detection_pass(World& w) {
         d.totals.removed += r.removed;
         d.totals.transferred += r.transferred;
         d.totals.removed_tensile += r.removed_tensile;
+        d.dissipated_removed += d.detector.removed_dissipated;
         d.totals.removed_shear += r.removed_shear;
         // A contact passed to another edge of a deformable block loads that edge's
         // nodes: the per-node index (and the faces of face_shear) must follow it,

@@ -305,6 +305,9 @@ struct Detection {
     std::uint8_t any_active = 0;       ///< this pass: some block has (shared by the team)
     std::vector<contact::Junction> junctions;
     contact::DetectionResult totals;   ///< contacts created, removed and transferred so far
+    /// What the removed contacts' joints had dissipated, J/m (the energy account's:
+    /// saved, not hashed).
+    double dissipated_removed = 0.0;
     /// Created since the contacts were last sorted by block: it decides when they
     /// are renumbered next, so it is state (a checkpoint saves it).
     int unsorted_contacts = 0;
@@ -319,6 +322,7 @@ void visit_fields(P& d, V&& v) {
     v(FieldInfo{"detection.detected_vertex", G::vertices, E}, d.detected_vertex);
     v(FieldInfo{"detection.active", G::blocks, E}, d.active);
     v(FieldInfo{"detection.totals", G::other, E}, d.totals);
+    v(FieldInfo{"detection.dissipated_removed", G::other, field_use::saved}, d.dissipated_removed);
     v(FieldInfo{"detection.unsorted_contacts", G::other, E}, d.unsorted_contacts);
     v(FieldInfo{"detection.radius", G::blocks, R}, d.radius);
     v(FieldInfo{"detection.junctions", G::other, R}, d.junctions);

@@ -364,6 +364,10 @@ SolverSpec read_solver(const Ctx& c, const toml::node& node, const Path& p,
         s.new_contact_length = static_cast<SolverSpec::NewContactLength>(choice(
             c, t, p, "new_contact_length", key_words(find_key(solver_keys, "new_contact_length")->words),
             "new contact length"));
+    if (t.contains("new_contact_overlap"))
+        s.new_contact_overlap = static_cast<SolverSpec::NewContactOverlap>(choice(
+            c, t, p, "new_contact_overlap", key_words(find_key(solver_keys, "new_contact_overlap")->words),
+            "new contact overlap"));
     if (const toml::node* n = find(c, t, p, "new_contact_property")) {
         const Path np = p.key("new_contact_property");
         s.new_contact_property = to_str(c, *n, np);
