@@ -286,6 +286,23 @@ struct ShearCommandLine {
     int run(bool quiet, bool check_only) { return studies::run_shear(values, quiet, check_only); }
 };
 
+/// `bbm creep`: its options (apps/study_flags.cpp) and its run.
+struct CreepCommandLine {
+    CLI::App* cmd = nullptr;
+    studies::CreepValues values;
+
+    void add(CLI::App& app, bool& quiet) {
+        cmd = app.add_subcommand(
+            "creep", "Static fatigue of a bonded-block specimen whose bonds corrode (law stress_corrosion): per seed its "
+                     "short-term strength under a dead load (bisected), then the specimen held at each --ratios of it "
+                     "until it fails or --max-time passes; the time to failure, creep strain and cracks against time. "
+                     "Writes summary.json, creep.csv, creep_curves.csv, time_to_failure.png, creep_curves.png and "
+                     "each run's model file in --out.");
+        cli::add_creep_options(cmd, values, quiet);
+    }
+    int run(bool quiet, bool check_only) { return studies::run_creep(values, quiet, check_only); }
+};
+
 /// The lab tests: each its own options, defaults = the paper's calibration (SPEC §8).
 struct LabTestCommandLines {
     std::vector<std::pair<CLI::App*, studies::LabTestValues>> commands;
@@ -329,6 +346,7 @@ struct Commands {
     CalibrateCommandLine calibrate;
     EnvelopeCommandLine envelope;
     ShearCommandLine shear;
+    CreepCommandLine creep;
     LabTestCommandLines labtests;
 
     void add(CLI::App& app, bool& quiet) {
@@ -339,6 +357,7 @@ struct Commands {
         calibrate.add(app, quiet);
         envelope.add(app, quiet);
         shear.add(app, quiet);
+        creep.add(app, quiet);
         labtests.add(app, quiet);
     }
 
@@ -347,6 +366,7 @@ struct Commands {
         if (*run.cmd) return run.run(quiet, check_only);
         if (*envelope.cmd) return envelope.run(quiet, check_only);
         if (*shear.cmd) return shear.run(quiet, check_only);
+        if (*creep.cmd) return creep.run(quiet, check_only);
         if (*calibrate.cmd) return calibrate.run(quiet, check_only);
         if (*sweep.cmd) return sweep.run(quiet, check_only);
         if (*compare.cmd) return compare.run(quiet, check_only);

@@ -23,6 +23,7 @@
 #include "base/keys.hpp"
 #include "core/rock.hpp"
 #include "studies/calibration/calibrate_command.hpp"
+#include "studies/lab/creep_test.hpp"
 #include "studies/lab/envelope.hpp"
 #include "studies/lab/labtest_command.hpp"
 #include "studies/lab/shear.hpp"
@@ -80,6 +81,8 @@ void add_labtest_options(CLI::App* command, studies::LabTestValues& values, bool
 void add_envelope_options(CLI::App* command, studies::EnvelopeOptions& options, bool& quiet);
 /// `bbm shear`'s options on a (sub)command.
 void add_shear_options(CLI::App* command, studies::ShearValues& values, bool& quiet);
+/// `bbm creep`'s options on a (sub)command.
+void add_creep_options(CLI::App* command, studies::CreepValues& values, bool& quiet);
 /// The calibrate options (lab-test options and targets) on a (sub)command.
 void add_calibrate_options(CLI::App* command, studies::CalibrateValues& values, bool& quiet);
 /// After parsing: which joint values the user gave (the calibration starts from them).
@@ -94,6 +97,7 @@ studies::LabTestStudy run_labtest_args(
     const std::function<void(const Solver&, const StressStrainPoint&, int)>& on_frame = {});
 studies::EnvelopeStudy run_envelope_args(const std::vector<std::string>& args, bool quiet);
 studies::ShearStudy run_shear_args(const std::vector<std::string>& args, bool quiet);
+studies::CreepStudy run_creep_args(const std::vector<std::string>& args, bool quiet);
 /// Returns calibration.json's text.
 std::string run_calibrate_args(const std::vector<std::string>& args, bool quiet);
 

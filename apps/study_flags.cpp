@@ -3,6 +3,8 @@
 #include "apps/checks.hpp"
 #include "apps/flags.hpp"
 
+#include "contact/laws/stress_corrosion.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <string>
@@ -91,6 +93,60 @@ void add_shear_options(CLI::App* sub, studies::ShearValues& v, bool& quiet) {
         apply_rock_file(*sub, v.lab.rock, v.o.rock);
         check_joint_law_flags(*sub, v.o.plane, "joint-");
     });
+}
+
+void add_creep_options(CLI::App* sub, studies::CreepValues& v, bool& quiet) {
+    CreepTestOptions& o = v.o;
+    sub->add_option("--rock", v.rock,
+                    "The rock's bonds, material and block pattern from a file, as the lab tests' --rock (what bbm "
+                    "calibrate writes); a softening bond becomes a corroding one with --corrosion-rate, and the rock's "
+                    "flags given beside the file override it")
+        ->check(CLI::ExistingFile);
+    sub->add_option("--width", o.width, "Specimen width (m)")->check(positive())->capture_default_str();
+    sub->add_option("--height", o.height, "Specimen height (m)")->check(positive())->capture_default_str();
+    add_rock_flags(sub, o.rock);
+    static constexpr const contact::JointKey* corrosion[] = {&contact::key_corrosion_rate, &contact::key_corrosion_exponent,
+                                                             &contact::key_corrosion_threshold};
+    add_key_flags<JointPropertySpec>(sub, o.rock.bonds, corrosion, "", "The bonds' corrosion: ");
+    sub->add_option("--ratios", o.ratios, "Held stresses over each seed's short-term strength, comma-separated, each in (0, 1)")
+        ->delimiter(',')->capture_default_str();
+    sub->add_option("--realizations", o.realizations, "Seeds per ratio (seed, seed+1, ...), each with its own short-term strength")
+        ->check(positive())->capture_default_str();
+    sub->add_option("--max-time", o.max_time, "Creep time after which a specimen that has not failed holds (s; default 100 years)")
+        ->check(positive())->capture_default_str();
+    sub->add_option("--loss", o.loss, "Largest fraction of a bond's section lost in one creep step")
+        ->check(in_range(1e-6, 0.5))->capture_default_str();
+    sub->add_option("--strength-tolerance", o.strength_tolerance,
+                    "The short-term strength's bisection stops when its bracket is this fraction of it")
+        ->check(in_range(1e-4, 0.5))->capture_default_str();
+    sub->add_option("--max-steps", o.max_steps, "Mechanical steps of a held specimen at most")
+        ->check(whole_at_least(1))->capture_default_str();
+    sub->add_option("--fit-record", v.fit_record,
+                    "Fit the corrosion law's exponent and rate to this static-fatigue record (CSV of stress ratio and "
+                    "time to failure in s, one row per test) on the bonds as given; writes joint_property.toml (the "
+                    "fitted set) and fit.json, and runs the test at the record's ratios")
+        ->check(CLI::ExistingFile);
+    sub->add_option("--threads", o.threads, "Threads of each run's contact loop")->check(positive())->capture_default_str();
+    sub->add_option("--max-elements", o.max_elements, max_elements_help)->check(positive());
+    sub->add_option("-o,--out", v.out, "Output directory")->capture_default_str();
+    sub->add_flag("-q,--quiet", quiet, "No progress, only errors");
+    sub->final_callback([sub, &v] { // after --config: see add_labtest_options
+        apply_rock_file(*sub, v.rock, v.o.rock);
+        // A calibrated rock file holds a softening bond: the corrosion makes it corroding.
+        if (v.o.rock.bonds.law == "softening" && sub->get_option("--corrosion-rate")->count() > 0)
+            v.o.rock.bonds.law = "stress_corrosion";
+    });
+}
+
+studies::CreepStudy run_creep_args(const std::vector<std::string>& args, bool quiet) {
+    CLI::App app{"creep", "creep"};
+    studies::CreepValues v;
+    bool q = quiet;
+    add_creep_options(&app, v, q);
+    v.write_files = parse_args(app, "creep", args);
+    studies::CreepStudy study;
+    studies::run_creep(v, q, false, &study);
+    return study;
 }
 
 studies::ShearStudy run_shear_args(const std::vector<std::string>& args, bool quiet) {

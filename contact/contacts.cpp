@@ -87,12 +87,14 @@ bool sort_contacts_by_blocks(Contacts& c) {
     return true;
 }
 
-void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
-                           const int* vertex_node) {
+namespace {
+
+/// The contacts by batch (property set, and whether a deformable block takes
+/// part), by counting sort in contact order; the batches cut into work items and
+/// their costs; the per-contact scratch sized.
+void index_batches(Contacts& c, int property_sets, const std::uint8_t* deformable) {
     const int n = c.size();
     auto is_deformable = [&](int blk) { return deformable && deformable[blk]; };
-    // Batches by counting sort: each contact's batch, the sizes, then the fill
-    // in contact order.
     const int batches = 2 * property_sets;
     c.batch_first.assign(batches + 1, 0);
     auto batch_of = [&](int i) {
@@ -121,9 +123,14 @@ void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std
     c.partial_sum.resize(c.work.size());
     c.partial_damped.assign(c.work.size(), 0.0);
     if (c.marking) c.bond_change.assign(c.length.size(), 0), c.force_before.resize(c.length.size());
+}
 
-    // Per-block and per-node lists in contact order: count, prefix sum, fill
-    // (`c.fill` is kept between calls: this runs inside steps that change contacts).
+/// Per-block and per-node lists of the contacts' ends, in contact order: count,
+/// prefix sum, fill (`c.fill` is kept between calls: this runs inside steps that
+/// change contacts).
+void index_blocks_and_nodes(Contacts& c, int blocks, const std::uint8_t* deformable, int nodes, const int* vertex_node) {
+    const int n = c.size();
+    auto is_deformable = [&](int blk) { return deformable && deformable[blk]; };
     c.block_first.assign(blocks + 1, 0);
     c.node_first.assign(nodes + 1, 0);
     for (int i = 0; i < n; ++i) {
@@ -148,6 +155,14 @@ void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std
             c.node_entry[c.fill[vertex_node[c.edge_end[i]]]++] = 4 * i + 2;
         }
     }
+}
+
+} // namespace
+
+void rebuild_contact_index(Contacts& c, int property_sets, int blocks, const std::uint8_t* deformable, int nodes,
+                           const int* vertex_node) {
+    index_batches(c, property_sets, deformable);
+    index_blocks_and_nodes(c, blocks, deformable, nodes, vertex_node);
 }
 
 void update_normals(Contacts& c, const BlockView& b, double corner_radius) {

@@ -401,7 +401,7 @@ struct CurveFrame {
 };
 
 /// The range of every series' points (on a log axis, the positive ones).
-CurveFrame curve_frame(const std::vector<Series>& series, bool log_y) {
+CurveFrame curve_frame(const std::vector<Series>& series, bool log_y, bool y_from_zero) {
     CurveFrame f;
     f.log_y = log_y;
     for (const auto& s : series)
@@ -417,7 +417,11 @@ CurveFrame curve_frame(const std::vector<Series>& series, bool log_y) {
     if (!std::isfinite(f.y0) || !std::isfinite(f.y1)) f.y0 = 0, f.y1 = 1;
     if (!(f.x1 > f.x0)) f.x1 = f.x0 + 1;
     if (!(f.y1 > f.y0)) f.y1 = f.y0 + 1;
-    if (!log_y) f.y0 = std::min(f.y0, 0.0);
+    if (!log_y && y_from_zero) f.y0 = std::min(f.y0, 0.0);
+    if (!log_y && !y_from_zero) { // the data's range, a twentieth of it to spare each side
+        const double pad = 0.05 * (f.y1 - f.y0);
+        f.y0 -= pad, f.y1 += pad;
+    }
     return f;
 }
 
@@ -541,10 +545,11 @@ void draw_failure(const World& w, const std::filesystem::path& file, const Failu
 }
 
 void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
-                 const std::filesystem::path& file, const std::string& title, bool log_y, bool legend_left) {
+                 const std::filesystem::path& file, const std::string& title, bool log_y, bool legend_left,
+                 bool y_from_zero) {
     Canvas canvas(file, CurveFrame::w, CurveFrame::h);
     cairo_t* cr = canvas.cr;
-    const CurveFrame frame = curve_frame(series, log_y);
+    const CurveFrame frame = curve_frame(series, log_y, y_from_zero);
     draw_axes(cr, frame, x_label, y_label, title);
     constexpr std::array<Rgb, 6> colours{
         {{0.1, 0.2, 0.7}, {0.8, 0.1, 0.1}, {0.1, 0.55, 0.2}, {0.5, 0.3, 0.6}, {0.9, 0.55, 0.0}, {0.3, 0.3, 0.3}}};

@@ -56,8 +56,9 @@ struct Series {
 /// Plot of one or more series (lines or markers) with axes, ticks, labels and,
 /// for several series, a legend.
 /// The legend goes top right, or top left with `legend_left` (curves that rise to the right).
+/// A linear y axis starts at zero unless `y_from_zero` is false (then it spans the data).
 void draw_curves(const std::vector<Series>& series, const std::string& x_label, const std::string& y_label,
                  const std::filesystem::path& file, const std::string& title = {}, bool log_y = false,
-                 bool legend_left = false);
+                 bool legend_left = false, bool y_from_zero = true);
 
 } // namespace bbm::io

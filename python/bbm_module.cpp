@@ -395,6 +395,24 @@ py::list shear_curves(const studies::ShearStudy& study) {
     return curves;
 }
 
+py::list creep_curves(const studies::CreepStudy& study) {
+    py::list curves;
+    for (const CreepRun& r : study.result.runs) {
+        const auto n = py::ssize_t(r.curve.size());
+        auto time = fresh<double>(n), strain = fresh<double>(n);
+        auto tensile = fresh<std::int32_t>(n), shear = fresh<std::int32_t>(n);
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const CreepPoint& p = r.curve[i];
+            time.mutable_at(i) = p.time, strain.mutable_at(i) = p.strain;
+            tensile.mutable_at(i) = p.cracks_tensile, shear.mutable_at(i) = p.cracks_shear;
+        }
+        py::dict c;
+        c["creep_time"] = time, c["creep_strain"] = strain, c["cracks_tensile"] = tensile, c["cracks_shear"] = shear;
+        curves.append(c);
+    }
+    return curves;
+}
+
 /// bbm.InputError and bbm.NumericalError, and the library's exceptions translated to them.
 void bind_errors(py::module_& mod) {
     // Exceptions: bbm.InputError (a ValueError) carries file, line and key.
@@ -785,6 +803,14 @@ void bind_lab_tests(py::module_& mod) {
             study = cli::run_shear_args(args, quiet);
         }
         return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), shear_curves(study));
+    });
+    mod.def("_creep", [](const std::vector<std::string>& args, bool quiet) {
+        studies::CreepStudy study;
+        {
+            py::gil_scoped_release release;
+            study = cli::run_creep_args(args, quiet);
+        }
+        return py::make_tuple(py::module_::import("json").attr("loads")(study.summary_json), creep_curves(study));
     });
     mod.def("_calibrate", [](const std::vector<std::string>& args, bool quiet) {
         std::string json;

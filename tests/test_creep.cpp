@@ -10,13 +10,20 @@
 #include "core/solver.hpp"
 #include "core/stages.hpp"
 #include "core/state.hpp"
+#include "base/error.hpp"
+#include "studies/lab/creep_test.hpp"
+#include "studies/model/model.hpp"
 
 #include "model_text.hpp"
 #include "restart.hpp"
 
 #include <doctest/doctest.h>
 
+#include "contact/laws/stress_corrosion.hpp"
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 
@@ -202,4 +209,132 @@ TEST_CASE("stress corrosion's bad input is refused with its key") {
     const std::string no_law = error(text);
     CHECK(no_law.find("stage[1].type") == 0);
     CHECK(no_law.find("stress_corrosion") != std::string::npos);
+}
+
+// --- bbm creep: the static-fatigue test (studies/lab/creep_test.hpp) ------------
+
+namespace {
+
+/// A small specimen (0.5 m x 1 m of 0.1 m Voronoi blocks) of the default
+/// corroding rock: seconds a run.
+CreepTestOptions small_creep_test() {
+    CreepTestOptions o;
+    o.width = 0.5, o.height = 1.0;
+    o.ratios = {0.9, 0.8};
+    return o;
+}
+
+} // namespace
+
+TEST_CASE("bbm creep: the short-term strength is bracketed, a lower held load lasts longer, and each run is its "
+          "model file's") {
+    const CreepTestOptions o = small_creep_test();
+    const CreepTestResult res = run_creep_test(o);
+    REQUIRE(res.strengths.size() == 1);
+    const ShortTermStrength& s = res.strengths[0];
+    CHECK(s.holds > 0.0);
+    CHECK(s.fails > s.holds);
+    CHECK(s.fails - s.holds <= o.strength_tolerance * s.holds);
+    REQUIRE(res.runs.size() == 2);
+    const CreepRun &high = res.runs[0], &low = res.runs[1];
+    CHECK(high.load == doctest::Approx(0.9 * s.holds).epsilon(1e-12));
+    REQUIRE(high.failed);
+    REQUIRE(low.failed);
+    // The static-fatigue line falls: the lower load lasts longer, by at least the
+    // factor one bond's law gives for the same drop in its ratio at its weakest
+    // (exp(β Δs) with Δs the macroscopic 0.1, β = 30: e^3 = 20, the assembly's
+    // redistribution makes it shallower, docs/time.md: at least 2).
+    CHECK(low.time_to_failure > 2.0 * high.time_to_failure);
+    CHECK(res.decades_per_ratio < 0.0);
+    // Creep strain grows while held, and fastest at the end (tertiary creep).
+    REQUIRE(high.curve.size() > 3);
+    CHECK(high.creep_strain > 0.0);
+    for (std::size_t k = 1; k < high.curve.size(); ++k) CHECK(high.curve[k].time >= high.curve[k - 1].time);
+    // The run is what `bbm run` does with the model file it writes: the same time to failure to the bit.
+    studies::Model m = studies::Model::from_text(creep_model_text(o, high.seed, high.load, true), "creep.toml");
+    m.run();
+    CHECK(m.reports().back().failed);
+    CHECK(m.reports().back().creep_time == high.time_to_failure);
+}
+
+TEST_CASE("bbm creep: a held load below every bond's threshold passes its century in one creep step") {
+    CreepTestOptions o = small_creep_test();
+    o.ratios = {0.1, 0.2};
+    o.strength_tolerance = 0.05;
+    const CreepTestResult res = run_creep_test(o);
+    REQUIRE(res.runs.size() == 2);
+    // At 0.1 of the strength no bond is at its threshold (0.4): nothing corrodes.
+    const CreepRun& idle = res.runs[0];
+    REQUIRE(idle.highest_ratio_at_load < 0.4);
+    CHECK_FALSE(idle.failed);
+    CHECK(idle.time_to_failure == doctest::Approx(o.max_time).epsilon(1e-12));
+    CHECK(idle.creep_steps == 1);
+    CHECK_FALSE(idle.step_limit);
+    CHECK(idle.cracks_tensile + idle.cracks_shear == idle.cracks_at_load);
+    CHECK(std::abs(idle.creep_strain) < 1e-9); // the elastic strain under the load is about 1e-4
+    // At 0.2 the blocks' corners put a few bonds above it (the assembly's stress
+    // concentrations): they corrode and break, the rock holds its century.
+    const CreepRun& slow = res.runs[1];
+    CHECK(slow.highest_ratio_at_load > 0.4);
+    CHECK_FALSE(slow.failed);
+    CHECK(slow.creep_steps > 1);
+}
+
+TEST_CASE("bbm creep's bad options are refused by flag") {
+    CreepTestOptions o = small_creep_test();
+    o.rock.bonds.law = "softening";
+    CHECK_THROWS_WITH_AS(check_creep_options(o), doctest::Contains("--law"), InputError);
+    o = small_creep_test();
+    o.ratios = {0.9, 1.2};
+    CHECK_THROWS_WITH_AS(check_creep_options(o), doctest::Contains("--ratios"), InputError);
+    o = small_creep_test();
+    o.rock.pattern.size = 0.4;
+    CHECK_THROWS_WITH_AS(check_creep_options(o), doctest::Contains("--size"), InputError);
+}
+
+TEST_CASE("bbm creep --fit-record recovers the corrosion law that made a static-fatigue record") {
+    // The record: the small specimen's own times at three ratios with beta = 30 and
+    // rate 1e-6 /s; the fit starts from beta = 15 and rate 1e-4 /s.
+    CreepTestOptions o = small_creep_test();
+    o.ratios = {0.9, 0.85, 0.8};
+    const CreepTestResult truth = run_creep_test(o);
+    std::vector<FatiguePoint> record;
+    for (const CreepRun& r : truth.runs) {
+        REQUIRE(r.failed);
+        record.push_back({r.ratio, r.time_to_failure});
+    }
+    CreepTestOptions start = o;
+    set_law_value(start.rock.bonds, "corrosion_exponent", 15.0);
+    set_law_value(start.rock.bonds, "corrosion_rate", 1e-4);
+    const FatigueFit fit = fit_static_fatigue(start, record, 0.05, 8);
+    REQUIRE(fit.converged);
+    CHECK(contact::key_corrosion_exponent.get(fit.bonds) == doctest::Approx(30.0).epsilon(0.15));
+    CHECK(std::log10(contact::key_corrosion_rate.get(fit.bonds)) == doctest::Approx(-6.0).epsilon(0.1));
+    // The fitted set's times against the record's, ratio by ratio: within a factor 1.5.
+    REQUIRE(fit.final_test.runs.size() == record.size());
+    for (std::size_t k = 0; k < record.size(); ++k) {
+        INFO("ratio " << record[k].ratio);
+        CHECK(fit.final_test.runs[k].failed);
+        CHECK(std::abs(std::log10(fit.final_test.runs[k].time_to_failure / record[k].time)) < std::log10(1.5));
+    }
+}
+
+TEST_CASE("a static-fatigue record's defects are refused with their line") {
+    const auto path = std::filesystem::temp_directory_path() / "bbm_fatigue_record.csv";
+    const auto refused = [&](const std::string& text) {
+        std::ofstream(path) << text;
+        try {
+            read_fatigue_record(path.string());
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    CHECK(refused("ratio,time\n0.9,100\n1.2,1000\n").find(":3") != std::string::npos);
+    CHECK(refused("ratio,time\n0.9,100\n0.8,-5\n").find("must be positive") != std::string::npos);
+    CHECK(refused("ratio,time\n0.9,100\n").find("two stress ratios") != std::string::npos);
+    CHECK(refused("ratio,time\n0.9,1000\n0.8,100\n").find("not static fatigue") != std::string::npos);
+    CHECK(refused("ratio,time\n0.9,100\nx,y\n").find(":3") != std::string::npos);
+    CHECK(refused("# a comment\nratio,time\n0.9,100\n0.8,1000\n") == "accepted");
+    std::filesystem::remove(path);
 }

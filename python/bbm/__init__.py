@@ -28,11 +28,11 @@ from ._bbm import (  # noqa: F401  (re-exported)
     NumericalError,
     ZoneArrays,
 )
-from ._bbm import _calibrate, _envelope, _labtest, _shear
+from ._bbm import _calibrate, _creep, _envelope, _labtest, _shear
 
 __all__ = [
     "Model", "InputError", "NumericalError", "ucs", "tension", "biaxial", "brazilian", "calibrate", "to_toml",
-    "envelope", "shear",
+    "envelope", "shear", "creep",
 ]
 
 
@@ -215,6 +215,21 @@ def shear(quiet=True, **options):
     ``shear_stress``, ``normal_stress``, ``dilation``, cracks) as numpy arrays in
     ``runs[i]["curve"]``. Files are written only with ``out``."""
     summary, curves = _shear(_option_args(options), quiet)
+    for run, curve in zip(summary["runs"], curves):
+        run["curve"] = curve
+    return summary
+
+
+def creep(quiet=True, **options):
+    """Static fatigue of a specimen whose bonds corrode, as ``bbm creep``: per
+    seed its short-term strength under a dead load, then held at each of
+    ``ratios`` of it (a list) until it fails or ``max_time`` (s) passes;
+    ``corrosion_rate``, ``corrosion_exponent``, ``corrosion_threshold`` and the
+    rock's keywords as the lab tests'. Returns the dict of summary.json
+    (``short_term``, ``ratios``, ``runs``, ``line``) with each run's curve
+    (``creep_time``, ``creep_strain``, cracks) as numpy arrays in
+    ``runs[i]["curve"]``. Files are written only with ``out``."""
+    summary, curves = _creep(_option_args(options), quiet)
     for run, curve in zip(summary["runs"], curves):
         run["curve"] = curve
     return summary

@@ -313,6 +313,35 @@ void add_run_verdict(nlohmann::json& summary, const std::vector<StageReport>& re
         }
 }
 
+/// What the world's optional parts report: flow, creep, events, the energy
+/// account and the viscous boundaries.
+void add_part_summaries(nlohmann::json& summary, const World& w, const std::vector<StageReport>& reports) {
+    if (w.flow) summary["flow"] = flow_summary(*w.flow);
+    if (w.creep) {
+        summary["creep"] = creep_summary(w);
+        for (const auto& r : reports)
+            if (r.failed) summary["creep"]["failed_at"] = r.creep_time;
+    }
+    if (w.events) summary["events"] = events_summary(*w.events);
+    if (w.settings.energy_account) {
+        // The energy account (core/measures.hpp), the last stage's error.
+        const EnergyAccount a = energy_account(w);
+        const double scale = std::max({std::abs(a.work + a.wave_input), a.kinetic + a.strain, 1e-300});
+        summary["energy_balance"] = {{"work", a.work},       {"wave_input", a.wave_input}, {"kinetic", a.kinetic},
+                                     {"strain", a.strain},   {"joints", a.joints},         {"damping", a.damping},
+                                     {"radiated", a.radiated}, {"error_in_stage", a.error},
+                                     {"relative_error", std::abs(a.error) / scale}};
+    }
+    if (w.viscous.count() > 0) {
+        // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
+        auto& e = summary["energy"];
+        e["absorbed"] = absorbed_energy(w), e["wave_input"] = wave_energy(w);
+        for (std::size_t k = 0; k < w.viscous.names.size(); ++k)
+            summary["viscous_boundaries"][w.viscous.names[k]] = {{"absorbed", w.viscous.absorbed[k]},
+                                                                  {"wave_input", w.viscous.supplied[k]}};
+    }
+}
+
 } // namespace
 
 nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& file,
@@ -346,30 +375,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
         // last good state, not the end of the model's stages.
         {"complete", complete},
         {"stages", stages_json(reports)}};
-    if (w.flow) summary["flow"] = flow_summary(*w.flow);
-    if (w.creep) {
-        summary["creep"] = creep_summary(w);
-        for (const auto& r : reports)
-            if (r.failed) summary["creep"]["failed_at"] = r.creep_time;
-    }
-    if (w.events) summary["events"] = events_summary(*w.events);
-    if (w.settings.energy_account) {
-        // The energy account (core/measures.hpp), the last stage's error.
-        const EnergyAccount a = energy_account(w);
-        const double scale = std::max({std::abs(a.work + a.wave_input), a.kinetic + a.strain, 1e-300});
-        summary["energy_balance"] = {{"work", a.work},       {"wave_input", a.wave_input}, {"kinetic", a.kinetic},
-                                     {"strain", a.strain},   {"joints", a.joints},         {"damping", a.damping},
-                                     {"radiated", a.radiated}, {"error_in_stage", a.error},
-                                     {"relative_error", std::abs(a.error) / scale}};
-    }
-    if (w.viscous.count() > 0) {
-        // The dynamic run's account with its absorbing edges (core/viscous.hpp), per boundary.
-        auto& e = summary["energy"];
-        e["absorbed"] = absorbed_energy(w), e["wave_input"] = wave_energy(w);
-        for (std::size_t k = 0; k < w.viscous.names.size(); ++k)
-            summary["viscous_boundaries"][w.viscous.names[k]] = {{"absorbed", w.viscous.absorbed[k]},
-                                                                  {"wave_input", w.viscous.supplied[k]}};
-    }
+    add_part_summaries(summary, w, reports);
     add_run_verdict(summary, reports);
     add_support_summaries(summary, w);
     const auto& rep = file.analysis.report;
