@@ -44,6 +44,9 @@ double BartonBandisLaw::strength(double sn, double travelled) const {
 }
 
 void BartonBandisLaw::update_stresses(JointHistory& h, double dus) const {
+    // upn < 0 only for a contact born overlapped in a dynamic run (its rest,
+    // DetectionInput::overlap_at_rest), until it opens; dilation keeps it >= 0 after.
+    if (h.upn < 0.0 && h.un >= 0.0) h.upn = 0.0;
     h.sn = std::max(0.0, -kn * (h.un - h.upn));
     if (h.sn == 0.0) { // apart: no shear stress, no wear of the asperities
         h.tau = 0.0;
