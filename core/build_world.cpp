@@ -598,6 +598,7 @@ World build_world(const meshing::BlockAssembly& a, const AnalysisSpec& an) {
     prepare_detection(w, a);
     start_events(w, an.events);
     prepare_team(w);
+    if (w.settings.mode == SolverSpec::Mode::dynamic) w.peak = start_peak_velocities(w, an.report);
     reindex_contacts(w);
     apply_boundaries(w, an, a, materials);
     // Support types (core/supports/registry.hpp), their sets installed by stages.

@@ -19,7 +19,7 @@ using ReportKey = Key<ReportSpec>;
 inline constexpr std::string_view history_quantity_words =
     "unbalanced_ratio, displacement_x, displacement_y, velocity_x, velocity_y, rotation, boundary_force_x, "
     "boundary_force_y, cracks_tensile, cracks_shear, kinetic_energy, strain_energy, dissipated_energy, work, inflow, absorbed_energy, "
-    "wave_energy, creep_time, damping_energy, energy_error";
+    "wave_energy, creep_time, damping_energy, energy_error, ejected_mass, ejection_speed";
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
@@ -49,6 +49,10 @@ inline constexpr ReportKey report_keys[] = {
     {.key = "window", .kind = KeyKind::table, .bounds = unbounded(" m"),
      .meaning = "{ min = [x, y], max = [x, y] }: the part drawn in failure.png and failure.svg",
      .absent = "±2.2 radii around the opening, or the whole model"},
+    {.key = "ejection_speed", .kind = KeyKind::number, .bounds = above(0.0, " m/s"),
+     .meaning = "Dynamic mode: rock detached from the rock mass and moving into the opening (in any direction "
+                "without an opening) faster than this is ejected (summary.json's ejecta)",
+     .absent = "1 m/s"},
 };
 #pragma GCC diagnostic pop
 

@@ -151,7 +151,9 @@ struct HistorySpec {
         wave_energy,     ///< the work of their incident waves so far, J/m
         creep_time,      ///< stress corrosion's creep time so far, s (core/creep.hpp)
         damping_energy,  ///< taken by damping so far (local and Rayleigh), J/m
-        energy_error     ///< the energy account's error since the stage started, J/m (core/measures.hpp)
+        energy_error,    ///< the energy account's error since the stage started, J/m (core/measures.hpp)
+        ejected_mass,    ///< rock detached from the rock mass: ejected, kg/m (core/ejecta.hpp)
+        ejection_speed   ///< its mass-weighted mean speed, m/s
     };
     std::string name;
     Quantity quantity = Quantity::unbalanced_ratio;
@@ -208,6 +210,7 @@ struct ReportSpec {
     bool opening = false;           ///< measure the opening (center, springline, crown given)
     Vec2 center{}, springline{}, crown{};
     std::optional<Box2> window;     ///< part drawn in failure.png; empty = 2 radii around the opening
+    double ejection_speed = 1.0;    ///< m/s: detached rock moving into the opening faster is ejected (core/ejecta.hpp)
 };
 
 /// [events]: the seismic events recorded from breaking bonds (optional;

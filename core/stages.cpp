@@ -118,6 +118,7 @@ private:
         case StageSpec::Kind::cycle: break;
         }
         start_energy_account(w_);
+        if (w_.peak) start_stage_peaks(*w_.peak);
         obs_.at(s_, cursor_);
     }
 
@@ -313,6 +314,8 @@ double quantity(const World& w, const HistorySpec& h, int i) {
     case Q::creep_time: return w.creep ? w.creep->time : 0.0;
     case Q::damping_energy: return w.clock.damped;
     case Q::energy_error: return energy_account(w).error;
+    case Q::ejected_mass: return measure_ejecta(w).mass;
+    case Q::ejection_speed: return measure_ejecta(w).speed_mean;
     }
     return 0.0;
 }

@@ -562,6 +562,9 @@ void integrate_stage(World& w, const StepContext&, Range r) {
 }
 Range chunk_share(const World& w, const StepContext& ctx) { return by_cost(w.team.chunk_cost_before, ctx); }
 
+void peak_stage(World& w, const StepContext&, Range r) { record_peak_velocities(w, r.first, r.last); }
+bool has_peaks(const World& w) { return w.peak.has_value(); }
+
 // --- 6. the convergence measure -------------------------------------------------------------
 
 } // namespace
@@ -700,6 +703,8 @@ const Stage stage_table[] = {
      "rigid faces' forces (core/viscous.hpp)", viscous_stage, Share::one_thread, nullptr, false, false, has_viscous},
     {"integrate", "5", "damping, central differences, prescribed velocities", integrate_stage, Share::team,
      chunk_share, true},
+    {"peak velocities", "—", "each body's largest speed, over the run and over the stage: the dynamic mode's PPV "
+     "(core/ejecta.hpp)", peak_stage, Share::team, chunk_share, false, false, has_peaks},
     {"unbalanced", "6", "the unbalanced-force ratio, the convergence measure", ratio_stage, Share::one_thread},
     {"bookkeeping", "—", "the relaxation's release, time, the contact pass's thread balance", bookkeeping_stage,
      Share::one_thread},

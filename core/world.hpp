@@ -24,6 +24,7 @@
 #include "contact/contacts.hpp"
 #include "contact/detection.hpp"
 #include "core/creep.hpp"
+#include "core/ejecta.hpp"
 #include "core/events.hpp"
 #include "core/joint_flow.hpp"
 #include "core/model_spec.hpp"
@@ -429,6 +430,7 @@ struct World {
     Ties ties;
     ViscousBoundaries viscous;      ///< the dynamic mode's absorbing edges and incident waves (core/viscous.hpp)
     std::optional<Events> events;   ///< seismic events from breaking bonds, where asked for (core/events.hpp)
+    std::optional<PeakVelocities> peak; ///< each body's peak speed: the dynamic mode's (core/ejecta.hpp)
     StageMonitor monitor;           ///< what the current stage did, for its verdict
     Team team;
     /// Taken when the world is built (model_fingerprint, core/state.hpp):
@@ -468,6 +470,8 @@ void for_each_field(W& w, V&& v) {
     visit_fields(w.viscous, v);
     // Seismic events (core/events.hpp): saved, not hashed (a record, not state).
     if (w.events) visit_fields(*w.events, v);
+    // Peak velocities (core/ejecta.hpp): saved, not hashed (a record, as the events).
+    if (w.peak) visit_fields(*w.peak, v);
     visit_fields(w.team, v);
     // The energy taken by damping (a measure: saved, not in the state hash).
     v(FieldInfo{"solver.damped", MemoryGroup::other, field_use::saved}, w.clock.damped);

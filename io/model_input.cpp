@@ -692,6 +692,8 @@ void read_report(Ctx& c, const toml::table& doc, ReportSpec& r) {
                 c.fail(t, p, "springline and crown must differ from center (they are points on the opening's wall)");
         }
         if (const toml::node* w = find(c, t, p, "window")) r.window = read_box(c, *w, p.key("window"));
+        r.ejection_speed =
+            number(c, t, p, "ejection_speed", bounds_of(report_keys, "ejection_speed")).value_or(r.ejection_speed);
     }
 }
 

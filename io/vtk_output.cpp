@@ -468,6 +468,28 @@ void set_zone_cells(StateCellArrays& a, const World& w, const std::vector<int>& 
     }
 }
 
+/// The dynamic mode's cells: each one's peak speed over the run and the stage (a
+/// zone: its fastest node's) and whether it is ejected rock (core/ejecta.hpp).
+void add_peak_cells(vtkUnstructuredGrid* grid, const World& w, const std::vector<int>& kept,
+                    const std::vector<int>& zones) {
+    const auto nk = static_cast<vtkIdType>(kept.size()), n = nk + static_cast<vtkIdType>(zones.size());
+    auto run = double_array("peak_speed", n), stage = double_array("stage_peak_speed", n);
+    auto ejected = int_array("ejected", n);
+    const PeakVelocities& p = *w.peak;
+    const Ejecta e = measure_ejecta(w);
+    for (vtkIdType k = 0; k < nk; ++k) {
+        const int i = kept[k];
+        run->SetValue(k, p.block_run[i]), stage->SetValue(k, p.block_stage[i]), ejected->SetValue(k, e.ejected[i]);
+    }
+    for (std::size_t q = 0; q < zones.size(); ++q) {
+        double r = 0.0, s = 0.0;
+        for (int nd : w.zones.node[zones[q]]) r = std::max(r, p.node_run[nd]), s = std::max(s, p.node_stage[nd]);
+        const vtkIdType k = nk + vtkIdType(q);
+        run->SetValue(k, r), stage->SetValue(k, s), ejected->SetValue(k, 0);
+    }
+    add_cell_arrays(grid, run, stage, ejected);
+}
+
 } // namespace
 
 void write_state_blocks_vtu(const World& w, const fs::path& file) {
@@ -486,6 +508,7 @@ void write_state_blocks_vtu(const World& w, const fs::path& file) {
     set_rigid_block_cells(a, w, kept, stress);
     set_zone_cells(a, w, zones, nk);
     add_cell_arrays(grid, a.id, a.region, a.material, a.kind, a.disp, a.vel, a.rotation, a.sig, a.eps);
+    if (w.peak) add_peak_cells(grid, w, kept, zones);
     grid->GetFieldData()->AddArray(string_array("region_names", w.region_names, [](const std::string& x) { return x; }));
     write_grid(grid, file);
 }

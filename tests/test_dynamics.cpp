@@ -104,6 +104,7 @@ struct Record {
     double left_after = 0.0;    ///< ... once it has reached the top and had time to leave
     double supplied = 0.0, absorbed = 0.0, worst_balance = 0.0;
     double base_absorbed_in_transit = 0.0;
+    double recorded_peak_top = 0.0; ///< the world's own record (core/ejecta.hpp): the top node's peak speed
 };
 
 Record send_pulse(const std::string& text, const std::string& name) {
@@ -135,6 +136,7 @@ Record send_pulse(const std::string& text, const std::string& name) {
         }
         r.supplied = supplied, r.absorbed = absorbed, r.left_after = inside;
     }
+    r.recorded_peak_top = w.peak->node_run[top];
     return r;
 }
 
@@ -186,6 +188,14 @@ TEST_CASE("a free top reflects the pulse with twice its particle velocity, and k
     const Record r = send_pulse(false);
     MESSAGE("peak at the top ", r.peak_top, " m/s; left ", r.left_after, " J/m of ", carried);
     CHECK(std::abs(r.peak_top / (2.0 * v_in) - 1.0) < 0.02);
+    // The peak-velocity row saw the velocities this loop saw, every step (its
+    // speed |v|, the loop's |vy|: apart by the top node's lateral motion, 1e-4 of it).
+    CHECK(r.recorded_peak_top == doctest::Approx(r.peak_top).epsilon(1e-6));
+    test::record_check(test::Against::closed_form, "peak particle velocity at a free surface struck by a P pulse",
+                       "twice the incident particle velocity", "within 2%",
+                       test::figure(r.recorded_peak_top, 4) + " m/s of " + test::figure(2.0 * v_in, 3) + " (" +
+                           test::percent(r.recorded_peak_top, 2.0 * v_in) + ")",
+                       std::abs(r.recorded_peak_top / (2.0 * v_in) - 1.0) < 0.02);
     // On its way back down at 1.5 transit times: still all inside.
     CHECK(std::abs(r.left_after / carried - 1.0) < 0.01);
 }
@@ -753,6 +763,50 @@ TEST_CASE("a viscous boundary on a rigid block's face damps it as its dashpot ρ
                        test::figure(xi, 4) + " (" + test::percent(xi, 0.05) + ")", std::abs(xi / 0.05 - 1.0) < 0.01);
 }
 
+TEST_CASE("a block sprung off its base is ejected at the speed its spring's energy gives: ½ m v² = ½ kn L u0²") {
+    // The oscillator's 1 m block (m = 1000 kg/m) on a joint that takes no tension
+    // (coulomb), pressed 1 mm into its base (1 MPa on kn = 1e9 Pa/m): released, it
+    // leaves the base after a quarter period at v = u0 ω = 1 m/s and flies on, no
+    // force on it — detached rock moving at 1 m/s, its kinetic energy 500 J/m.
+    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/verification/oscillator.toml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string t = text.str();
+    t.replace(t.find("law = \"elastic\""), 15, "law = \"coulomb\"\nfriction = 30.0");
+    const auto m = test::build_model(t, "oscillator.toml");
+    Solver s(m.blocks, m.file.analysis);
+    StageObserver quiet;
+    run_stages(s, {m.file.analysis.stages[0]}, quiet);
+    const World& w = s.world();
+    while (w.clock.time < 0.005) s.step();
+    const int block = w.blocks.centroid0[0].y > w.blocks.centroid0[1].y ? 0 : 1;
+    const Ejecta e = measure_ejecta(w, std::nullopt, 0.5);
+    MESSAGE("ejected " << e.blocks << " block, " << e.mass << " kg/m at " << e.speed_mean << " m/s (peak "
+                       << e.peak_speed_max << "), " << e.kinetic << " J/m");
+    REQUIRE(e.blocks == 1);
+    CHECK(e.ejected[block] == 1);
+    CHECK(e.mass == doctest::Approx(1000.0));
+    CHECK(e.speed_mean == doctest::Approx(1.0).epsilon(0.01));
+    CHECK(e.kinetic == doctest::Approx(500.0).epsilon(0.02));
+    // In flight its speed is its peak: nothing slows it.
+    CHECK(e.peak_speed_max == doctest::Approx(e.speed_max).epsilon(1e-9));
+    CHECK(w.peak->block_time[block] < 0.003);
+    // Slower than the threshold, or moving away from an opening's centre below it: detached, not ejected.
+    const Ejecta slow = measure_ejecta(w, std::nullopt, 1.5);
+    CHECK(slow.blocks == 0);
+    CHECK(slow.detached_blocks == 1);
+    CHECK(slow.mass_faster[0] == doctest::Approx(1000.0)); // faster than 0.5 m/s
+    const Ejecta away = measure_ejecta(w, OpeningCircle{{0.5, -5.0}, 4.0}, 0.5);
+    CHECK(away.blocks == 0);
+    const Ejecta toward = measure_ejecta(w, OpeningCircle{{0.5, 6.0}, 4.0}, 0.5);
+    CHECK(toward.blocks == 1);
+    CHECK(toward.depth == doctest::Approx(6.0 - 0.5 - 4.0).epsilon(1e-9)); // its origin 1.5 m behind the wall
+    test::record_check(test::Against::closed_form, "ejection velocity of a block sprung off its base",
+                       "v = u0 √(kn L / m) = 1 m/s, ½ m v² = 500 J/m", "within 1% (speed), 2% (energy)",
+                       test::figure(e.speed_mean, 4) + " m/s, " + test::figure(e.kinetic, 4) + " J/m",
+                       std::abs(e.speed_mean - 1.0) < 0.01 && std::abs(e.kinetic / 500.0 - 1.0) < 0.02);
+}
+
 namespace {
 
 /// A column of rigid hexagons (size 0.3 m, the paper's kn and ks, elastic bonds)
@@ -911,6 +965,13 @@ TEST_CASE("a tunnel excavated at once: the energy account of its fragmenting roc
                      << e["error_in_stage"].get<double>() << " J/m");
     CHECK(cracks > 500);
     CHECK(error < 0.01);
+    // Its walls throw rock (core/ejecta.hpp), each ejected block no faster now than at its peak.
+    const auto& ej = rest["ejecta"];
+    MESSAGE("ejecta: " << ej["mass_t_per_m"].get<double>() << " t/m at " << ej["speed_mean"].get<double>() << " m/s");
+    CHECK(ej["mass_t_per_m"].get<double>() > 0.0);
+    CHECK(ej["peak_speed_mean"].get<double>() >= ej["speed_mean"].get<double>());
+    CHECK(ej["peak_speed_max"].get<double>() >= ej["speed_max"].get<double>());
+    CHECK(ej["mass_t_per_m"].get<double>() <= ej["detached_mass_t_per_m"].get<double>());
     test::record_check(test::Against::closed_form,
                        "energy account of the trigon tunnel excavated at once, 0.01 s of its burst",
                        "supplied = stored + spent (work of the loads, strain, kinetic, joints, radiated)",

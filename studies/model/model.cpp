@@ -289,6 +289,45 @@ nlohmann::json events_summary(const Events& ev) {
     return j;
 }
 
+/// "0.5 m/s": a speed as a key.
+std::string speed_label(double v) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%g m/s", v);
+    return s;
+}
+
+/// The rock a dynamic run threw (core/ejecta.hpp): its mass, speeds and kinetic
+/// energy, and around the opening of [report] its depth, the wall it came off,
+/// its weight and energy per m² of that wall; the fastest body's peak speed (PPV).
+nlohmann::json ejecta_summary(const World& w) {
+    const Ejecta e = measure_ejecta(w);
+    nlohmann::json j{{"blocks", e.blocks},
+                     {"mass_t_per_m", e.mass / 1000.0},
+                     {"speed_mean", e.speed_mean},
+                     {"speed_max", e.speed_max},
+                     {"peak_speed_mean", e.peak_speed_mean},
+                     {"peak_speed_max", e.peak_speed_max},
+                     {"kinetic_energy", e.kinetic},
+                     {"kinetic_energy_at_peak", e.kinetic_at_peak},
+                     {"ejection_speed", e.threshold},
+                     {"detached_blocks", e.detached_blocks},
+                     {"detached_mass_t_per_m", e.detached_mass / 1000.0}};
+    auto& faster = j["inward_mass_t_per_m_faster_than"];
+    for (std::size_t k = 0; k < e.mass_faster.size(); ++k)
+        faster[speed_label(ejecta_speed_steps[k])] = e.mass_faster[k] / 1000.0;
+    if (e.around_opening) {
+        j["depth"] = e.depth, j["mean_depth"] = e.mean_depth, j["wall_length"] = e.wall_length;
+        const double g = norm(w.settings.gravity) > 0.0 ? norm(w.settings.gravity) : 9.81;
+        j["weight_kN_per_m2"] = e.wall_length > 0.0 ? e.mass * g / e.wall_length / 1000.0 : 0.0;
+        j["kinetic_energy_kJ_per_m2"] = e.wall_length > 0.0 ? e.kinetic / e.wall_length / 1000.0 : 0.0;
+    }
+    double ppv = 0.0;
+    for (double s : w.peak->block_run) ppv = std::max(ppv, s);
+    for (double s : w.peak->node_run) ppv = std::max(ppv, s);
+    j["peak_particle_velocity_max"] = ppv;
+    return j;
+}
+
 /// The water in the joints: the network, its conducting pipes, the inflow, the highest pressure.
 nlohmann::json flow_summary(const JointFlow& flow) {
     const auto& st = flow.state;
@@ -380,6 +419,7 @@ nlohmann::json run_summary(const std::string& model_name, const io::ModelFile& f
     add_support_summaries(summary, w);
     const auto& rep = file.analysis.report;
     if (rep.opening) summary["opening"] = opening_summary(w, rep);
+    if (w.peak) summary["ejecta"] = ejecta_summary(w);
     return summary;
 }
 

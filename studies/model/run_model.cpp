@@ -548,6 +548,20 @@ void print_run_report(const Solver& solver, const nlohmann::json& summary, const
                          zone["region_edge_cells_damaged"].get<int>(), zone["region_edge_cells"].get<int>());
         }
     }
+    if (summary.contains("ejecta")) {
+        const auto& e = summary["ejecta"];
+        std::fprintf(stderr, "ejecta: %.3g t/m in %d blocks, at %.2f m/s (mass-weighted; fastest %.2f, peaks %.2f), "
+                             "kinetic energy %.3g kJ/m",
+                     e["mass_t_per_m"].get<double>(), e["blocks"].get<int>(), e["speed_mean"].get<double>(),
+                     e["speed_max"].get<double>(), e["peak_speed_mean"].get<double>(),
+                     e["kinetic_energy"].get<double>() / 1e3);
+        if (e.contains("wall_length") && e["wall_length"].get<double>() > 0.0)
+            std::fprintf(stderr, "; %.3g kN/m² and %.3g kJ/m² of the %.2f m of wall it came off, from up to %.2f m "
+                                 "deep",
+                         e["weight_kN_per_m2"].get<double>(), e["kinetic_energy_kJ_per_m2"].get<double>(),
+                         e["wall_length"].get<double>(), e["depth"].get<double>());
+        std::fprintf(stderr, "; PPV %.2f m/s\n", e["peak_particle_velocity_max"].get<double>());
+    }
     // Each installed set of every support type, its figures as summary.json has them.
     for (const auto& [type, sets] : support_summaries(solver.world()))
         for (const auto& set : sets) {
