@@ -113,7 +113,14 @@ EnergyAccount raw_account(const World& w) {
     a.work = w.clock.work, a.wave_input = wave_energy(w);
     a.kinetic = w.clock.steps > 0 ? w.clock.kinetic : integrated_kinetic_energy(w), a.strain = strain_energy(w), a.joints = dissipated_energy(w);
     a.damping = w.clock.damped, a.radiated = absorbed_energy(w);
-    a.error = a.work + a.wave_input - (a.kinetic + a.strain + a.joints + a.damping + a.radiated);
+    if (!w.ties.reaction.empty()) {
+        const SupportRock rock = support_rock(w);
+        for_each_support(w.supports, [&](auto type, const auto& state) {
+            using T = typename decltype(type)::type;
+            if (T::tie_count(state) > 0) a.supports += T::energy(state, rock);
+        });
+    }
+    a.error = a.work + a.wave_input - (a.kinetic + a.strain + a.joints + a.damping + a.radiated + a.supports);
     return a;
 }
 } // namespace

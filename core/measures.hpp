@@ -40,6 +40,7 @@ double wave_energy(const World& w);
 /// stresses or removes rock without work: the account starts again after it).
 struct EnergyAccount {
     double work = 0.0, wave_input = 0.0, kinetic = 0.0, strain = 0.0, joints = 0.0, damping = 0.0, radiated = 0.0;
+    double supports = 0.0; ///< the work the rock did on its supports (each type's energy: core/supports/support.hpp)
     double error = 0.0;
 };
 EnergyAccount energy_account(const World& w);

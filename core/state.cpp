@@ -26,7 +26,7 @@ namespace {
 // viscous boundaries' fields; D the monitor's samples with their model time (a
 // dynamic stage's verdict and its end in time); E the rigid faces' dashpots; F
 // the removed contacts' dissipated energy (the energy account); G the dynamic
-// mode's peak velocities.
+// mode's peak velocities and the bolts' energy (what they dissipated, per set).
 constexpr std::uint64_t magic_base = 0x62626d2d63687000ull; // "bbm-chp\0"
 constexpr std::uint64_t format = 'G';
 constexpr std::uint64_t magic = magic_base | format;

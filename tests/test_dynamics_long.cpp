@@ -17,16 +17,25 @@ using namespace bbm;
 
 namespace {
 
-/// examples/dynamics/strainburst.toml with its opening excavated over `relax_steps` (0: at once).
-nlohmann::json strainburst(long relax_steps) {
-    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/dynamics/strainburst.toml");
+/// A shipped example's text, examples/dynamics/`name`.
+std::string dynamics_example(const std::string& name) {
+    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/dynamics/" + name);
     std::stringstream buffer;
     buffer << in.rdbuf();
-    std::string text = buffer.str();
-    const std::string key = "relax_steps = 0\n";
-    const auto at = text.find(key);
+    return buffer.str();
+}
+
+/// `text` with its (first) `from` replaced by `to`, which must be there.
+std::string with(std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
     REQUIRE(at != std::string::npos);
-    text.replace(at, key.size(), "relax_steps = " + std::to_string(relax_steps) + "\n");
+    return text.replace(at, from.size(), to);
+}
+
+/// examples/dynamics/strainburst.toml with its opening excavated over `relax_steps` (0: at once).
+nlohmann::json strainburst(long relax_steps) {
+    const std::string text = with(dynamics_example("strainburst.toml"), "relax_steps = 0\n",
+                                  "relax_steps = " + std::to_string(relax_steps) + "\n");
     studies::Model m = studies::Model::from_text(text, "strainburst.toml", 2);
     m.run();
     return m.summary();
@@ -77,14 +86,8 @@ struct Shaking {
 
 /// examples/dynamics/tunnel_shaken.toml struck by its S wave of peak particle velocity `ppv`.
 Shaking shake(double ppv) {
-    std::ifstream in(std::string(BBM_SOURCE_DIR) + "/examples/dynamics/tunnel_shaken.toml");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    std::string text = buffer.str();
-    const std::string key = "velocity = 1.0\n";
-    const auto at = text.find(key);
-    REQUIRE(at != std::string::npos);
-    text.replace(at, key.size(), "velocity = " + std::to_string(ppv) + "\n");
+    const std::string text = with(dynamics_example("tunnel_shaken.toml"), "velocity = 1.0\n",
+                                  "velocity = " + std::to_string(ppv) + "\n");
     studies::Model m = studies::Model::from_text(text, "tunnel_shaken.toml", 2);
     const auto count = [&] {
         return cracks(m.solver().world(), contact::JointState::broken_tension) +
@@ -131,4 +134,47 @@ TEST_CASE("a dynamically triggered burst: the S wave of a remote event leaves a 
                            " and " + test::figure(high.summary["ejecta"]["mass_t_per_m"].get<double>(), 3) +
                            " t/m ejected at 2 m/s",
                        low.cracks_added <= 2 && high.cracks_added > 500);
+}
+
+namespace {
+
+/// examples/dynamics/strainburst_bolted.toml with `set` installed ("" : none).
+nlohmann::json bolted_burst(const std::string& set) {
+    std::string text = dynamics_example("strainburst_bolted.toml");
+    if (set.empty()) { // the install stage taken out
+        const auto at = text.find("[[stage]]\nname = \"bolting\"");
+        REQUIRE(at != std::string::npos);
+        text.erase(at, text.find("[[stage]]", at + 1) - at);
+    } else {
+        text = with(text, "supports = [\"d_bolts\"]", "supports = [\"" + set + "\"]");
+    }
+    studies::Model m = studies::Model::from_text(text, "strainburst_bolted.toml", 2);
+    m.run();
+    return m.summary();
+}
+
+} // namespace
+
+TEST_CASE("support in a strainburst: yielding bolts hold and keep most of the rock in, the energy they absorb "
+          "closing the account") {
+    const nlohmann::json none = bolted_burst(""), yielding = bolted_burst("d_bolts");
+    const auto ejected = [](const nlohmann::json& j) { return j["ejecta"]["mass_t_per_m"].get<double>(); };
+    const auto& y = yielding["yielding_bolts"][0];
+    MESSAGE("ejected: none " << ejected(none) << " t/m, yielding bolts " << ejected(yielding) << " (" << y.dump() << ")");
+    for (const auto* j : {&none, &yielding}) {
+        const auto& a = (*j)["energy_balance"];
+        CHECK(std::abs(a["error_in_stage"].get<double>()) < 0.01 * a["work"].get<double>());
+    }
+    CHECK(y["ruptured"].get<double>() == 0.0);
+    CHECK(y["energy_kJ"].get<double>() > 0.0);
+    CHECK(yielding["energy_balance"]["supports"].get<double>() ==
+          doctest::Approx(1e3 * y["energy_kJ"].get<double>()).epsilon(1e-9));
+    CHECK(ejected(yielding) < 0.25 * ejected(none));
+    const double error = std::abs(yielding["energy_balance"]["error_in_stage"].get<double>()) /
+                         yielding["energy_balance"]["work"].get<double>();
+    test::record_check(test::Against::closed_form, "energy account of the strainburst held by yielding bolts",
+                       "supplied = stored + spent, the bolts' work (∫ N dδ) among the sinks", "within 1% of the work",
+                       test::figure(100.0 * error, 2) + "%, the bolts " +
+                           test::figure(y["energy_kJ"].get<double>(), 3) + " kJ/m",
+                       error < 0.01);
 }

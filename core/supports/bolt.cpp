@@ -58,6 +58,7 @@ BoltState Bolts::make(const std::vector<BoltSetSpec>& specs) {
                           spec.density * spec.area / S, S, std::uint8_t(spec.cable)});
     }
     B.installed.assign(B.sets.size(), 0);
+    B.dissipated.assign(B.sets.size(), 0.0);
     return B;
 }
 
@@ -86,6 +87,7 @@ void Bolts::install(BoltState& B, int set, const HostFinder& find) {
             add_node(B.nodes, p, j == 0 || j == n ? 0.5 * segment : segment, h, set, false);
             B.applied.push_back({});
             B.slip.push_back(0.0);
+            B.across_energy.push_back(0.0);
             B.bond.push_back(0.0);
             B.tied.push_back((j == 0 && spec.face_plate) || (j == n && spec.end_anchor));
             if (j < n) {
@@ -111,6 +113,8 @@ void Bolts::force_pass(BoltState& B, const SupportRock& rock, Vec2* reaction, do
         const Vec2 d = N.position[a + 1] - N.position[a];
         const double l = norm(d), strain = l / B.rest[s] - 1.0;
         if (set.rupture_strain > 0.0 && strain > set.rupture_strain) {
+            // Its stored energy is released as it snaps.
+            B.dissipated[N.set[a]] += 0.5 * B.axial[s] * B.axial[s] * B.rest[s] / set.ea;
             B.state[s] = BoltState::broken;
             B.axial[s] = 0.0;
             continue;
@@ -119,7 +123,9 @@ void Bolts::force_pass(BoltState& B, const SupportRock& rock, Vec2* reaction, do
         if (set.cable && axial < 0.0) {
             axial = 0.0;
         } else if (set.yield_force > 0.0 && std::abs(axial) > set.yield_force) {
+            const double plastic = B.plastic[s];
             axial = support::plastic_return(axial, set.yield_force, set.ea, strain, B.plastic[s]);
+            B.dissipated[N.set[a]] += set.yield_force * std::abs(B.plastic[s] - plastic) * B.rest[s];
             B.state[s] = BoltState::yielded;
         }
         B.axial[s] = axial;
@@ -133,20 +139,46 @@ void Bolts::force_pass(BoltState& B, const SupportRock& rock, Vec2* reaction, do
             const TieHost& h = N.host[k];
             if (!rock.holds(h)) {
                 B.bond[k] = 0.0;
+                B.across_energy[k] = 0.0;
                 reaction[k] = {};
                 reaction_moment[k] = 0.0;
                 continue;
             }
             const auto& set = B.sets[N.set[k]];
             const Vec2 x = rock.position(h);
-            const auto g = support::grout(x - N.position[k], support::bar_axis(N.position, k, first, last),
-                                          set.bond_stiffness, set.bond_strength, set.normal_stiffness, B.tied[k], B.slip[k]);
+            const Vec2 t = support::bar_axis(N.position, k, first, last);
+            const double slip = B.slip[k];
+            const auto g = support::grout(x - N.position[k], t, set.bond_stiffness, set.bond_strength,
+                                          set.normal_stiffness, B.tied[k], B.slip[k]);
+            B.dissipated[N.set[k]] += std::abs(g.along) * std::abs(B.slip[k] - slip) * N.length[k];
+            B.across_energy[k] = 0.5 * norm2(g.across) / set.normal_stiffness * N.length[k];
             B.bond[k] = g.along;
             const Vec2 f = N.length[k] * g.per_metre;
             N.force[k] += f;
             rock.reaction(h, x, f, reaction[k], reaction_moment[k]);
         }
     }
+}
+
+double Bolts::set_energy(const BoltState& B, int set) {
+    const auto& N = B.nodes;
+    const auto& S = B.sets[set];
+    double e = B.dissipated[set];
+    for (int s = 0; s < B.segment_count(); ++s)
+        if (N.set[B.segment_node[s]] == set && B.state[s] != BoltState::broken)
+            e += 0.5 * B.axial[s] * B.axial[s] * B.rest[s] / S.ea;
+    // The grout's springs along the hole (its last force) and across it; the nodes' motion.
+    for (int k = 0; k < N.count(); ++k)
+        if (N.set[k] == set)
+            e += 0.5 * B.bond[k] * B.bond[k] / S.bond_stiffness * N.length[k] + B.across_energy[k] +
+                 0.5 * N.mass[k] * norm2(N.velocity[k]);
+    return e;
+}
+
+double Bolts::energy(const BoltState& B, const SupportRock&) {
+    double e = 0.0;
+    for (int set = 0; set < int(B.sets.size()); ++set) e += set_energy(B, set);
+    return e;
 }
 
 void Bolts::add_stiffness(BoltState& B, RockStiffness& rock) {
@@ -215,7 +247,8 @@ std::vector<SupportSetSummary> Bolts::summary(const BoltState& B) {
                         {"max_compression_kN", -min_axial / 1e3},
                         {"max_bond_kN_per_m", max_bond / 1e3},
                         {"yielded", double(yielded_bolts), true},
-                        {"broken", double(broken_bolts), true}}});
+                        {"broken", double(broken_bolts), true},
+                        {"energy_kJ", set_energy(B, int(set)) * spacing / 1e3}}});
     }
     return out;
 }

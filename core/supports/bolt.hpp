@@ -159,6 +159,11 @@ struct BoltState {
     // bolts: nodes [first[b], first[b + 1])
     std::vector<int> first{0}, bolt_set;
     std::vector<std::uint8_t> installed; ///< per set
+    /// Per set, dissipated so far: the steel's plastic work, the grout's slip, and
+    /// a segment's elastic energy when it ruptures, J/m (the energy account's).
+    std::vector<double> dissipated;
+    /// Per node, the energy in its grout's springs across the hole at the last force pass, J/m.
+    std::vector<double> across_energy;
 
     int node_count() const { return nodes.count(); }
     int segment_count() const { return static_cast<int>(rest.size()); }
@@ -194,8 +199,13 @@ struct Bolts {
     template <class S, class V>
     static void visit_fields(S& B, V&& v);
     static void after_load(State& s) { support::resize_node_scratch(s.nodes); }
+    /// Elastic in the segments and the grout, dissipated, the nodes' kinetic energy.
+    static double energy(const State& s, const SupportRock& rock);
+    /// The same for one set.
+    static double set_energy(const State& s, int set);
     /// Per installed set, per bolt: bolts, max_axial_kN, max_compression_kN,
-    /// max_bond_kN_per_m, yielded, broken (bolts with a yielded / broken segment).
+    /// max_bond_kN_per_m, yielded, broken (bolts with a yielded / broken segment);
+    /// energy_kJ, the work done on the set's bolts of one row (set_energy × spacing).
     static std::vector<SupportSetSummary> summary(const State& s);
     /// One line cell per segment, cell data axial_force_kN (per bolt, tension
     /// positive), state (0 elastic, 1 yielded, 2 broken), set, bolt; point data
@@ -231,6 +241,8 @@ void Bolts::visit_fields(S& B, V&& v) {
     v(FieldInfo{"bolts.state", G::other, E}, B.state);
     v(FieldInfo{"bolts.first", G::other, E}, B.first);
     v(FieldInfo{"bolts.bolt_set", G::other, E}, B.bolt_set);
+    v(FieldInfo{"bolts.dissipated", G::other, field_use::saved}, B.dissipated);
+    v(FieldInfo{"bolts.across_energy", G::other, field_use::saved}, B.across_energy);
     v(FieldInfo{"bolts.force", G::other, R}, B.nodes.force);
     v(FieldInfo{"bolts.stiffness", G::other, R}, B.nodes.stiffness);
 }

@@ -88,6 +88,9 @@ struct Dowels {
     template <class S, class V>
     static void visit_fields(S& D, V&& v);
     static void after_load(State& s) { support::resize_node_scratch(s.nodes); }
+    /// Its nodes' kinetic energy only: the elastic and plastic work of its
+    /// elements and interface are not yet in the energy account (docs/theory.md §19.1).
+    static double energy(const State& s, const SupportRock&) { return support::nodes_kinetic_energy(s.nodes); }
     /// Per set: dowels, largest tension and shear force (kN per bolt), largest
     /// moment (kN·m per bolt), largest grout force along and across the bar
     /// (kN/m per bolt), elements yielded and broken.

@@ -176,6 +176,9 @@ struct Liners {
     template <class S, class V>
     static void visit_fields(S& L, V&& v);
     static void after_load(State& s) { support::resize_node_scratch(s.nodes); }
+    /// Its nodes' kinetic energy only: the elastic and plastic work of its
+    /// elements and interface are not yet in the energy account (docs/theory.md §19.1).
+    static double energy(const State& s, const SupportRock&) { return support::nodes_kinetic_energy(s.nodes); }
     /// Per installed liner: nodes, max_thrust_kN_per_m, min_thrust_kN_per_m,
     /// max_moment_kNm_per_m, open_interface_nodes, elements, yielded_elements.
     static std::vector<SupportSetSummary> summary(const State& s);

@@ -29,7 +29,10 @@
 //   after_load           per-step scratch sized again after a checkpoint;
 //   summary, lines       its figures per set (summary.json) and its polylines
 //                        with named arrays (VTK, the picture, Python);
-//   compare              the figures `bbm compare` tabulates, over its sets.
+//   compare              the figures `bbm compare` tabulates, over its sets;
+//   energy               the work the rock has done on it so far (stored,
+//                        dissipated and its nodes' kinetic energy, J/m: the
+//                        energy account's supports, core/measures.hpp).
 // The solver calls them once per type per step (a compile-time loop over the
 // registry, no virtual call at all) and gathers the ties' reactions in tie
 // order, a fixed order on any thread count. The node integration, the masses and
@@ -268,6 +271,16 @@ double integrate_nodes(SupportNodes& n, const Sets& sets, const SupportMotion& m
         work += dot(loads.applied ? weight + (*loads.applied)[k] : weight, v) * dt;
     }
     return unbalanced;
+}
+
+/// The kinetic energy of a type's nodes (translation, and rotation if it bends), J/m.
+inline double nodes_kinetic_energy(const SupportNodes& n) {
+    double e = 0.0;
+    for (int k = 0; k < n.count(); ++k) {
+        e += 0.5 * n.mass[k] * norm2(n.velocity[k]);
+        if (!n.theta.empty()) e += 0.5 * n.inertia[k] * n.omega[k] * n.omega[k];
+    }
+    return e;
 }
 
 /// add_stiffness's start: the per-node stiffness scratch zeroed.

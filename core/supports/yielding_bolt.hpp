@@ -121,6 +121,12 @@ struct YieldingBolts {
     template <class S, class V>
     static void visit_fields(S& Y, V&& v);
     static void after_load(State&) {}
+    /// ∫ N dδ over its bolts (no nodes of its own: nothing kinetic).
+    static double energy(const State& s, const SupportRock&) {
+        double e = 0.0;
+        for (double x : s.energy) e += x;
+        return e;
+    }
     /// Per installed set, per bolt: bolts, max_axial_kN, max_slip_mm, energy_kJ
     /// (absorbed by the set), max_energy_kJ (by one bolt), yielding, ruptured.
     static std::vector<SupportSetSummary> summary(const State& s);

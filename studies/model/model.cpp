@@ -368,7 +368,8 @@ void add_part_summaries(nlohmann::json& summary, const World& w, const std::vect
         const double scale = std::max({std::abs(a.work + a.wave_input), a.kinetic + a.strain, 1e-300});
         summary["energy_balance"] = {{"work", a.work},       {"wave_input", a.wave_input}, {"kinetic", a.kinetic},
                                      {"strain", a.strain},   {"joints", a.joints},         {"damping", a.damping},
-                                     {"radiated", a.radiated}, {"error_in_stage", a.error},
+                                     {"radiated", a.radiated}, {"supports", a.supports},
+                                     {"error_in_stage", a.error},
                                      {"relative_error", std::abs(a.error) / scale}};
     }
     if (w.viscous.count() > 0) {
