@@ -202,6 +202,10 @@ struct StageSpec {
     std::vector<std::string> supports; ///< install: names of support sets (of any registered type)
     double duration = 0.0;             ///< creep: the creep time it runs, s
     double loss = 0.02;                ///< creep: the largest fraction of a bond's section one creep step takes
+    /// creep: mechanical steps after a creep step that find no rest: the rock is
+    /// failing under its held load (a pillar whose strata follow it down moves too
+    /// slowly for the collapse test), and the stage ends with its time to failure.
+    long settle_steps = 200000;
 };
 
 /// [report]: what `bbm run` measures and draws around an opening (optional;

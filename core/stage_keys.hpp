@@ -56,6 +56,11 @@ inline constexpr StageKey stage_keys[] = {
      .meaning = "The largest fraction of a bond's intact section one creep step takes (divided by β s where "
                 "the rate is steeper): halving it checks the time steps' convergence",
      .absent = "0.02"},
+    {.key = "settle_steps", .kind = KeyKind::integer, .bounds = at_least(1000, " steps"), .only = "creep",
+     .meaning = "Mechanical steps after a creep step in which the model does not come back to rest mean it is "
+                "failing under its held load, as a collapse does: the stage ends there, its creep time the time to "
+                "failure (a pillar whose roof follows it down fails too slowly for the collapse test)",
+     .absent = "200000"},
     {.key = "until", .kind = KeyKind::choice, .only = "solve",
      .meaning = "ratio: stop at the model's ratio; rest: also once the rock mass is at rest, no crack in the last "
                 "quiet_steps and the ratio of the rock mass without its detached fragments at ratio (theory.md "

@@ -168,7 +168,8 @@ private:
     /// A rock failing under its held load: a body moving a quarter of the
     /// detection tolerance in one step (a quasi-static model at rest moves by
     /// elastic amounts only; the run's health check stops one at the whole
-    /// tolerance), where a creep stage ends with its time to failure.
+    /// tolerance), where a creep stage ends with its time to failure; so does one
+    /// that finds no rest within settle_steps of a creep step (run_steps).
     bool creep_collapsing() const {
         const double limit = 0.25 * w_.detection.tolerance / w_.clock.dt;
         for (int i = 0; i < w_.bodies.count(); ++i)
@@ -196,7 +197,7 @@ private:
             s_.step();
             if (creep) {
                 w_.creep->due = 0, ++w_.creep->since;
-                if (creep_collapsing()) {
+                if (creep_collapsing() || w_.creep->since > st_.settle_steps) {
                     r_.failed = true;
                     ++r_.steps, cursor_.step = k;
                     return;

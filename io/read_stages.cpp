@@ -169,6 +169,7 @@ StageSpec read_stage(Ctx& c, const toml::table& t, const Path& p, std::size_t in
         s.loss = number(c, t, p, "loss", bounds("loss")).value_or(s.loss);
         s.ratio = number(c, t, p, "ratio", bounds("ratio")).value_or(s.ratio);
         s.max_steps = whole_number(c, t, p, "max_steps", bounds("max_steps")).value_or(10000000);
+        s.settle_steps = whole_number(c, t, p, "settle_steps", bounds("settle_steps")).value_or(s.settle_steps);
         break;
     }
     return s;
