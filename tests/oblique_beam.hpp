@@ -43,7 +43,8 @@ namespace bbm::test::oblique {
 
 
 inline constexpr double young = 10e9, poisson = 0.25, density = 2500.0;
-constexpr double lame = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)), shear = young / (2.0 * (1.0 + poisson));
+inline constexpr double lame = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+inline constexpr double shear = young / (2.0 * (1.0 + poisson));
 inline const double c_p = std::sqrt((lame + 2.0 * shear) / density), c_s = std::sqrt(shear / density);
 
 enum class Wave { p, s };
@@ -59,7 +60,8 @@ inline std::array<double, 2> lysmer_kuhlemeyer(Wave incident, double theta) {
         std::array<C, 2> residual; ///< σxx + ρ c_p v_x, σxy + ρ c_s v_y per unit amplitude
         C kx;
     };
-    // `outgoing` waves travel to −x: k_x = −√(1/c² − k_y²), or −i√(k_y² − 1/c²) (evanescent, decaying into x < 0).
+    // `outgoing` waves travel to −x: k_x = −√(1/c² − k_y²), or −i√(k_y² − 1/c²)
+    // (evanescent, decaying into x < 0).
     const auto plane = [&](double c, bool p_wave, bool outgoing) {
         const C root = std::sqrt(C(1.0 / (c * c) - ky * ky));
         C kx = outgoing ? -root : root;
@@ -179,7 +181,9 @@ inline Result strike(Wave wave, double theta_degrees, double mesh, double width 
     // The model's extent: every point of the beam along its path until it meets
     // x = 0, then along its reflection (both kinds) until `duration`.
     double x_min = 0.0, y_min = 0.0, y_max = 0.0;
-    const auto include = [&](Vec2 p) { x_min = std::min(x_min, p.x), y_min = std::min(y_min, p.y), y_max = std::max(y_max, p.y); };
+    const auto include = [&](Vec2 p) {
+        x_min = std::min(x_min, p.x), y_min = std::min(y_min, p.y), y_max = std::max(y_max, p.y);
+    };
     const double other = wave == Wave::p ? c_s : c_p, sin_other = std::sin(b.theta) * other / b.speed();
     for (int i = -6; i <= 6; ++i)
         for (int j = -20; j <= 20; ++j) {

@@ -202,7 +202,8 @@ TEST_CASE("P and S beams striking a viscous boundary at 30 and 60 degrees reflec
                 100 * extrapolated, "% extrapolated; theory ", 100 * expected, "% for the beam, ",
                 100 * fine.expected_plane, "% for a plane wave; account ", 100 * fine.account, "%, ", fine.zones,
                 " zones");
-        const double error_fine = std::abs(fine.measured - expected), error_coarse = std::abs(coarse.measured - expected);
+        const double error_fine = std::abs(fine.measured - expected);
+        const double error_coarse = std::abs(coarse.measured - expected);
         const bool within = error_fine < 0.05 * expected;
         const bool converging = error_fine < 0.8 * error_coarse &&
                                 std::abs(extrapolated - expected) < std::max(0.15 * expected, 0.001);
@@ -215,7 +216,7 @@ TEST_CASE("P and S beams striking a viscous boundary at 30 and 60 degrees reflec
         measured += bbm::test::percent(fine.measured, expected) + "), " + bbm::test::figure(100 * coarse.measured, 3);
         measured += "% on 0.3 m, " + bbm::test::figure(100 * extrapolated, 3) + "% extrapolated";
         bbm::test::record_check(bbm::test::Against::closed_form,
-                                "energy a " + name + " beam reflects off a viscous boundary", reference,
+                                "energy reflected off a viscous boundary by a beam, " + name, reference,
                                 "within 5% on 0.15 m, or (P) converging: its error a fifth smaller than on 0.3 m "
                                 "and the extrapolation within 15%",
                                 measured, within || (wave == Wave::p && converging));
