@@ -178,6 +178,28 @@ TEST_CASE("a creep stage resumed from a checkpoint, on 1 or 2 threads, ends in t
     test::check_exact_restart({m.blocks, m.file.analysis}, {steps / 3, 2 * steps / 3}, {1, 2});
 }
 
+TEST_CASE("a creep stage that finds no rest within settle_steps of its last creep step ends as a failure") {
+    // An equilibrium it cannot reach (a ratio below round-off): without a creep
+    // step the model never rests, and after settle_steps mechanical steps the
+    // stage ends failed, at the creep time it had (none); with the default
+    // 200,000 the same 3,000-step stage just runs out of steps.
+    const auto run = [](const std::string& settle) {
+        std::string text = bonded_pair(0.8, 0.0, 1.0, 0.02, 3000);
+        text.replace(text.find("ratio = 1e-7"), 12, "ratio = 1e-300" + settle);
+        const auto m = test::build_model(text, "creep.toml");
+        Solver s(m.blocks, m.file.analysis);
+        StageObserver quiet;
+        return run_stages(s, m.file.analysis.stages, quiet).back();
+    };
+    const StageReport cut = run("\nsettle_steps = 1000");
+    CHECK(cut.failed);
+    CHECK(cut.steps == 1001);
+    CHECK(cut.creep_steps == 0);
+    const StageReport whole = run("");
+    CHECK_FALSE(whole.failed);
+    CHECK(whole.steps == 3000);
+}
+
 TEST_CASE("stress corrosion's bad input is refused with its key") {
     auto error = [](const std::string& text) -> std::string {
         try {
@@ -199,6 +221,7 @@ TEST_CASE("stress corrosion's bad input is refused with its key") {
     CHECK(error(with("corrosion_rate = 1e-6", "corrosion_rate = -1e-6")).find("corrosion_rate") != std::string::npos);
     CHECK(error(with("duration = 1.000000", "duration = 0.0")).find("duration") != std::string::npos);
     CHECK(error(with("loss = 0.020000", "loss = 0.0")).find("loss") != std::string::npos);
+    CHECK(error(with("ratio = 1e-7", "ratio = 1e-7\nsettle_steps = 10")).find("settle_steps") != std::string::npos);
     const std::string no_corrosion = error(with("law = \"stress_corrosion\"", "law = \"softening\""));
     // A softening set does not read the corrosion keys; without them, the creep
     // stage is refused by its type.
